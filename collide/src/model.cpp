@@ -1,0 +1,105 @@
+// The surface-tagged model: the small operations every module shares.
+#include "cadclash/collide.h"
+
+#include <cassert>
+#include <map>
+
+namespace cadclash {
+
+std::string format_diagnostic(const Diagnostic& d) {
+  std::string out = d.file.empty() ? std::string("<input>") : d.file;
+  if (d.line > 0) out += ":" + std::to_string(d.line);
+  out += ": ";
+  if (d.step_id >= 0) out += "#" + std::to_string(d.step_id) + ": ";
+  out += d.severity == Severity::Error ? "error: " : "warning: ";
+  out += d.message;
+  return out;
+}
+
+bool has_error(std::span<const Diagnostic> ds) {
+  for (const Diagnostic& d : ds)
+    if (d.severity == Severity::Error) return true;
+  return false;
+}
+
+const char* source_kind_name(SourceKind kind) {
+  switch (kind) {
+    case SourceKind::StepFace: return "step-face";
+    case SourceKind::IgesFace: return "iges-face";
+    case SourceKind::BrepFace: return "brep-face";
+    case SourceKind::ObjGroup: return "obj-group";
+    case SourceKind::OffColourGroup: return "off-colour-group";
+    case SourceKind::MeshFile: return "mesh";
+    case SourceKind::Segment: return "segment";
+  }
+  return "unknown";
+}
+
+void append_model(Model& into, Model from, const std::string& path_prefix) {
+  const auto part_shift = static_cast<PartId>(into.parts.size());
+  const auto surface_shift = static_cast<SurfaceId>(into.surfaces.size());
+  for (Part& p : from.parts) {
+    p.first_surface += surface_shift;
+    into.parts.push_back(std::move(p));
+  }
+  for (Surface& s : from.surfaces) {
+    s.part += part_shift;
+    if (s.provenance.parent != kInvalidId) s.provenance.parent += surface_shift;
+    into.surfaces.push_back(std::move(s));
+  }
+  for (Instance& i : from.instances) {
+    i.part += part_shift;
+    if (!path_prefix.empty()) i.path = path_prefix + i.path;
+    into.instances.push_back(std::move(i));
+  }
+}
+
+Aabb mesh_aabb(const TriangleMesh& mesh) {
+  Aabb box;
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) box.extend(mesh.vertices[v]);
+  return box;
+}
+
+std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
+                                          double deflection) {
+  // Group the missing surfaces by part: a source is thread-safe across parts, not within one.
+  std::map<PartId, std::vector<SurfaceId>> by_part;
+  for (SurfaceId s : surfaces) {
+    assert(s < model.surfaces.size());
+    const Surface& surf = model.surfaces[s];
+    if (!surf.has_triangles && model.parts[surf.part].source) by_part[surf.part].push_back(s);
+  }
+  std::vector<std::pair<PartId, std::vector<SurfaceId>>> work(by_part.begin(), by_part.end());
+  std::vector<std::vector<Diagnostic>> errors(work.size());
+
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t w = 0; w < static_cast<std::ptrdiff_t>(work.size()); ++w) {
+    const auto& [part_id, ids] = work[static_cast<std::size_t>(w)];
+    const Part& part = model.parts[part_id];
+    for (SurfaceId s : ids) {
+      Surface& surf = model.surfaces[s];
+      TriangleMesh mesh;
+      double achieved = 0.0;
+      Diagnostic error;
+      if (part.source->triangulate(s - part.first_surface, deflection, mesh, achieved, error)) {
+        surf.mesh = std::move(mesh);
+        surf.deflection = achieved;
+        surf.has_triangles = true;
+      } else {
+        errors[static_cast<std::size_t>(w)].push_back(std::move(error));
+      }
+    }
+  }
+  std::vector<Diagnostic> out;
+  for (auto& e : errors) out.insert(out.end(), e.begin(), e.end());
+  return out;
+}
+
+std::size_t triangle_count(const Model& model) {
+  std::size_t n = 0;
+  for (const Surface& s : model.surfaces) n += s.mesh.triangles.size();
+  return n;
+}
+
+}  // namespace cadclash

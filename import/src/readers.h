@@ -1,0 +1,22 @@
+// Per-format readers behind import_file(). Internal to cadclash::import.
+#pragma once
+
+#include "cadclash/import.h"
+
+namespace cadclash::detail {
+
+ImportResult read_obj(const std::string& path, const ImportOptions& options);
+ImportResult read_off(const std::string& path, const ImportOptions& options);
+ImportResult read_assimp_mesh(const std::string& path, const ImportOptions& options);  // stl, ply, gltf, glb, ...
+ImportResult read_cadclash_glb(const std::string& path, const ImportOptions& options);  // our own .glb, exact round trip
+ImportResult read_step(const std::string& path, const ImportOptions& options);
+ImportResult read_iges(const std::string& path, const ImportOptions& options);
+ImportResult read_brep(const std::string& path, const ImportOptions& options);
+
+// Returns true if `path` is a .glb that cadclash wrote (asset.generator starts with "cadclash").
+bool is_cadclash_glb(const std::string& path);
+
+// An ImportResult holding only an error about `path`.
+ImportResult failed_import(const std::string& path, std::string message);
+
+}  // namespace cadclash::detail

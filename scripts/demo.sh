@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# README command 1: set up, build (Release) and run the main job on a bundled real assembly.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+"$root/scripts/setup.sh"
+"$root/scripts/build.sh" "$root/build" -DCADCLASH_BUILD_TESTS=OFF -DCADCLASH_BUILD_BENCH=OFF >/dev/null
+exec "$root/build/tools/cadclash" check "$root/data/external/as1-tu-203.stp" "$@"

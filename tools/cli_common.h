@@ -1,0 +1,44 @@
+// Shared pieces of the cadclash subcommands.
+#pragma once
+
+#include "cadclash/import.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace cadclash::cli {
+
+// Exit codes of every subcommand.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInputError = 1;
+inline constexpr int kExitUsage = 2;
+
+// Options every subcommand that reads files shares.
+struct InputOptions {
+  std::vector<std::string> files;
+  double deflection = 0.1;
+  bool relative = false;
+  double angular = 0.5;
+  std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
+  bool lazy = false;
+};
+
+// Adds FILE... and the tessellation switches to `cmd`, bound to `in`.
+void add_input_options(CLI::App& cmd, InputOptions& in);
+
+// Imports the files, printing every diagnostic to stderr. Returns the result.
+ImportResult import_inputs(const InputOptions& in);
+
+// Prints diagnostics to stderr, one line each.
+void print_diagnostics(const std::vector<Diagnostic>& ds);
+
+// True when stderr is a terminal (progress is shown only then).
+bool stderr_is_terminal();
+
+void register_info(CLI::App& app);
+void register_tessellate(CLI::App& app);
+void register_check(CLI::App& app);
+
+}  // namespace cadclash::cli
