@@ -8,9 +8,6 @@ ImportResult read_off(const std::string& p, const ImportOptions&) { return faile
 ImportResult read_assimp_mesh(const std::string& p, const ImportOptions&) { return failed_import(p, "mesh import not built yet"); }
 ImportResult read_cadclash_glb(const std::string& p, const ImportOptions&) { return failed_import(p, "glb import not built yet"); }
 bool is_cadclash_glb(const std::string&) { return false; }
-ImportResult read_step(const std::string& p, const ImportOptions&) { return failed_import(p, "STEP import not built yet"); }
-ImportResult read_iges(const std::string& p, const ImportOptions&) { return failed_import(p, "IGES import not built yet"); }
-ImportResult read_brep(const std::string& p, const ImportOptions&) { return failed_import(p, "BREP import not built yet"); }
 }  // namespace detail
 std::vector<Diagnostic> export_model(const Model&, const std::string& p) { return {{Severity::Error, p, 0, -1, "export not built yet"}}; }
 }  // namespace cadclash
