@@ -34,6 +34,7 @@ if [ ! -f "$stamp" ]; then
   echo "setup: fetching sample CAD data (${data_packages[*]}) into data/external" >&2
   work=$(mktemp -d)
   trap 'rm -rf "$work"' EXIT
+  chmod 755 "$work"  # apt's sandbox user must be able to write the downloads here
   if [ ${#missing[@]} -eq 0 ]; then "${sudo_cmd[@]}" apt-get update -qq; fi
   (cd "$work" && apt-get download -qq "${data_packages[@]}" >/dev/null)
   for deb in "$work"/*.deb; do dpkg -x "$deb" "$work/x"; done

@@ -15,9 +15,16 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_option("--preset", in.preset, "Tessellation preset (overrides --deflection/--angular)")
       ->check(CLI::IsMember({"coarse", "normal", "fine", "very-fine"}));
   cmd.add_flag("--lazy", in.lazy, "Tessellate B-rep faces only when a query needs them");
+  cmd.add_flag("--repair", in.repair,
+               "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
+  cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
+  cmd.add_flag("--segment", in.segment, "Cut mesh surfaces into patches at sharp edges");
+  cmd.add_option("--sharp-angle", in.sharp_angle, "With --segment: dihedral angle that makes an edge sharp, degrees")
+      ->check(CLI::Range(1.0, 179.0));
+  cmd.add_flag("--planar", in.planar, "With --segment: also split patches into planar regions");
 }
 
-ImportResult import_inputs(const InputOptions& in) {
+ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report, SegmentReport* segment_report) {
   ImportOptions options;
   options.tessellation.linear_deflection = in.deflection;
   options.tessellation.relative = in.relative;
@@ -25,6 +32,33 @@ ImportResult import_inputs(const InputOptions& in) {
   options.lazy = in.lazy;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
+  if (in.repair) {
+    MeshRepairOptions repair_options;
+    repair_options.fill_holes = in.fill_holes;
+    MeshRepairReport r = repair_meshes(result.model, repair_options);
+    print_diagnostics(r.diagnostics);
+    std::size_t changed = 0;
+    for (const SurfaceRepairStats& s : r.per_surface) changed += s.changed ? 1 : 0;
+    const SurfaceRepairStats& t = r.total;
+    std::cerr << "repair: " << changed << " of " << r.per_surface.size() << " mesh surfaces changed: "
+              << t.merged_points << " merged points, " << t.unused_points << " unused points, " << t.degenerate_faces
+              << " degenerate and " << t.duplicate_faces << " repeated triangles removed, " << t.flipped_faces
+              << " flipped, " << t.stitched_edges << " edges stitched, " << t.duplicated_vertices
+              << " vertices duplicated";
+    if (in.fill_holes) std::cerr << ", " << t.filled_holes << " holes filled with " << t.hole_faces << " triangles";
+    std::cerr << '\n';
+    if (repair_report) *repair_report = std::move(r);
+  }
+  if (in.segment) {
+    SegmentOptions segment_options;
+    segment_options.sharp_angle_degrees = in.sharp_angle;
+    segment_options.planar = in.planar;
+    SegmentReport r = segment_surfaces(result.model, segment_options);
+    print_diagnostics(r.diagnostics);
+    std::cerr << "segment: " << r.surfaces_split << " of " << r.surfaces.size() << " surfaces split into " << r.patches
+              << " patches\n";
+    if (segment_report) *segment_report = std::move(r);
+  }
   return result;
 }
 

@@ -23,13 +23,22 @@ struct InputOptions {
   double angular = 0.5;
   std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
   bool lazy = false;
+  // Mesh post-processing (mesh parts only; see tessellate.h).
+  bool repair = false;
+  bool fill_holes = false;  // with --repair
+  bool segment = false;
+  double sharp_angle = 60.0;  // degrees
+  bool planar = false;        // with --segment
 };
 
 // Adds FILE... and the tessellation switches to `cmd`, bound to `in`.
 void add_input_options(CLI::App& cmd, InputOptions& in);
 
-// Imports the files, printing every diagnostic to stderr. Returns the result.
-ImportResult import_inputs(const InputOptions& in);
+// Imports the files, printing every diagnostic to stderr, then repairs and segments the mesh parts
+// when asked (printing what changed to stderr). Returns the result; `repair_report` / `segment_report`,
+// when given, receive what repair and segmentation did (left empty without --repair / --segment).
+ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report = nullptr,
+                           SegmentReport* segment_report = nullptr);
 
 // Prints diagnostics to stderr, one line each.
 void print_diagnostics(const std::vector<Diagnostic>& ds);

@@ -1,18 +1,343 @@
-// cadclash check: placeholder until the collide narrow phase lands (issue 4).
+// cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
 #include "cli_common.h"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <sstream>
 
 namespace cadclash::cli {
+namespace {
+
+// Version of the JSON report; see docs/report-schema.md. Bump on any incompatible change.
+constexpr int kReportVersion = 1;
+// Exit code of --fail-on-collision when a penetrating or touching pair (or containment) was found.
+constexpr int kExitCollision = 3;
+
+struct CheckOptions {
+  InputOptions in;
+  double tolerance = 0.0;
+  double clearance = 0.0;
+  int threads = 0;
+  std::string path_csv;
+  bool all_triangles = false;
+  std::string json;
+  bool no_timings = false;
+  bool fail_on_collision = false;
+  bool brute_force = false;
+  bool no_containment = false;
+  std::string parallel = "v1";
+  std::string schedule = "guided";
+  std::string triangle_level = "auto";
+  std::vector<std::string> select_a, select_b, exclude_under;
+};
+
+bool path_under(const std::string& path, const std::string& prefix) {
+  return path.compare(0, prefix.size(), prefix) == 0 &&
+         (path.size() == prefix.size() || path[prefix.size()] == '/' || prefix.back() == '/');
+}
+
+std::vector<InstanceId> select(const Model& m, const std::vector<std::string>& prefixes) {
+  std::vector<InstanceId> out;
+  for (InstanceId i = 0; i < m.instances.size(); ++i)
+    for (const std::string& p : prefixes)
+      if (path_under(m.instances[i].path, p)) {
+        out.push_back(i);
+        break;
+      }
+  return out;
+}
+
+CollideOptions collide_options(const CheckOptions& o) {
+  CollideOptions c;
+  c.tolerance = o.tolerance;
+  c.clearance = o.clearance;
+  c.threads = o.threads;
+  c.mode = o.all_triangles ? CollideMode::AllTrianglePairs : CollideMode::EarlyExit;
+  c.version = o.parallel == "v2" ? ParallelVersion::V2 : ParallelVersion::V1;
+  c.schedule = o.schedule == "dynamic" ? Schedule::Dynamic : o.schedule == "static" ? Schedule::Static : Schedule::Guided;
+  c.triangle_level = o.triangle_level == "flat" ? TriangleLevel::Flat
+                     : o.triangle_level == "bvh" ? TriangleLevel::Bvh
+                                                 : TriangleLevel::Auto;
+  c.use_oaabb = !o.brute_force;
+  c.detect_containment = !o.no_containment;
+  if (!o.in.relative) {
+    c.deflection_hint = o.in.deflection;
+    c.tessellation_deflection = o.in.deflection;
+  }
+  return c;
+}
+
+// "#123" for STEP faces, the group name for mesh groups, else the face index.
+std::string source_label(const Surface& s) {
+  if (s.provenance.step_id >= 0) return "#" + std::to_string(s.provenance.step_id);
+  if (!s.provenance.source_name.empty()) return s.provenance.source_name;
+  return "face " + std::to_string(s.provenance.face_index);
+}
+
+nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json side_json(const Model& m, InstanceId i, SurfaceId s) {
+  const Instance& inst = m.instances[i];
+  nlohmann::json j{{"instance", inst.path}, {"part", m.parts[inst.part].name}};
+  if (s == kInvalidId) return j;
+  const Surface& surf = m.surfaces[s];
+  j["surface"] = surf.name;
+  j["kind"] = source_kind_name(surf.provenance.kind);
+  j["face_index"] = surf.provenance.face_index;
+  if (surf.provenance.step_id >= 0) j["step_id"] = surf.provenance.step_id;
+  if (!surf.provenance.source_name.empty()) j["source_name"] = surf.provenance.source_name;
+  j["deflection"] = surf.deflection;
+  return j;
+}
+
+struct ClassCounts {
+  std::size_t c[4] = {0, 0, 0, 0};
+  void add(const Report& r) {
+    for (const SurfacePairResult& p : r.pairs) ++c[static_cast<int>(p.contact)];
+  }
+  bool collision() const { return c[0] + c[1] + c[3] > 0; }
+};
+
+nlohmann::json summary_json(const Report& r) {
+  ClassCounts n;
+  n.add(r);
+  return {{"pairs", r.pairs.size()},   {"penetrating", n.c[0]}, {"touching", n.c[1]},
+          {"clearance", n.c[2]},       {"containment", n.c[3]}};
+}
+
+nlohmann::json counters_json(const CollideCounters& c) {
+  return {{"instance_pairs", c.instance_pairs},   {"aabb_tests", c.aabb_tests},
+          {"aabb_updates", c.aabb_updates},       {"surfaces_a", c.surfaces_a},
+          {"surfaces_b", c.surfaces_b},           {"surface_pairs", c.surface_pairs},
+          {"triangles_a", c.triangles_a},         {"triangles_b", c.triangles_b},
+          {"triangle_tests", c.triangle_tests},   {"exact_fallbacks", c.exact_fallbacks},
+          {"distance_tests", c.distance_tests},   {"intersecting_pairs", c.intersecting_pairs},
+          {"tessellated_surfaces", c.tessellated_surfaces}};
+}
+
+nlohmann::json timings_json(const CollideTimings& t) {
+  return {{"broad", t.broad},
+          {"surface_level", t.surface_level},
+          {"tessellation", t.tessellation},
+          {"triangle_level", t.triangle_level},
+          {"total", t.total}};
+}
+
+nlohmann::json pairs_json(const Model& m, const Report& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SurfacePairResult& p : r.pairs) {
+    nlohmann::json j{{"a", side_json(m, p.instance_a, p.surface_a)},
+                     {"b", side_json(m, p.instance_b, p.surface_b)},
+                     {"class", contact_class_name(p.contact)},
+                     {"intersecting", p.intersecting},
+                     {"distance", number_or_null(p.distance)},
+                     {"penetration", p.penetration}};
+    if (p.exact_distance) j["exact_distance"] = *p.exact_distance;
+    if (!p.triangle_pairs.empty()) j["triangle_pairs"] = p.triangle_pairs;
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+std::string fmt(double v) {
+  if (!std::isfinite(v)) return "-";
+  std::ostringstream s;
+  s << std::setprecision(4) << v;
+  return s.str();
+}
+
+void print_table(const Model& m, const Report& r, std::ostream& os) {
+  InstanceId ca = kInvalidId, cb = kInvalidId;
+  for (const SurfacePairResult& p : r.pairs) {
+    if (p.instance_a != ca || p.instance_b != cb) {
+      ca = p.instance_a;
+      cb = p.instance_b;
+      const Instance& a = m.instances[ca];
+      const Instance& b = m.instances[cb];
+      os << '\n' << a.path << " (" << m.parts[a.part].name << ")  x  " << b.path << " (" << m.parts[b.part].name << ")\n";
+      os << "  " << std::left << std::setw(12) << "class" << std::setw(11) << "distance" << std::setw(34)
+         << "surface A" << "surface B\n";
+    }
+    auto side = [&](SurfaceId s) {
+      if (s == kInvalidId) return std::string("(whole part)");
+      return m.surfaces[s].name + " [" + source_label(m.surfaces[s]) + "]";
+    };
+    std::string dist = p.contact == ContactClass::Penetrating ? "-" + fmt(p.penetration) : fmt(p.distance);
+    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(11) << dist
+       << std::setw(34) << side(p.surface_a) << side(p.surface_b) << '\n';
+  }
+}
+
+void print_summary(const Report& r, bool timings, std::ostream& os) {
+  ClassCounts n;
+  n.add(r);
+  const CollideCounters& c = r.counters;
+  os << "\n" << r.pairs.size() << " reported pairs: " << n.c[0] << " penetrating, " << n.c[1] << " touching, "
+     << n.c[2] << " clearance, " << n.c[3] << " containment\n";
+  os << "counters: instance pairs " << c.instance_pairs << ", AABB tests " << c.aabb_tests << ", AABB updates "
+     << c.aabb_updates << ", msA " << c.surfaces_a << ", msB " << c.surfaces_b << ", surface pairs " << c.surface_pairs
+     << ", mpSk " << c.triangles_a << ", mpSl " << c.triangles_b << ", triangle tests " << c.triangle_tests
+     << ", exact fallbacks " << c.exact_fallbacks << ", distance tests " << c.distance_tests
+     << ", intersecting surface pairs " << c.intersecting_pairs << ", tessellated on demand "
+     << c.tessellated_surfaces << '\n';
+  if (timings)
+    os << "time: " << fmt(r.timings.total * 1e3) << " ms (broad " << fmt(r.timings.broad * 1e3) << ", surfaces "
+       << fmt(r.timings.surface_level * 1e3) << ", tessellation " << fmt(r.timings.tessellation * 1e3)
+       << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
+}
+
+int run_check(const CheckOptions& o) {
+  ImportResult imported = import_inputs(o.in);
+  bool input_error = has_error(imported.diagnostics);
+  Model& m = imported.model;
+  if (m.instances.empty()) {
+    std::cerr << "cadclash check: no instances to check\n";
+    return kExitInputError;
+  }
+
+  std::vector<TrajectoryRow> rows;
+  if (!o.path_csv.empty()) {
+    std::ifstream f(o.path_csv, std::ios::binary);
+    if (!f) {
+      std::cerr << o.path_csv << ": error: cannot open trajectory\n";
+      return kExitInputError;
+    }
+    std::stringstream text;
+    text << f.rdbuf();
+    std::vector<Diagnostic> ds;
+    rows = parse_trajectory(text.str(), o.path_csv, ds);
+    print_diagnostics(ds);
+    if (has_error(ds)) {
+      std::cerr << "cadclash check: the trajectory has errors; nothing checked\n";
+      return kExitInputError;
+    }
+  }
+
+  SceneSelection sel;
+  sel.set_a = select(m, o.select_a);
+  sel.set_b = select(m, o.select_b);
+  if ((!o.select_a.empty() && sel.set_a.empty()) || (!o.select_b.empty() && sel.set_b.empty())) {
+    std::cerr << "cadclash check: --select-a/--select-b match no instance path\n";
+    return kExitInputError;
+  }
+  sel.excluded_subassemblies = o.exclude_under;
+  const CollideOptions copt = collide_options(o);
+  Scene scene(m, sel);
+
+  nlohmann::json j;
+  j["schema"] = "cadclash-check-report";
+  j["version"] = kReportVersion;
+  j["files"] = o.in.files;
+  j["settings"] = {{"tolerance", o.tolerance},
+                   {"clearance", o.clearance},
+                   {"deflection", o.in.deflection},
+                   {"relative_deflection", o.in.relative},
+                   {"angular_deflection", o.in.angular},
+                   {"lazy", o.in.lazy},
+                   {"mode", o.all_triangles ? "all-triangle-pairs" : "early-exit"},
+                   {"parallel", o.parallel},
+                   {"schedule", o.schedule},
+                   {"triangle_level", o.triangle_level},
+                   {"oaabb", !o.brute_force},
+                   {"containment", !o.no_containment},
+                   {"exclude_under", o.exclude_under},
+                   {"select_a", o.select_a},
+                   {"select_b", o.select_b}};
+  bool collision = false;
+  std::vector<Diagnostic> run_diags;
+  if (rows.empty()) {
+    Report r = scene.check(copt);
+    run_diags = r.diagnostics;
+    ClassCounts n;
+    n.add(r);
+    collision = n.collision();
+    if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
+    print_table(m, r, std::cout);
+    print_summary(r, !o.no_timings, std::cout);
+    j["pairs"] = pairs_json(m, r);
+    j["summary"] = summary_json(r);
+    j["counters"] = counters_json(r.counters);
+    if (!o.no_timings) j["timings"] = timings_json(r.timings);
+  } else {
+    std::vector<Diagnostic> ds;
+    std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
+    print_diagnostics(ds);
+    j["trajectory"] = o.path_csv;
+    j["steps"] = nlohmann::json::array();
+    for (const StepResult& s : steps) {
+      ClassCounts n;
+      n.add(s.report);
+      collision = collision || n.collision();
+      run_diags.insert(run_diags.end(), s.report.diagnostics.begin(), s.report.diagnostics.end());
+      std::cout << "step " << s.step << ": " << n.c[0] << " penetrating, " << n.c[1] << " touching, " << n.c[2]
+                << " clearance, " << n.c[3] << " containment";
+      if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
+      std::cout << '\n';
+      nlohmann::json js{{"step", s.step},
+                        {"pairs", pairs_json(m, s.report)},
+                        {"summary", summary_json(s.report)},
+                        {"counters", counters_json(s.report.counters)}};
+      if (!o.no_timings) js["timings"] = timings_json(s.report.timings);
+      j["steps"].push_back(std::move(js));
+    }
+    for (const Diagnostic& d : ds) j["diagnostics"].push_back(format_diagnostic(d));
+  }
+  print_diagnostics(run_diags);
+  input_error = input_error || has_error(run_diags);
+  for (const Diagnostic& d : imported.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
+  for (const Diagnostic& d : run_diags) j["diagnostics"].push_back(format_diagnostic(d));
+  if (!j.contains("diagnostics")) j["diagnostics"] = nlohmann::json::array();
+  j["complete"] = imported.complete && !has_error(run_diags);
+
+  if (!o.json.empty()) {
+    std::ofstream f(o.json, std::ios::binary);
+    f << j.dump(2) << '\n';
+    if (!f) {
+      std::cerr << o.json << ": error: cannot write the report\n";
+      return kExitInputError;
+    }
+  }
+  if (input_error) return kExitInputError;
+  return (o.fail_on_collision && collision) ? kExitCollision : kExitOk;
+}
+
+}  // namespace
 
 void register_check(CLI::App& app) {
-  auto in = std::make_shared<InputOptions>();
-  CLI::App* cmd = app.add_subcommand("check", "Report colliding surface pairs");
-  add_input_options(*cmd, *in);
-  cmd->callback([in] {
-    std::cerr << "cadclash check: not built yet\n";
-    throw CLI::RuntimeError(kExitUsage);
+  auto o = std::make_shared<CheckOptions>();
+  CLI::App* cmd = app.add_subcommand("check", "Report penetrating, touching, close and contained surface pairs");
+  add_input_options(*cmd, o->in);
+  cmd->add_option("--tolerance", o->tolerance, "Contact tolerance t, mm (touching: distance <= t + both deflections)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", o->threads, "OpenMP threads (default: all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--all-triangles", o->all_triangles, "List every intersecting triangle pair (no early exit)");
+  cmd->add_option("--json", o->json, "Write the JSON report (docs/report-schema.md) here");
+  cmd->add_flag("--no-timings", o->no_timings, "Leave timings out (the report is then identical for any thread count)");
+  cmd->add_flag("--fail-on-collision", o->fail_on_collision,
+                "Exit 3 when a penetrating, touching or containment pair is found");
+  cmd->add_flag("--brute-force", o->brute_force, "Test every triangle pair, no OAABB culling (for comparison)");
+  cmd->add_flag("--no-containment", o->no_containment, "Skip the point-in-part containment test");
+  cmd->add_option("--parallel", o->parallel, "Parallel version: v1 (per surface pair) or v2 (flattened)")
+      ->check(CLI::IsMember({"v1", "v2"}));
+  cmd->add_option("--schedule", o->schedule, "OpenMP schedule")->check(CLI::IsMember({"guided", "dynamic", "static"}));
+  cmd->add_option("--triangle-level", o->triangle_level, "Candidate triangle pairs: auto, flat loops or bvh")
+      ->check(CLI::IsMember({"auto", "flat", "bvh"}));
+  cmd->add_option("--select-a", o->select_a, "Check only instances under these paths (set A) ...");
+  cmd->add_option("--select-b", o->select_b, "... against instances under these paths (set B)");
+  cmd->add_option("--exclude-under", o->exclude_under, "Skip pairs whose instances are both under this sub-assembly path");
+  cmd->callback([o] {
+    const int code = run_check(*o);
+    if (code != kExitOk) throw CLI::RuntimeError(code);
   });
 }
 

@@ -28,19 +28,61 @@ nlohmann::json surface_json(const Surface& s) {
   return j;
 }
 
+// What --repair changed in one surface: its non-zero counts.
+nlohmann::json repair_json(const SurfaceRepairStats& s) {
+  nlohmann::json j = nlohmann::json::object();
+  auto put = [&](const char* key, std::uint32_t n) {
+    if (n) j[key] = n;
+  };
+  put("merged_points", s.merged_points);
+  put("unused_points", s.unused_points);
+  put("degenerate_faces", s.degenerate_faces);
+  put("duplicate_faces", s.duplicate_faces);
+  put("flipped_faces", s.flipped_faces);
+  put("stitched_edges", s.stitched_edges);
+  put("duplicated_vertices", s.duplicated_vertices);
+  put("removed_component_faces", s.removed_component_faces);
+  put("filled_holes", s.filled_holes);
+  put("hole_faces", s.hole_faces);
+  return j;
+}
+
+// Repair counts of each final surface (null when repair did not look at it). Repair ran before
+// segmentation, so a patch shows the counts of the surface it was cut from.
+std::vector<const SurfaceRepairStats*> repair_per_final_surface(const Model& m, const MeshRepairReport& repair,
+                                                                 const SegmentReport& segment) {
+  std::vector<const SurfaceRepairStats*> out(m.surfaces.size(), nullptr);
+  for (const SurfaceRepairStats& s : repair.per_surface) {
+    if (segment.surfaces.empty()) {
+      if (s.surface < out.size()) out[s.surface] = &s;
+      continue;
+    }
+    const SurfaceSegments& seg = segment.surfaces[s.surface];
+    for (SurfaceId f = seg.first; f < seg.first + seg.count; ++f) out[f] = &s;
+  }
+  return out;
+}
+
 int run_info(const InfoOptions& o) {
-  ImportResult r = import_inputs(o.in);
+  MeshRepairReport repair;
+  SegmentReport segment;
+  ImportResult r = import_inputs(o.in, &repair, &segment);
   const Model& m = r.model;
+  const std::vector<const SurfaceRepairStats*> repaired = repair_per_final_surface(m, repair, segment);
   if (o.json) {
     nlohmann::json j;
     j["files"] = o.in.files;
     j["complete"] = r.complete;
     for (const Part& p : m.parts) {
       nlohmann::json jp{{"name", p.name}, {"source_file", p.source_file}, {"surfaces", nlohmann::json::array()}};
-      for (SurfaceId s = p.first_surface; s < p.first_surface + p.surface_count; ++s)
+      for (SurfaceId s = p.first_surface; s < p.first_surface + p.surface_count; ++s) {
         jp["surfaces"].push_back(surface_json(m.surfaces[s]));
+        if (repaired[s] && repaired[s]->changed) jp["surfaces"].back()["repair"] = repair_json(*repaired[s]);
+      }
       j["parts"].push_back(jp);
     }
+    if (o.in.repair) j["repair"] = repair_json(repair.total);
+    if (o.in.segment) j["segment"] = {{"surfaces_split", segment.surfaces_split}, {"patches", segment.patches}};
     for (const Instance& i : m.instances) j["instances"].push_back({{"path", i.path}, {"part", i.part}});
     for (const Diagnostic& d : r.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
     std::cout << j.dump(2) << '\n';
@@ -49,6 +91,16 @@ int run_info(const InfoOptions& o) {
     for (const Instance& i : m.instances) instance_faces += m.parts[i.part].surface_count;
     std::cout << m.parts.size() << " parts, " << m.instances.size() << " instances, " << m.surfaces.size()
               << " surfaces (" << instance_faces << " over instances), " << triangle_count(m) << " triangles\n";
+    if (o.in.repair) {
+      std::size_t changed = 0;
+      for (const SurfaceRepairStats& st : repair.per_surface) changed += st.changed ? 1 : 0;
+      std::cout << "repair: " << changed << " of " << repair.per_surface.size() << " mesh surfaces changed";
+      const nlohmann::json counts = repair_json(repair.total);  // outlives the loop, unlike a temporary
+      for (const auto& [key, n] : counts.items()) std::cout << ' ' << key << '=' << n;
+      std::cout << '\n';
+    }
+    if (o.in.segment)
+      std::cout << "segment: " << segment.surfaces_split << " surfaces split into " << segment.patches << " patches\n";
     std::cout << "\nInstances:\n";
     for (const Instance& i : m.instances) {
       const Part& p = m.parts[i.part];
@@ -70,6 +122,10 @@ int run_info(const InfoOptions& o) {
         if (surf.deflection > 0) std::cout << ", deflection " << surf.deflection;
         if (surf.provenance.healed) std::cout << ", healed";
         if (surf.provenance.repaired) std::cout << ", repaired";
+        if (repaired[s] && repaired[s]->changed) {
+          const nlohmann::json counts = repair_json(*repaired[s]);
+          for (const auto& [key, n] : counts.items()) std::cout << ' ' << key << '=' << n;
+        }
         std::cout << '\n';
       }
     }

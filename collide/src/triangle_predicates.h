@@ -1,4 +1,15 @@
 // Triangle–triangle predicates used by the narrow phase. Internal to cadclash::collide.
+//
+// triangles_intersect is exact: its answer equals what exact arithmetic on the given doubles decides.
+// A floating-point Guigue–Devillers test whose every orientation sign carries a proven error bound
+// (double, then long double) answers almost every call; when a sign is within its bound
+// (coplanar, touching, degenerate triangles) the call falls back to CGAL's exact predicates.
+// Shared vertices and two triangles in one coordinate plane (z = c contacts) are settled without
+// CGAL too. Exact fallback rates on the test families: 0 on random and far-offset pairs, 1% on
+// 1e-12 slivers, 4% under large rigid motions and on shared features, 45-65% on exactly coplanar
+// (arbitrary plane), touching and 1-ulp-perturbed pairs, where the answer hinges on an exact zero.
+// The distance functions are plain double precision (see triangle_distance for the accuracy).
+// All functions are pure and thread-safe (the stats object is the caller's).
 #pragma once
 
 #include "cadclash/collide.h"
@@ -8,19 +19,53 @@
 namespace cadclash::detail {
 
 struct TrianglePredicateStats {
-  std::uint64_t tests = 0;            // calls of triangles_intersect
-  std::uint64_t exact_fallbacks = 0;  // calls whose float filter could not decide
+  std::uint64_t tests = 0;            // calls of triangles_intersect, including those made for
+                                      // triangle_distance(..., stats) and triangles_within
+  std::uint64_t exact_fallbacks = 0;  // calls whose float filters could not decide (went to CGAL)
+  std::uint64_t extended_signs = 0;   // orientation signs the double filter left to long double
 };
 
 // True iff the closed triangles (a0,a1,a2) and (b0,b1,b2) share at least one point, exactly as exact
 // arithmetic on the given double coordinates decides (coplanar overlap and touching count).
 // Degenerate triangles (collinear or repeated vertices) are handled as the point sets they are.
+// Precondition: all coordinates are finite.
 bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2,
                          const Vec3& b0, const Vec3& b1, const Vec3& b2,
                          TrianglePredicateStats& stats);
 
-// Euclidean distance between the closed triangles; 0 when they intersect. Double precision.
+// The exact decision alone (no float filter, no stats): what triangles_intersect falls back to.
+// Slower; exposed for tests and benchmarks. Same contract as triangles_intersect.
+bool triangles_intersect_exact(const Vec3& a0, const Vec3& a1, const Vec3& a2,
+                               const Vec3& b0, const Vec3& b1, const Vec3& b2);
+
+// Euclidean distance between the closed triangles; 0 when they intersect (decided exactly by
+// triangles_intersect). Otherwise the minimum over the 9 edge pairs and the 6 vertex–face pairs,
+// computed in double relative to a0: the absolute error is a small multiple of 2^-53 times the
+// extent of the two triangles around a0, not times their distance from the origin (measured below
+// 1e-15 x extent against a long-double reference). Every candidate is the distance between two
+// points of the triangles, so slivers and nearly parallel edges cannot make it too small.
+// Disjoint triangles get a result > 0 even if it rounds to below the smallest normal double.
+// Degenerate triangles are measured as the segments or points they are.
+// Precondition: all coordinates are finite.
 double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2,
                          const Vec3& b0, const Vec3& b1, const Vec3& b2);
+double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2,
+                         const Vec3& b0, const Vec3& b1, const Vec3& b2,
+                         TrianglePredicateStats& stats);
+
+// triangle_distance for a pair the caller already knows to be disjoint (triangles_intersect returned
+// false), without testing again. Always > 0. Precondition: the triangles do not intersect.
+double triangle_distance_apart(const Vec3& a0, const Vec3& a1, const Vec3& a2,
+                               const Vec3& b0, const Vec3& b1, const Vec3& b2);
+
+// True iff triangle_distance(a, b) <= d, answered with early outs: boxes farther apart than d, or
+// one triangle wholly beyond d on one side of the other's plane (with a certified bound, widened by
+// 64 x 2^-53 x the pair's extent so it never contradicts triangle_distance), return false before any
+// distance is computed; the distance loop stops at the first candidate clearly below d.
+// d == 0 asks whether they intersect (exactly); d < 0 is never met; d = +inf always is.
+// Precondition: d is not NaN; coordinates finite.
+bool triangles_within(const Vec3& a0, const Vec3& a1, const Vec3& a2,
+                      const Vec3& b0, const Vec3& b1, const Vec3& b2,
+                      double d, TrianglePredicateStats& stats);
 
 }  // namespace cadclash::detail

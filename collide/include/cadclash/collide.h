@@ -169,4 +169,194 @@ std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceI
 // Counts triangles over all surfaces that have them.
 std::size_t triangle_count(const Model& model);
 
+// =============================================================================================
+// Collision queries: the OAABB narrow phase, contact classes, prepared scenes, trajectories
+// =============================================================================================
+//
+// The query, level by level (Figueiredo & Fernando's OAABB scheme, extended with distances):
+// 1. Broad phase: sweep-and-prune over instance world AABBs (inflated by the margin) → instance pairs.
+// 2. Object level: OAABB(A,B) = A's local box ∩ B's local box mapped into A's frame; mapped once
+//    more into B's frame (the paper's single update). Surfaces meeting it survive (msA, msB).
+// 3. Surface level: surviving pairs whose boxes (in A's frame) overlap → surface-pair OAABB.
+// 4. Triangle level: each surface's BVH (built once) is queried under the surface-pair OAABB on both
+//    sides (mpSk, mpSl); candidate triangle pairs come from a sweep over the survivors, or from the
+//    paper's flat double loop for small lists.
+// 5. Exact test (triangles_intersect; float filter + exact fallback) and, while no intersection is
+//    found, triangle–triangle distance.
+//
+// Frames: every triangle test happens in instance A's part frame. B's vertices are mapped by
+// T = pose_a⁻¹·pose_b (computed once per instance pair) and the answer is exact arithmetic on those
+// mapped doubles. Instance A is always the one with the smaller id. All culling boxes are padded by a
+// relative epsilon, so culling never drops a pair the unculled (brute-force) query would report.
+//
+// Contact classes of one surface pair (Sk of A, Sl of B). Let τ = tolerance + deflection(Sk) +
+// deflection(Sl) be the touching bound: the tessellation of a B-rep face may lie up to its
+// deflection away from the exact face, so two faces in exact contact can be τ apart or cross by τ
+// on their triangles.
+// - Penetrating: some triangle pair intersects and its crossing depth exceeds τ. The crossing depth of
+//   an intersecting pair (Ta, Tb) is min(straddle(Ta, Tb), straddle(Tb, Ta)), where straddle(T, P)
+//   takes the part of T inside P's normal prism (T clipped by the three planes through P's edges
+//   perpendicular to P) and returns the smaller of its largest heights above and below P's plane: how
+//   far one triangle reaches through the other on its shorter side. It is 0 for coplanar overlap and
+//   for triangles that only meet at an edge or vertex. It is an ESTIMATE of penetration (a local,
+//   per-triangle-pair quantity), not the penetration depth of the enclosed solids. Known blind spot:
+//   two solids that overlap while every face of one meets the other only along face boundaries (boxes
+//   shifted along one axis with equal cross-sections) give crossing depth 0 everywhere: touching.
+// - Touching: not penetrating, and either some triangle pair intersects (depth <= τ: coplanar
+//   contact, shared edges, chords of coincident cylinders crossing) or the minimum triangle distance
+//   d satisfies d <= τ (tangency, faceted cylinder against a plane).
+// - Clearance: no triangle pair intersects and τ < d <= clearance.
+// - Containment (an instance pair, not a surface pair): every surface of one instance lies inside the
+//   other instance's triangles, judged by the generalized winding number |w| >= 0.5 of the first
+//   vertex of each surface of the inner part (|w| ≈ 1 inside a closed mesh, ≈ 0 outside), the
+//   inner instance's box lies in the outer's box, and no surface pair of the two intersects. The
+//   reported surface ids are kInvalidId (whole instances).
+
+enum class ContactClass : std::uint8_t { Penetrating, Touching, Clearance, Containment };
+
+// Returns "penetrating", "touching", "clearance" or "containment".
+const char* contact_class_name(ContactClass c);
+
+enum class CollideMode : std::uint8_t {
+  EarlyExit,          // per surface pair, stop at the first triangle pair that decides the class
+  AllTrianglePairs,   // visit every candidate triangle pair and list all intersecting ones
+};
+
+// How the candidate surface pairs are spread over threads.
+enum class ParallelVersion : std::uint8_t {
+  V1,  // one work item per candidate surface pair (the paper's Version 1)
+  V2,  // one work item per (surface pair, block of A's surviving triangles): the flattened index
+};
+enum class Schedule : std::uint8_t { Guided, Dynamic, Static };
+
+// How candidate triangle pairs are formed under the surface-pair OAABB.
+enum class TriangleLevel : std::uint8_t {
+  Auto,  // flat loops when |survivors of Sk| * |survivors of Sl| <= flat_limit, else the BVH + sweep
+  Flat,  // the paper's loops: every triangle of Sk against every triangle of Sl, box test first
+  Bvh,   // per-surface BVH queried under the OAABB, candidate pairs by a sweep over the survivors
+};
+
+struct CollideOptions {
+  double tolerance = 0.0;         // contact tolerance t, mm (>= 0)
+  double clearance = 0.0;         // report non-touching pairs closer than this, mm (0 = never)
+  double deflection_hint = 0.0;   // deflection assumed for surfaces not yet tessellated (lazy), mm
+  CollideMode mode = CollideMode::EarlyExit;
+  int threads = 0;                // <= 0: OpenMP's default
+  ParallelVersion version = ParallelVersion::V1;
+  Schedule schedule = Schedule::Guided;
+  bool use_oaabb = true;          // false: brute force — every surface pair, every triangle pair, no culling
+  TriangleLevel triangle_level = TriangleLevel::Auto;
+  std::size_t flat_limit = 4096;  // Auto switches to the BVH above this many candidate pairs
+  bool detect_containment = true;
+  bool exact_verification = false;  // ask SurfaceSource::exact_distance for touching/clearance pairs
+  double tessellation_deflection = 0.0;  // passed to require_triangles (<= 0: each source's default)
+};
+
+// Counters of one query, summed over instance pairs (the paper's Table 2). They depend on the options
+// (including the parallel version) but never on the number of threads.
+struct CollideCounters {
+  std::uint64_t instance_pairs = 0;       // instance pairs whose world boxes overlap (broad phase output)
+  std::uint64_t aabb_tests = 0;           // box-box overlap tests at every level
+  std::uint64_t aabb_updates = 0;         // boxes transformed into another frame
+  std::uint64_t surfaces_a = 0;           // msA: surfaces of A surviving the object OAABB
+  std::uint64_t surfaces_b = 0;           // msB
+  std::uint64_t surface_pairs = 0;        // candidate surface pairs (boxes overlap)
+  std::uint64_t triangles_a = 0;          // mpSk: triangles of Sk surviving the surface-pair OAABB
+  std::uint64_t triangles_b = 0;          // mpSl
+  std::uint64_t triangle_tests = 0;       // exact triangle intersection tests
+  std::uint64_t exact_fallbacks = 0;      // tests the float filter could not decide
+  std::uint64_t distance_tests = 0;       // triangle distance computations
+  std::uint64_t intersecting_pairs = 0;   // surface pairs with at least one intersecting triangle pair
+  std::uint64_t tessellated_surfaces = 0; // surfaces this query asked require_triangles for
+};
+
+struct CollideTimings {  // seconds; never part of a determinism comparison
+  double broad = 0.0, surface_level = 0.0, tessellation = 0.0, triangle_level = 0.0, total = 0.0;
+};
+
+struct SurfacePairResult {
+  InstanceId instance_a = kInvalidId;  // instance_a < instance_b
+  InstanceId instance_b = kInvalidId;
+  SurfaceId surface_a = kInvalidId;    // model surface ids; kInvalidId for Containment
+  SurfaceId surface_b = kInvalidId;
+  ContactClass contact = ContactClass::Touching;
+  bool intersecting = false;  // some triangle pair intersects exactly
+  double distance = 0.0;      // min triangle distance; 0 when intersecting; for Containment, the min
+                              // distance when within the search margin, else +infinity
+  double penetration = 0.0;   // crossing-depth estimate (see above); in EarlyExit mode a lower bound
+  // exact_verification only: SurfaceSource::exact_distance for non-intersecting pairs, when both
+  // parts have exact geometry (a value > the search margin means "farther than the margin").
+  std::optional<double> exact_distance;
+  // AllTrianglePairs only: intersecting (triangle index in Sk, triangle index in Sl), sorted.
+  std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
+};
+
+struct Report {
+  std::vector<SurfacePairResult> pairs;  // sorted by (instance_a, instance_b, surface_a, surface_b)
+  CollideCounters counters;
+  CollideTimings timings;
+  std::vector<Diagnostic> diagnostics;   // surfaces that could not be tessellated (skipped)
+};
+
+// One-off query of two instances. Tessellates (require_triangles) exactly the surfaces it needs.
+// Preconditions: a < model.instances.size(); b < model.instances.size(); a != b.
+Report collide(Model& model, InstanceId a, InstanceId b, const CollideOptions& options = {});
+
+// Which instance pairs a Scene checks.
+struct SceneSelection {
+  std::vector<InstanceId> set_a;  // empty: every instance
+  std::vector<InstanceId> set_b;  // empty: every instance; a pair is checked if one side is in A, the other in B
+  std::vector<std::array<std::string, 2>> excluded_pairs;  // instance paths, either order
+  std::vector<std::string> excluded_subassemblies;  // pairs with both paths under one of these prefixes ("/root/sub")
+};
+
+// A prepared scene: per-surface BVHs and instance world boxes are built once; each check() updates
+// only the instances moved by set_pose since the last check.
+// The model must outlive the scene; the scene writes only surfaces' triangles (lazy tessellation).
+class Scene {
+ public:
+  explicit Scene(Model& model, SceneSelection selection = {});
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // Moves an instance (part-local → world). Precondition: instance < model.instances.size().
+  void set_pose(InstanceId instance, const Pose& pose);
+  const Pose& pose(InstanceId instance) const;
+
+  // Returns the instance id with this path, or kInvalidId.
+  InstanceId find_instance(const std::string& path) const;
+
+  Report check(const CollideOptions& options = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One row of a trajectory: instance `path` gets the absolute world pose at step `step`.
+struct TrajectoryRow {
+  std::int64_t step = 0;
+  std::string path;
+  Pose pose = Pose::Identity();
+  std::int64_t line = 0;  // 1-based line in the CSV
+};
+
+// Parses CSV text "step,instance_path,tx,ty,tz,qw,qx,qy,qz" (optional header line starting with
+// "step"; blank lines and lines starting with '#' skipped). Bad rows become diagnostics naming
+// `file` and the line and are skipped; quaternions are normalised (a zero quaternion is an error).
+std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::string& file,
+                                            std::vector<Diagnostic>& diagnostics);
+
+struct StepResult {
+  std::int64_t step = 0;
+  Report report;
+};
+
+// Replays rows on `scene`: rows with equal consecutive step numbers are applied together, then the
+// scene is checked. Rows naming unknown instances become diagnostics (warning) and are skipped.
+std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const TrajectoryRow> rows,
+                                          const CollideOptions& options,
+                                          std::vector<Diagnostic>& diagnostics, const std::string& file = {});
+
 }  // namespace cadclash

@@ -1,8 +1,28 @@
 // cadclash/tessellate.h — B-rep faces to tagged triangle surfaces (OCCT BRepMesh), and raw mesh
 // repair / segmentation (CGAL). The one public header of cadclash::tessellate.
+//
+// B-rep parts: every face of a part becomes one Surface. Faces are numbered in the order of
+// TopExp::MapShapes(shape, TopAbs_FACE) on the part's shape; that number is Provenance::face_index
+// and the surface's local index within its part. A part's SurfaceSource (BrepSource) keeps the exact
+// faces: it tessellates on demand (lazy mode, refinement) and answers exact distances.
+//
+// This header names OCCT types only by forward declaration: including it does not need OCCT headers,
+// but calling the B-rep functions does (link cadclash::tessellate, which links OCCT).
 #pragma once
 
 #include "cadclash/collide.h"
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+class TopoDS_Shape;
+class TopoDS_Face;
 
 namespace cadclash {
 
@@ -12,6 +32,210 @@ struct TessellationOptions {
   bool relative = false;            // linear_deflection is relative to each part's bounding-box diagonal
   double angular_deflection = 0.5;  // radians between adjacent normals along a curve
   bool parallel = true;             // let BRepMesh mesh faces of one part in parallel
+  // Measure each face's chord error at its triangle centroids (one surface evaluation per triangle)
+  // and re-mesh finer (up to 3 times) where it exceeds the requested deflection. The stored achieved
+  // deflection is then max(BRepMesh's own figure, the measured error).
+  bool verify_deflection = true;
 };
+
+// Named settings a user understands, like Mayo's and FreeCAD's mesh quality choices.
+// Absolute deflections in millimetres:
+//   coarse     1.0   mm, 0.8  rad     quick look, collision broad checks
+//   normal     0.1   mm, 0.5  rad     the default
+//   fine       0.01  mm, 0.25 rad     close-contact checks
+//   very-fine  0.001 mm, 0.1  rad     tolerance studies; slow on large assemblies
+enum class TessellationPreset : std::uint8_t { Coarse, Normal, Fine, VeryFine };
+
+// Returns the options of a preset (parallel and verify_deflection keep their defaults).
+TessellationOptions tessellation_preset(TessellationPreset preset);
+
+// Parses "coarse", "normal", "fine", "very-fine" (also "very_fine", "veryfine"); nullopt otherwise.
+std::optional<TessellationPreset> parse_tessellation_preset(std::string_view name);
+
+// Returns "coarse", "normal", "fine" or "very-fine".
+const char* tessellation_preset_name(TessellationPreset preset);
+
+// ---------------------------------------------------------------------------------------------
+// B-rep parts
+// ---------------------------------------------------------------------------------------------
+
+// What the file says about one face; indexed by face_index.
+struct BrepFaceTag {
+  std::int64_t entity_id = -1;  // STEP #id (or IGES directory entry number) of the face entity; -1 if unknown
+  std::string name;             // the file's name for the face; may be empty
+  std::optional<std::array<float, 3>> colour;  // RGB in [0,1]
+};
+
+// One part to add to a Model.
+struct BrepPartInput {
+  const TopoDS_Shape* shape = nullptr;  // not owned; copied (by handle) into the part's source
+  std::string name;
+  std::string source_file;
+  SourceKind kind = SourceKind::BrepFace;  // StepFace, IgesFace or BrepFace
+  std::vector<BrepFaceTag> tags;           // per face index; shorter (or empty) means "no tag" for the rest
+};
+
+// Appends one part per input to `model`, each with its surfaces (contiguous, face order) and a
+// BrepSource. Eager (lazy == false): every face is tessellated now; lazy: only AABBs (from the exact
+// geometry) are computed and has_triangles stays false until require_triangles() or
+// BrepSource::triangulate(). Faces that BRepCheck finds invalid are fixed with ShapeFix_Face first
+// (Provenance::healed). A face that fails to mesh keeps its surface with has_triangles == false and
+// gets an Error diagnostic naming the part and the face's entity #id; `complete` is then set false.
+// Returns the new parts' ids, in input order.
+// Preconditions: every input's shape is non-null; options.linear_deflection > 0.
+std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
+                                   const TessellationOptions& options, bool lazy,
+                                   std::vector<Diagnostic>& diagnostics, bool& complete);
+
+// The SurfaceSource of a B-rep part. Thread-safe across parts: each part has its own mutex, and
+// calls on one part serialise.
+class BrepSource final : public SurfaceSource {
+ public:
+  struct Impl;
+  explicit BrepSource(std::unique_ptr<Impl> impl);
+  ~BrepSource() override;
+  BrepSource(const BrepSource&) = delete;
+  BrepSource& operator=(const BrepSource&) = delete;
+
+  std::uint32_t face_count() const;
+  // The part-local face behind surface `local_index` (the healed one if healing changed it).
+  // Precondition: local_index < face_count(). Do not mesh it while other threads use this part.
+  const TopoDS_Face& face(std::uint32_t local_index) const;
+  // The deflection used when triangulate() is given deflection <= 0 (absolute, millimetres).
+  double default_deflection() const;
+
+  // Meshes the face with BRepMesh_IncrementalMesh when it has no triangulation or a coarser one than
+  // `deflection` (refinement); otherwise reads the existing one. Triangles are part-local and
+  // counter-clockwise seen from outside (winding flipped for reversed faces).
+  bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
+                   double& achieved_deflection, Diagnostic& error) override;
+
+  // BRepExtrema_DistShapeShape on the two placed faces; `other` must be a BrepSource, else nullopt.
+  // When the faces' boxes are farther apart than max_distance, returns that box distance (a lower
+  // bound > max_distance) without running the exact search.
+  std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
+                                       std::uint32_t local_b, const Pose& pose_b,
+                                       double max_distance) const override;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// =============================================================================================
+// Raw meshes: repair and segmentation (CGAL Polygon_mesh_processing)
+// =============================================================================================
+//
+// Post-processing steps on an imported Model, for any mesh reader. They touch only "mesh parts":
+// parts without a SurfaceSource (Part::source == nullptr), and within them only surfaces with
+// triangles. B-rep parts are left alone (their SurfaceSource indexes surfaces by local index).
+// Both steps are deterministic: the same Model and options give the same triangles, names and ids,
+// whatever the thread count.
+
+// What repair_meshes() does. Point merging and the three duplicate / degenerate removals always run.
+struct MeshRepairOptions {
+  bool orient = true;                   // make each connected component consistently oriented (see below)
+  bool stitch_borders = true;           // glue border edges whose end points coincide exactly
+  bool duplicate_non_manifold_vertices = true;  // split vertices whose faces do not form one fan
+  bool remove_negligible_components = false;    // drop tiny components (CGAL's default thresholds: 1% of
+                                                // the part's box diagonal, squared for area, cubed for volume)
+  bool fill_holes = false;              // triangulate every border cycle (triangulate_hole)
+  std::uint32_t max_hole_edges = 0;     // fill only holes with at most this many edges; 0 = any size
+};
+
+// What repair changed in one surface. Counts are exact and refer to that surface only.
+struct SurfaceRepairStats {
+  SurfaceId surface = kInvalidId;          // repair never adds, removes or renumbers surfaces
+  std::uint32_t triangles_before = 0, triangles_after = 0;
+  std::uint32_t vertices_before = 0, vertices_after = 0;
+  // Vertices of this surface that repeat (bit-exactly, -0 == +0) an earlier vertex of the same
+  // surface. Equal points of different surfaces of one part are joined too (that is what connects
+  // the surfaces), but each surface keeps its own vertex array, so they are not counted here.
+  std::uint32_t merged_points = 0;
+  std::uint32_t unused_points = 0;         // vertices no triangle referenced, dropped
+  std::uint32_t degenerate_faces = 0;      // triangles removed: two corners at the same point (or a
+                                           // non-finite coordinate). Zero-area triangles with three
+                                           // distinct collinear corners are kept.
+  std::uint32_t duplicate_faces = 0;       // triangles removed: same three points as an earlier triangle of
+                                           // the part (either orientation); "earlier" = lower surface id,
+                                           // then lower triangle index
+  std::uint32_t flipped_faces = 0;         // kept triangles whose final winding is the reverse of the input's
+  std::uint32_t stitched_edges = 0;        // border edges of this surface that stitching joined to a neighbour
+  std::uint32_t duplicated_vertices = 0;   // vertex copies made to split non-manifold vertices (or
+                                           // non-manifold / incompatibly oriented edges) that this
+                                           // surface's triangles use
+  std::uint32_t removed_component_faces = 0;  // triangles dropped with negligible components
+  std::uint32_t filled_holes = 0;          // holes whose new triangles went to this surface
+  std::uint32_t hole_faces = 0;            // triangles added by hole filling to this surface
+  // The surface's vertex or triangle arrays differ from before (then provenance.repaired is set).
+  // Stitching and vertex duplication between two surfaces can be counted above and still leave
+  // both surfaces' own arrays as they were.
+  bool changed = false;
+};
+
+struct MeshRepairReport {
+  std::vector<SurfaceRepairStats> per_surface;  // one per surface repair looked at, ascending surface id
+  SurfaceRepairStats total;                     // sums (surface = kInvalidId; changed = any changed)
+  std::uint32_t parts_repaired = 0;             // mesh parts that had at least one changed surface
+  std::vector<Diagnostic> diagnostics;          // parts repair had to leave unchanged, and why
+};
+
+// Repairs the triangles of every mesh surface, one part at a time, keeping every triangle on the
+// surface it came from. Per part:
+//  1. Points equal bit-for-bit are merged (within and across the part's surfaces); unused points go.
+//  2. Triangles with two corners at one point are removed; so are repeats of an earlier triangle.
+//  3. The rest is oriented with orient_polygon_soup and turned into a halfedge mesh; points at
+//     non-manifold spots are duplicated (orient_polygon_soup, then duplicate_non_manifold_vertices).
+//  4. stitch_borders; then each connected component gets one orientation. A closed component faces
+//     outward (positive enclosed volume), or inward when it lies inside an odd number of other
+//     closed components (a cavity; nesting by generalized winding number). An open component keeps
+//     the orientation that agrees with most of its input windings (ties: orient_polygon_soup's,
+//     which follows its lowest triangle).
+//  5. On request: negligible components removed; holes filled, each hole's triangles going to the
+//     surface with the most triangles along the hole (ties: the lower surface id).
+// Each surface's triangles keep their input order (hole triangles last); its vertex array is
+// rebuilt in order of first use. Surfaces whose triangles changed get provenance.repaired = true
+// and a fresh aabb. Surfaces, names, ids and provenance otherwise stay as they were.
+// A part CGAL cannot turn into a mesh is left unchanged and named in a Warning diagnostic.
+MeshRepairReport repair_meshes(Model& model, const MeshRepairOptions& options = {});
+
+// How segment_surfaces() cuts surfaces into patches.
+struct SegmentOptions {
+  // An edge is sharp when the angle between its two faces' normals exceeds this (degrees, in (0, 180)).
+  double sharp_angle_degrees = 60.0;
+  // Region growing (Shape_detection::Region_growing, Least_squares_plane_fit_region) within each
+  // sharp-edge patch: splits smooth-but-not-flat patches into planar regions.
+  bool planar = false;
+  double planar_max_distance = 0.0;        // mm from the fitted plane; <= 0: 1e-3 of the surface's box diagonal
+  double planar_max_angle_degrees = 5.0;   // between a face normal and the fitted plane's normal
+};
+
+// What segmentation did to one input surface.
+struct SurfaceSegments {
+  SurfaceId input = kInvalidId;   // id before segment_surfaces()
+  SurfaceId first = kInvalidId;   // its replacement range [first, first + count) after
+  std::uint32_t count = 0;        // 1 when it was kept whole (one patch): then it is unchanged
+};
+
+struct SegmentReport {
+  // One entry per input surface, in input order: where every surface went (ids shift when a surface
+  // is replaced by several). Surfaces of B-rep parts and surfaces without triangles map to one.
+  std::vector<SurfaceSegments> surfaces;
+  std::uint32_t surfaces_split = 0;   // input surfaces replaced by two or more patches
+  std::uint32_t patches = 0;          // surfaces created by splitting
+  std::vector<Diagnostic> diagnostics;  // surfaces kept whole because CGAL could not mesh them
+};
+
+// Cuts every mesh surface into CAD-like patches: faces joined across edges that are not sharp
+// (sharp_edges_segmentation; adjacency through points equal bit-for-bit), optionally refined by
+// planar region growing. A surface with one patch is kept as it is. A surface with k > 1 patches is
+// replaced, in place, by k surfaces named "<name>/patch-<j>" (j = 0..k-1) ordered by the lowest
+// input triangle index each patch holds; triangles keep their input order and winding. A patch's
+// provenance is its parent's (source file, step_id, face_index, source_name, colour, repaired) with
+// kind = Segment and parent = the parent's id in the model as it was BEFORE this call (the report
+// maps old ids to new ranges). Triangles a valid mesh cannot hold (degenerate, repeated) join the
+// patch of the lowest triangle sharing a point with them, or form a patch of their own.
+// Part::first_surface / surface_count stay contiguous; instances are untouched.
+// Precondition: 0 < options.sharp_angle_degrees < 180.
+SegmentReport segment_surfaces(Model& model, const SegmentOptions& options = {});
 
 }  // namespace cadclash

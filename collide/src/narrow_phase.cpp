@@ -1,0 +1,237 @@
+#include "narrow_phase.h"
+
+#include "box_util.h"
+#include "triangle_predicates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cadclash::detail {
+namespace {
+
+// How far the part of triangle T inside the normal prism of triangle P straddles P's plane: the
+// smaller of its largest heights above and below the plane; 0 when it stays on one side. Clipping to
+// the prism keeps the measure local: a wide triangle that crosses P's plane far away from P does not
+// count, only what lies over (or under) P.
+double straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& p1,
+                const Vec3& p2) {
+  const Vec3 n = (p1 - p0).cross(p2 - p0);
+  const double len = n.norm();
+  if (!(len > 0.0)) return 0.0;
+  std::vector<Vec3> poly{v0, v1, v2}, next;
+  const Vec3* corners[3] = {&p0, &p1, &p2};
+  for (int e = 0; e < 3 && !poly.empty(); ++e) {
+    const Vec3& a = *corners[e];
+    const Vec3 inward = n.cross(*corners[(e + 1) % 3] - a);  // side plane through the edge, facing P
+    next.clear();
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const Vec3& x = poly[k];
+      const Vec3& y = poly[(k + 1) % poly.size()];
+      const double dx = inward.dot(x - a), dy = inward.dot(y - a);
+      if (dx >= 0.0) next.push_back(x);
+      if ((dx >= 0.0) != (dy >= 0.0)) next.push_back(x + (y - x) * (dx / (dx - dy)));
+    }
+    poly.swap(next);
+  }
+  double up = 0.0, down = 0.0;
+  for (const Vec3& v : poly) {
+    const double h = n.dot(v - p0) / len;
+    up = std::max(up, h);
+    down = std::max(down, -h);
+  }
+  return std::min(up, down);
+}
+
+double max_magnitude(const std::vector<Aabb>& boxes) {
+  double m = 0.0;
+  for (const Aabb& b : boxes) m = std::max(m, box_magnitude(b));
+  return m;
+}
+
+}  // namespace
+
+double crossing_depth(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                      const Vec3& b2) {
+  return std::min(straddle(a0, a1, a2, b0, b1, b2), straddle(b0, b1, b2, a0, a1, a2));
+}
+
+double winding_number(const Vec3& p, std::span<const Surface* const> surfaces) {
+  double sum = 0.0;
+  for (const Surface* s : surfaces) {
+    for (const auto& t : s->mesh.triangles) {
+      const Vec3 a = s->mesh.vertices[t[0]] - p, b = s->mesh.vertices[t[1]] - p, c = s->mesh.vertices[t[2]] - p;
+      const double la = a.norm(), lb = b.norm(), lc = c.norm();
+      const double num = a.dot(b.cross(c));
+      const double den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+      sum += 2.0 * std::atan2(num, den);  // solid angle (Van Oosterom & Strackee)
+    }
+  }
+  return sum / (4.0 * std::numbers::pi);
+}
+
+void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
+                  const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, PreparedPair& out,
+                  CollideCounters& counters) {
+  out = PreparedPair{};
+  out.tau = options.tolerance + sa.deflection + sb.deflection;
+  const double search = std::max(out.tau, options.clearance);
+  if (options.use_oaabb) {
+    // Surface-pair OAABB in A's frame: where a triangle of one side can come within `search` of the
+    // other. Built from the triangles' boxes (the BVH roots): a B-rep face's stored box may be looser.
+    const Aabb tri_box_a = bvh_a.nodes.empty() ? Aabb() : bvh_a.nodes[0].box;
+    if (bvh_a.nodes.empty() || bvh_b.nodes.empty()) return;
+    const Aabb tri_box_b = transform_box(bvh_b.nodes[0].box, t_ab);
+    ++counters.aabb_updates;
+    const Aabb oaabb = pad_box(tri_box_a, search).intersection(pad_box(tri_box_b, search));
+    if (oaabb.isEmpty()) return;
+    query_surface_bvh(bvh_a, oaabb, out.la, counters.aabb_tests);
+    if (out.la.empty()) return;
+    const Aabb oaabb_b = transform_box(oaabb, t_ba);  // the single update into B's frame
+    ++counters.aabb_updates;
+    query_surface_bvh(bvh_b, oaabb_b, out.lb, counters.aabb_tests);
+  } else {
+    out.la.resize(sa.mesh.triangles.size());
+    out.lb.resize(sb.mesh.triangles.size());
+    for (std::uint32_t i = 0; i < out.la.size(); ++i) out.la[i] = i;
+    for (std::uint32_t i = 0; i < out.lb.size(); ++i) out.lb[i] = i;
+  }
+  if (out.la.empty() || out.lb.empty()) {
+    out.la.clear();
+    out.lb.clear();
+    return;
+  }
+  counters.triangles_a += out.la.size();
+  counters.triangles_b += out.lb.size();
+  out.box_a.resize(out.la.size());
+  for (std::size_t i = 0; i < out.la.size(); ++i) out.box_a[i] = bvh_a.triangle_boxes[out.la[i]];
+  out.tri_b.resize(out.lb.size());
+  out.box_b.resize(out.lb.size());
+  for (std::size_t j = 0; j < out.lb.size(); ++j) {
+    const auto& t = sb.mesh.triangles[out.lb[j]];
+    Aabb b;
+    for (int k = 0; k < 3; ++k) {
+      out.tri_b[j][k] = t_ab * sb.mesh.vertices[t[k]];
+      b.extend(out.tri_b[j][k]);
+    }
+    out.box_b[j] = b;
+  }
+  // Slack so that rounding in box arithmetic never turns "within the margin" into "beyond it".
+  out.margin = search + kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
+}
+
+void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
+              const CollideOptions& options, PairOutcome& out, CollideCounters& counters) {
+  TrianglePredicateStats stats;
+  const bool all = options.mode == CollideMode::AllTrianglePairs;
+  const bool want_distance = p.margin > 0.0;
+  bool done = false;
+  auto test = [&](std::size_t i, std::size_t j) {
+    const auto& ta = sa.mesh.triangles[p.la[i]];
+    const Vec3& a0 = sa.mesh.vertices[ta[0]];
+    const Vec3& a1 = sa.mesh.vertices[ta[1]];
+    const Vec3& a2 = sa.mesh.vertices[ta[2]];
+    const auto& tb = p.tri_b[j];
+    if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
+      out.intersecting = true;
+      const double depth = crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]);
+      out.penetration = std::max(out.penetration, depth);
+      if (all) out.triangle_pairs.push_back({p.la[i], p.lb[j]});
+      else if (depth > p.tau) done = true;
+    } else if (!out.intersecting && want_distance) {
+      // A box lower bound beyond what is already known cannot lower the minimum (slack: rounding).
+      const double lower = box_distance(p.box_a[i], p.box_b[j]);
+      if (lower <= std::min(out.distance, p.margin) + (p.margin - std::max(p.tau, options.clearance))) {
+        ++counters.distance_tests;
+        out.distance = std::min(out.distance, triangle_distance(a0, a1, a2, tb[0], tb[1], tb[2]));
+      }
+    }
+  };
+
+  const std::size_t na = end - begin, nb = p.lb.size();
+  if (!options.use_oaabb) {
+    for (std::size_t i = begin; i < end && !done; ++i)
+      for (std::size_t j = 0; j < nb && !done; ++j) test(i, j);
+  } else if (options.triangle_level == TriangleLevel::Flat ||
+             (options.triangle_level == TriangleLevel::Auto && na * nb <= options.flat_limit)) {
+    for (std::size_t i = begin; i < end && !done; ++i)
+      for (std::size_t j = 0; j < nb && !done; ++j) {
+        ++counters.aabb_tests;
+        if (boxes_within(p.box_a[i], p.box_b[j], p.margin)) test(i, j);
+      }
+  } else {
+    // Sweep over x of A's survivors (grown by the margin) and B's; candidates then visited in the
+    // same (a, b) order as the flat loops, so both variants give the same answer.
+    std::vector<std::uint32_t> oa(na), ob(nb);
+    for (std::size_t i = 0; i < na; ++i) oa[i] = static_cast<std::uint32_t>(begin + i);
+    for (std::size_t j = 0; j < nb; ++j) ob[j] = static_cast<std::uint32_t>(j);
+    auto by_min_a = [&](std::uint32_t x, std::uint32_t y) {
+      return p.box_a[x].min().x() < p.box_a[y].min().x() || (p.box_a[x].min().x() == p.box_a[y].min().x() && x < y);
+    };
+    auto by_min_b = [&](std::uint32_t x, std::uint32_t y) {
+      return p.box_b[x].min().x() < p.box_b[y].min().x() || (p.box_b[x].min().x() == p.box_b[y].min().x() && x < y);
+    };
+    std::sort(oa.begin(), oa.end(), by_min_a);
+    std::sort(ob.begin(), ob.end(), by_min_b);
+    std::vector<std::array<std::uint32_t, 2>> cand;
+    std::size_t ia = 0, ib = 0;
+    const double m = p.margin;
+    while (ia < na && ib < nb) {
+      const Aabb& ba = p.box_a[oa[ia]];
+      const Aabb& bb = p.box_b[ob[ib]];
+      if (ba.min().x() - m <= bb.min().x()) {
+        for (std::size_t k = ib; k < nb && p.box_b[ob[k]].min().x() <= ba.max().x() + m; ++k) {
+          ++counters.aabb_tests;
+          if (boxes_within(ba, p.box_b[ob[k]], m)) cand.push_back({oa[ia], ob[k]});
+        }
+        ++ia;
+      } else {
+        for (std::size_t k = ia; k < na && p.box_a[oa[k]].min().x() - m <= bb.max().x(); ++k) {
+          ++counters.aabb_tests;
+          if (boxes_within(p.box_a[oa[k]], bb, m)) cand.push_back({oa[k], ob[ib]});
+        }
+        ++ib;
+      }
+    }
+    std::sort(cand.begin(), cand.end());
+    for (const auto& c : cand) {
+      if (done) break;
+      test(c[0], c[1]);
+    }
+  }
+  counters.triangle_tests += stats.tests;
+  counters.exact_fallbacks += stats.exact_fallbacks;
+}
+
+void merge_outcome(PairOutcome& into, PairOutcome&& later) {
+  into.intersecting = into.intersecting || later.intersecting;
+  into.penetration = std::max(into.penetration, later.penetration);
+  into.distance = std::min(into.distance, later.distance);
+  into.triangle_pairs.insert(into.triangle_pairs.end(), later.triangle_pairs.begin(), later.triangle_pairs.end());
+}
+
+}  // namespace cadclash::detail
+
+namespace cadclash {
+
+const char* contact_class_name(ContactClass c) {
+  switch (c) {
+    case ContactClass::Penetrating: return "penetrating";
+    case ContactClass::Touching: return "touching";
+    case ContactClass::Clearance: return "clearance";
+    case ContactClass::Containment: return "containment";
+  }
+  return "unknown";
+}
+
+namespace detail {
+
+std::optional<ContactClass> classify(const PairOutcome& o, double tau, double clearance) {
+  if (o.intersecting) return o.penetration > tau ? ContactClass::Penetrating : ContactClass::Touching;
+  if (o.distance <= tau) return ContactClass::Touching;
+  if (clearance > 0.0 && o.distance <= clearance) return ContactClass::Clearance;
+  return std::nullopt;
+}
+
+}  // namespace detail
+}  // namespace cadclash

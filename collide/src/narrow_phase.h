@@ -1,0 +1,54 @@
+// The triangle level of one candidate surface pair, split in a preparation (OAABB, BVH queries,
+// mapping B's surviving triangles into A's frame) and a run over a range of A's survivors, so the
+// parallel Version 2 can cut a pair into blocks. Internal to cadclash::collide.
+#pragma once
+
+#include "cadclash/collide.h"
+#include "surface_bvh.h"
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace cadclash::detail {
+
+struct PreparedPair {
+  double tau = 0.0;     // touching bound: tolerance + both deflections
+  double margin = 0.0;  // search margin: max(tau, clearance) plus the rounding slack
+  std::vector<std::uint32_t> la, lb;           // surviving triangle indices of Sk and Sl, ascending
+  std::vector<Aabb> box_a, box_b;              // their boxes in A's frame, parallel to la / lb
+  std::vector<std::array<Vec3, 3>> tri_b;      // Sl's survivors mapped into A's frame
+};
+
+struct PairOutcome {
+  bool intersecting = false;
+  double penetration = 0.0;
+  double distance = std::numeric_limits<double>::infinity();
+  std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
+};
+
+// Fills `out` for surfaces `sa` (of instance A, A's frame) and `sb` (of B, mapped by t_ab: B → A;
+// t_ba its inverse). With use_oaabb false every triangle of both surfaces survives (brute force).
+void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
+                  const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, PreparedPair& out,
+                  CollideCounters& counters);
+
+// Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
+void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
+              const CollideOptions& options, PairOutcome& out, CollideCounters& counters);
+
+// Merges the outcome of a later block into an earlier one (blocks in ascending order of A's triangles).
+void merge_outcome(PairOutcome& into, PairOutcome&& later);
+
+// Crossing depth of two intersecting triangles (see "Penetrating" in collide.h).
+double crossing_depth(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                      const Vec3& b2);
+
+// The class of a surface pair from its outcome, or nullopt when it is not reported (collide.h).
+std::optional<ContactClass> classify(const PairOutcome& o, double tau, double clearance);
+
+// Generalized winding number of point `p` with respect to the triangles of `surfaces` (their own frame).
+double winding_number(const Vec3& p, std::span<const Surface* const> surfaces);
+
+}  // namespace cadclash::detail

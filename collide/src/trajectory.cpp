@@ -1,0 +1,109 @@
+// Trajectories: CSV of per-step instance poses, replayed on a Scene.
+#include "cadclash/collide.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace cadclash {
+namespace {
+
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+bool parse_double(const std::string& s, double& v) {
+  const char* end = s.data() + s.size();
+  const auto r = std::from_chars(s.data(), end, v);
+  return r.ec == std::errc() && r.ptr == end && std::isfinite(v);
+}
+
+}  // namespace
+
+std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::string& file,
+                                            std::vector<Diagnostic>& diagnostics) {
+  std::vector<TrajectoryRow> rows;
+  std::istringstream in(text);
+  std::string line;
+  std::int64_t number = 0;
+  auto error = [&](const std::string& message) {
+    diagnostics.push_back({Severity::Error, file, number, -1, message});
+  };
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    std::vector<std::string> fields;
+    std::size_t start = 0;
+    while (true) {
+      const auto comma = t.find(',', start);
+      fields.push_back(trim(std::string_view(t).substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (rows.empty() && fields[0] == "step") continue;  // header
+    if (fields.size() != 9) {
+      error("expected 9 fields 'step,instance_path,tx,ty,tz,qw,qx,qy,qz', found " + std::to_string(fields.size()));
+      continue;
+    }
+    TrajectoryRow row;
+    row.line = number;
+    const auto r = std::from_chars(fields[0].data(), fields[0].data() + fields[0].size(), row.step);
+    if (r.ec != std::errc() || r.ptr != fields[0].data() + fields[0].size()) {
+      error("step '" + fields[0] + "' is not an integer");
+      continue;
+    }
+    row.path = fields[1];
+    if (row.path.empty()) {
+      error("empty instance path");
+      continue;
+    }
+    double v[7];
+    bool ok = true;
+    for (int k = 0; k < 7 && ok; ++k) {
+      if (!parse_double(fields[static_cast<std::size_t>(k) + 2], v[k])) {
+        error("field " + std::to_string(k + 3) + " '" + fields[static_cast<std::size_t>(k) + 2] + "' is not a finite number");
+        ok = false;
+      }
+    }
+    if (!ok) continue;
+    Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    const double n = q.norm();
+    if (!(n > 1e-12)) {
+      error("quaternion (qw,qx,qy,qz) is zero");
+      continue;
+    }
+    q.coeffs() /= n;
+    row.pose = Pose::Identity();
+    row.pose.linear() = q.toRotationMatrix();
+    row.pose.translation() = Vec3(v[0], v[1], v[2]);
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const TrajectoryRow> rows,
+                                          const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
+                                          const std::string& file) {
+  std::vector<StepResult> results;
+  std::size_t k = 0;
+  while (k < rows.size()) {
+    const std::int64_t step = rows[k].step;
+    for (; k < rows.size() && rows[k].step == step; ++k) {
+      const InstanceId id = scene.find_instance(rows[k].path);
+      if (id == kInvalidId) {
+        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
+                               "no instance with path '" + rows[k].path + "'; row skipped"});
+        continue;
+      }
+      scene.set_pose(id, rows[k].pose);
+    }
+    results.push_back({step, scene.check(options)});
+  }
+  return results;
+}
+
+}  // namespace cadclash

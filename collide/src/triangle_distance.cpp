@@ -1,0 +1,204 @@
+// Triangle–triangle distance in double precision.
+//
+// The minimum distance between two disjoint closed triangles is attained between an edge of one
+// and an edge of the other, or between a vertex of one and the interior of the other. Every
+// candidate below is the distance between two explicit points, each (up to the rounding of its
+// construction) on its closed triangle: no candidate underestimates, so ill-conditioned parts
+// (the normal of a sliver, nearly parallel edges) can only lose a candidate, never report a
+// distance that is too small, and the well-conditioned candidate of the same class (an edge
+// endpoint against the other edge) still finds the minimum.
+#include "triangle_predicates.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace cadclash::detail {
+namespace {
+
+struct P3 {
+  double x, y, z;
+};
+
+inline P3 operator-(const P3& a, const P3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline P3 operator+(const P3& a, const P3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline P3 operator*(double s, const P3& a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(const P3& a, const P3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline P3 cross(const P3& a, const P3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double norm2(const P3& a) { return dot(a, a); }
+inline P3 load(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+inline double clamp01(double t) { return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t); }
+
+// An edge a + t d, t in [0, 1], with 1 / |d|^2 precomputed (0 for a zero-length edge).
+struct Edge {
+  P3 a, d;
+  double inv_dd;
+};
+
+inline Edge make_edge(const P3& a, const P3& b) {
+  const P3 d = b - a;
+  const double dd = norm2(d);
+  return {a, d, dd > 0.0 ? 1.0 / dd : 0.0};
+}
+
+// Squared distance from p to the edge.
+inline double point_edge2(const P3& p, const Edge& e) {
+  const P3 w = p - e.a;
+  const double t = clamp01(dot(w, e.d) * e.inv_dd);
+  return norm2(w - t * e.d);
+}
+
+// Squared distance between the edges at the stationary point of the lines, when it lies inside
+// both edges' parameter ranges; +inf otherwise (an endpoint–edge pair then holds the minimum).
+// s comes from the cross-product form, whose error grows like 1/angle rather than the 1/angle^2 of
+// the normal equations; t is then the projection of that point, so the returned value is the
+// distance between two actual points of the edges and only second-order sensitive to s.
+inline double edge_edge_interior2(const Edge& e, const Edge& f) {
+  const P3 n = cross(e.d, f.d);
+  const double nn = norm2(n);
+  if (!(nn > 0.0)) return std::numeric_limits<double>::infinity();  // parallel: endpoints decide
+  const P3 r = f.a - e.a;
+  const double s = dot(cross(r, f.d), n) / nn;
+  if (!(s > 0.0 && s < 1.0)) return std::numeric_limits<double>::infinity();
+  const P3 ps = e.a + s * e.d;
+  const double t = dot(ps - f.a, f.d) * f.inv_dd;
+  if (!(t > 0.0 && t < 1.0)) return std::numeric_limits<double>::infinity();
+  return norm2(ps - (f.a + t * f.d));
+}
+
+// Squared distance from p to the interior of triangle (o, o+e1, o+e2) when p projects inside it;
+// +inf otherwise (the edges then hold the minimum). n = e1 x e2, nn = |n|^2 > 0.
+inline double point_face2(const P3& p, const P3& o, const P3& e1, const P3& e2, const P3& n, double nn) {
+  const P3 w = p - o;
+  const double l1 = dot(cross(w, e2), n) / nn;
+  const double l2 = dot(cross(e1, w), n) / nn;
+  if (!(l1 >= 0.0 && l2 >= 0.0 && l1 + l2 <= 1.0)) return std::numeric_limits<double>::infinity();
+  return norm2(w - (l1 * e1 + l2 * e2));
+}
+
+// Squared distance between the closed triangles, assuming they do not intersect. Stops as soon as
+// a candidate is <= stop2 (returning that candidate).
+double disjoint_distance2(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                          const Vec3& b1, const Vec3& b2, double stop2) {
+  // Work relative to a0 so that the error scales with the triangles' extent, not their position.
+  const P3 o{a0.x(), a0.y(), a0.z()};
+  const P3 A[3] = {{0.0, 0.0, 0.0}, P3{a1.x(), a1.y(), a1.z()} - o, P3{a2.x(), a2.y(), a2.z()} - o};
+  const P3 B[3] = {P3{b0.x(), b0.y(), b0.z()} - o, P3{b1.x(), b1.y(), b1.z()} - o,
+                   P3{b2.x(), b2.y(), b2.z()} - o};
+  const Edge ea[3] = {make_edge(A[0], A[1]), make_edge(A[1], A[2]), make_edge(A[2], A[0])};
+  const Edge eb[3] = {make_edge(B[0], B[1]), make_edge(B[1], B[2]), make_edge(B[2], B[0])};
+  double best = std::numeric_limits<double>::infinity();
+  // Vertex–edge (covers every edge pair whose minimum has an endpoint).
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      best = std::min(best, std::min(point_edge2(A[i], eb[j]), point_edge2(B[i], ea[j])));
+    }
+  if (best <= stop2) return best;
+  // Edge–edge interiors.
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) best = std::min(best, edge_edge_interior2(ea[i], eb[j]));
+  if (best <= stop2) return best;
+  // Vertex–face interiors.
+  const P3 na = cross(ea[0].d, A[2] - A[0]), nb = cross(eb[0].d, B[2] - B[0]);
+  const double nna = norm2(na), nnb = norm2(nb);
+  if (nna > 0.0)
+    for (int i = 0; i < 3; ++i) best = std::min(best, point_face2(B[i], A[0], ea[0].d, A[2] - A[0], na, nna));
+  if (nnb > 0.0)
+    for (int i = 0; i < 3; ++i) best = std::min(best, point_face2(A[i], B[0], eb[0].d, B[2] - B[0], nb, nnb));
+  return best;
+}
+
+// True when every vertex of (q0, q1, q2) is certainly farther than d from the plane of
+// (p0, p1, p2), all on one side: then so is the whole triangle, and the pair is farther than d.
+// Certain means for the exact values, not just the rounded ones: det = w · n is the orientation
+// determinant of triangle_intersect.cpp, whose error is below 9u · perm (see the bound there), and
+// |n_exact| <= |fl(n)| + 4u·|perm_n| (each component of n takes 4 roundings). So
+// |fl(det)| - 9u·perm > d · (|fl(n)| + 4u·|perm_n|) · (1 + 8u) implies |det| > d · |n_exact|.
+// Inputs must satisfy |x| <= 2^48 (checked by the caller), so nothing overflows or underflows badly.
+// d is widened by 64u times the pair's extent, more than triangle_distance's rounding (measured
+// below 1e-15 times the extent in the tests), so the early out never contradicts
+// triangle_distance(...) <= d.
+bool plane_separates(const P3& p0, const P3& p1, const P3& p2, const P3& q0, const P3& q1, const P3& q2,
+                     double d) {
+  constexpr double u = 0x1p-53;
+  const P3 a = p1 - p0, b = p2 - p0;
+  double ext = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y), std::abs(b.z)});
+  for (const P3* q : {&q0, &q1, &q2}) {
+    const P3 w = *q - p0;
+    ext = std::max({ext, std::abs(w.x), std::abs(w.y), std::abs(w.z)});
+  }
+  d += 64 * u * ext;
+  const P3 n = cross(a, b);
+  const P3 pn{std::abs(a.y * b.z) + std::abs(a.z * b.y), std::abs(a.z * b.x) + std::abs(a.x * b.z),
+              std::abs(a.x * b.y) + std::abs(a.y * b.x)};
+  const double n_up = (std::sqrt(norm2(n)) + 4 * u * std::sqrt(norm2(pn))) * (1 + 8 * u);
+  const double limit = d * n_up;
+  int sign = 0;
+  for (const P3* q : {&q0, &q1, &q2}) {
+    const P3 w = *q - p0;
+    const double det = dot(w, n);
+    const double perm = std::abs(w.x) * pn.x + std::abs(w.y) * pn.y + std::abs(w.z) * pn.z;
+    const double margin = std::abs(det) - 9 * u * perm - 0x1p-1000;
+    if (!(margin > limit)) return false;
+    const int s = det > 0 ? 1 : -1;
+    if (sign != 0 && s != sign) return false;
+    sign = s;
+  }
+  return true;
+}
+
+// Disjoint closed sets are at a positive distance: keep "0 iff intersecting" even if it rounds.
+inline double positive_sqrt(double d2) {
+  return std::max(std::sqrt(d2), std::numeric_limits<double>::denorm_min());
+}
+
+}  // namespace
+
+double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                         const Vec3& b1, const Vec3& b2, TrianglePredicateStats& stats) {
+  if (triangles_intersect(a0, a1, a2, b0, b1, b2, stats)) return 0.0;
+  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, 0.0));
+}
+
+double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                         const Vec3& b1, const Vec3& b2) {
+  TrianglePredicateStats stats;
+  return triangle_distance(a0, a1, a2, b0, b1, b2, stats);
+}
+
+double triangle_distance_apart(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                               const Vec3& b1, const Vec3& b2) {
+  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, 0.0));
+}
+
+bool triangles_within(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                      const Vec3& b1, const Vec3& b2, double d, TrianglePredicateStats& stats) {
+  assert(!std::isnan(d));
+  if (!(d >= 0.0)) return false;
+  // Boxes farther apart than d along an axis: the triangles are too.
+  for (int k = 0; k < 3; ++k) {
+    const double amin = std::min({a0[k], a1[k], a2[k]}), amax = std::max({a0[k], a1[k], a2[k]});
+    const double bmin = std::min({b0[k], b1[k], b2[k]}), bmax = std::max({b0[k], b1[k], b2[k]});
+    if (bmin - amax > d || amin - bmax > d) return false;
+  }
+  if (d == 0.0) return triangles_intersect(a0, a1, a2, b0, b1, b2, stats);
+  // Either triangle's plane with the other wholly beyond d on one side. The bound behind it needs
+  // |coordinates| <= 2^48; larger ones skip this early out.
+  const P3 A[3] = {load(a0), load(a1), load(a2)}, B[3] = {load(b0), load(b1), load(b2)};
+  double mag = 0.0;
+  for (const P3& v : A) mag = std::max({mag, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  for (const P3& v : B) mag = std::max({mag, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  if (mag <= 0x1p48 && (plane_separates(A[0], A[1], A[2], B[0], B[1], B[2], d) ||
+                        plane_separates(B[0], B[1], B[2], A[0], A[1], A[2], d)))
+    return false;
+  if (triangles_intersect(a0, a1, a2, b0, b1, b2, stats)) return true;
+  // Stop early only when the candidate is clearly below d^2, so that the answer is the one
+  // triangle_distance(...) <= d gives, to the last bit.
+  const double stop2 = d * d * (1.0 - 0x1p-50);
+  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, stop2)) <= d;
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,291 @@
+// XCAF document → parts and instances; transfer-process face map; OCCT check lists as diagnostics.
+#include "cad_xcaf.h"
+
+#include <Interface_Check.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_PrinterOStream.hxx>
+#include <Quantity_Color.hxx>
+#include <Standard_Failure.hxx>
+#include <TCollection_AsciiString.hxx>
+#include <TDF_Label.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <TDF_Tool.hxx>
+#include <TDataStd_Name.hxx>
+#include <TopExp.hxx>
+#include <TopLoc_Location.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TransferBRep.hxx>
+#include <Transfer_Binder.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+#include <XCAFPrs.hxx>
+#include <XCAFPrs_IndexedDataMapOfShapeStyle.hxx>
+#include <XCAFPrs_Style.hxx>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <set>
+
+namespace cadclash::detail {
+namespace {
+
+std::string label_name(const TDF_Label& label) {
+  Handle(TDataStd_Name) name;
+  if (label.IsNull() || !label.FindAttribute(TDataStd_Name::GetID(), name)) return {};
+  return TCollection_AsciiString(name->Get()).ToCString();
+}
+
+// A path component: '/' would split it, so it becomes '_'; an empty name becomes "unnamed".
+std::string path_component(std::string name) {
+  std::replace(name.begin(), name.end(), '/', '_');
+  return name.empty() ? std::string("unnamed") : name;
+}
+
+// Applies the occurrence rule to one set of siblings (see import.h): a name that occurs more than
+// once among them gets "::k" on every occurrence, k counting from 1 in file order and skipping any k
+// that would repeat another sibling's name.
+std::vector<std::string> sibling_components(const std::vector<std::string>& names) {
+  std::map<std::string, int> total;
+  for (const std::string& n : names) ++total[n];
+  std::set<std::string> used;
+  for (const std::string& n : names)
+    if (total[n] == 1) used.insert(n);
+  std::map<std::string, int> next;
+  std::vector<std::string> out;
+  out.reserve(names.size());
+  for (const std::string& n : names) {
+    if (total[n] == 1) {
+      out.push_back(n);
+      continue;
+    }
+    std::string candidate;
+    do candidate = n + "::" + std::to_string(++next[n]);
+    while (!used.insert(candidate).second);
+    out.push_back(candidate);
+  }
+  return out;
+}
+
+struct Walker {
+  Handle(XCAFDoc_ShapeTool) shapes;
+  const std::string& file;
+  std::map<std::string, std::size_t> part_of_label;  // TDF entry → index in `leaves`
+  std::vector<TDF_Label> leaves;
+  std::vector<Instance> instances;  // part = index into `leaves`
+  std::vector<Diagnostic>& diagnostics;
+
+  void visit(const TDF_Label& label, const TopLoc_Location& location, const std::string& path, int depth) {
+    if (depth > 64) {
+      diagnostics.push_back({Severity::Error, file, 0, -1, "assembly nesting deeper than 64 levels at " + path + "; cut there"});
+      return;
+    }
+    if (XCAFDoc_ShapeTool::IsAssembly(label)) {
+      TDF_LabelSequence components;
+      XCAFDoc_ShapeTool::GetComponents(label, components, Standard_False);
+      std::vector<TDF_Label> referred;
+      std::vector<std::string> names;
+      for (Standard_Integer i = 1; i <= components.Length(); ++i) {
+        TDF_Label ref;
+        if (!XCAFDoc_ShapeTool::GetReferredShape(components(i), ref)) ref = components(i);
+        // The instance's own name (STEP: the NEXT_ASSEMBLY_USAGE_OCCURRENCE's), else its product's.
+        std::string name = label_name(components(i));
+        if (name.empty()) name = label_name(ref);
+        referred.push_back(ref);
+        names.push_back(path_component(name));
+      }
+      const std::vector<std::string> parts = sibling_components(names);
+      for (std::size_t i = 0; i < referred.size(); ++i) {
+        const TopLoc_Location child = location * XCAFDoc_ShapeTool::GetLocation(components(static_cast<Standard_Integer>(i) + 1));
+        visit(referred[i], child, path + "/" + parts[i], depth + 1);
+      }
+      return;
+    }
+    TCollection_AsciiString entry;
+    TDF_Tool::Entry(label, entry);
+    auto [it, inserted] = part_of_label.try_emplace(entry.ToCString(), leaves.size());
+    if (inserted) leaves.push_back(label);
+    const gp_Trsf& trsf = location.Transformation();
+    if (std::abs(trsf.ScaleFactor() - 1.0) > 1e-9) {
+      diagnostics.push_back({Severity::Warning, file, 0, -1,
+                             "instance " + path + " is placed with scale factor " + std::to_string(trsf.ScaleFactor()) +
+                                 "; the scale is dropped from its pose"});
+    }
+    Instance instance;
+    instance.path = path;
+    instance.part = static_cast<PartId>(it->second);
+    Pose pose = Pose::Identity();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) pose.matrix()(r, c) = trsf.Value(r + 1, c + 1) / trsf.ScaleFactor();
+      pose.matrix()(r, 3) = trsf.Value(r + 1, 4);
+    }
+    instance.pose = pose;
+    instances.push_back(std::move(instance));
+  }
+};
+
+// Face colours of a part: a face's own colour, else the colour of the nearest enclosing shape
+// (shell, solid, compound) that has one.
+std::unordered_map<const void*, std::array<float, 3>> part_face_colours(const TDF_Label& label) {
+  std::unordered_map<const void*, std::array<float, 3>> out;
+  XCAFPrs_IndexedDataMapOfShapeStyle styles;
+  try {
+    XCAFPrs::CollectStyleSettings(label, TopLoc_Location(), styles);
+  } catch (const Standard_Failure&) {
+    return out;
+  }
+  std::vector<Standard_Integer> order;
+  for (Standard_Integer i = 1; i <= styles.Extent(); ++i) order.push_back(i);
+  // Most specific first: TopAbs_FACE > SHELL > SOLID > COMPSOLID > COMPOUND in the enum.
+  std::stable_sort(order.begin(), order.end(), [&](Standard_Integer a, Standard_Integer b) {
+    return styles.FindKey(a).ShapeType() > styles.FindKey(b).ShapeType();
+  });
+  for (Standard_Integer i : order) {
+    const XCAFPrs_Style& style = styles.FindFromIndex(i);
+    if (!style.IsSetColorSurf()) continue;
+    Standard_Real r = 0, g = 0, b = 0;
+    style.GetColorSurf().Values(r, g, b, Quantity_TOC_sRGB);
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(styles.FindKey(i), TopAbs_FACE, faces);
+    for (Standard_Integer f = 1; f <= faces.Extent(); ++f)
+      out.try_emplace(faces(f).TShape().get(), std::array<float, 3>{static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)});
+  }
+  return out;
+}
+
+}  // namespace
+
+FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe) {
+  FaceEntityMap map;
+  if (process.IsNull()) return map;
+  // Entities whose result is exactly one face claim it first; an entity whose result holds several
+  // faces (a shell, a solid, a face split by healing) only tags faces no face entity claimed.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (Standard_Integer i = 1; i <= process->NbMapped(); ++i) {
+      const Handle(Standard_Transient)& entity = process->Mapped(i);
+      const TopoDS_Shape shape = TransferBRep::ShapeResult(process->MapItem(i));
+      if (shape.IsNull() || (shape.ShapeType() == TopAbs_FACE) != (pass == 0)) continue;
+      FaceEntity info;
+      if (entity.IsNull() || !describe(entity, info)) continue;
+      TopTools_IndexedMapOfShape faces;
+      TopExp::MapShapes(shape, TopAbs_FACE, faces);
+      for (Standard_Integer f = 1; f <= faces.Extent(); ++f) map.try_emplace(faces(f).TShape().get(), info);
+    }
+  }
+  return map;
+}
+
+std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(Interface_InterfaceModel)& model,
+                          const EntityLabelFn& label, const std::string& file, const std::string& what,
+                          bool warnings, std::vector<Diagnostic>& out, std::size_t limit) {
+  std::size_t fails = 0, appended = 0, dropped = 0;
+  for (checks.Start(); checks.More(); checks.Next()) {
+    const Handle(Interface_Check)& check = checks.Value();
+    if (check.IsNull()) continue;
+    std::int64_t id = -1;
+    Handle(Standard_Transient) entity = check->Entity();
+    if (entity.IsNull() && !model.IsNull() && checks.Number() > 0 && checks.Number() <= model->NbEntities())
+      entity = model->Value(checks.Number());
+    if (!entity.IsNull()) id = label(entity);
+    auto add = [&](Severity severity, const char* text) {
+      if (appended >= limit) {
+        ++dropped;
+        return;
+      }
+      out.push_back({severity, file, 0, id, what + ": " + text});
+      ++appended;
+    };
+    for (Standard_Integer i = 1; i <= check->NbFails(); ++i) {
+      ++fails;
+      add(Severity::Error, check->CFail(i));
+    }
+    if (warnings)
+      for (Standard_Integer i = 1; i <= check->NbWarnings(); ++i) add(Severity::Warning, check->CWarning(i));
+  }
+  if (dropped > 0)
+    out.push_back({fails > 0 ? Severity::Error : Severity::Warning, file, 0, -1,
+                   what + ": " + std::to_string(dropped) + " more messages not listed"});
+  return fails;
+}
+
+void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
+                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result) {
+  Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, result.diagnostics};
+  TDF_LabelSequence roots;
+  walker.shapes->GetFreeShapes(roots);
+  std::vector<std::string> names;
+  for (Standard_Integer i = 1; i <= roots.Length(); ++i) names.push_back(path_component(label_name(roots(i))));
+  const std::vector<std::string> components = sibling_components(names);
+  for (Standard_Integer i = 1; i <= roots.Length(); ++i)
+    walker.visit(roots(i), TopLoc_Location(), "/" + components[static_cast<std::size_t>(i - 1)], 0);
+
+  std::vector<TopoDS_Shape> shapes(walker.leaves.size());
+  std::vector<BrepPartInput> inputs(walker.leaves.size());
+  for (std::size_t p = 0; p < walker.leaves.size(); ++p) {
+    const TDF_Label& label = walker.leaves[p];
+    shapes[p] = XCAFDoc_ShapeTool::GetShape(label);
+    BrepPartInput& in = inputs[p];
+    in.shape = &shapes[p];
+    in.name = label_name(label);
+    if (in.name.empty()) in.name = "part" + std::to_string(p);
+    in.source_file = file;
+    in.kind = kind;
+    const auto colours = part_face_colours(label);
+    TopTools_IndexedMapOfShape face_map;
+    if (!shapes[p].IsNull()) TopExp::MapShapes(shapes[p], TopAbs_FACE, face_map);
+    in.tags.resize(static_cast<std::size_t>(face_map.Extent()));
+    std::size_t untagged = 0;
+    for (Standard_Integer f = 1; f <= face_map.Extent(); ++f) {
+      BrepFaceTag& tag = in.tags[static_cast<std::size_t>(f - 1)];
+      const void* key = face_map(f).TShape().get();
+      if (auto it = faces.find(key); it != faces.end()) {
+        tag.entity_id = it->second.id;
+        tag.name = it->second.name;
+      } else {
+        ++untagged;
+      }
+      if (auto it = colours.find(key); it != colours.end()) tag.colour = it->second;
+    }
+    if (face_map.Extent() == 0)
+      result.diagnostics.push_back({Severity::Warning, file, 0, -1, "part '" + in.name + "' has no faces"});
+    if (untagged > 0 && kind != SourceKind::BrepFace)
+      result.diagnostics.push_back({Severity::Warning, file, 0, -1,
+                                    "part '" + in.name + "': " + std::to_string(untagged) +
+                                        " faces could not be traced to a file entity"});
+  }
+  std::vector<BrepPartInput> nonempty_inputs;
+  std::vector<std::size_t> input_of;
+  for (std::size_t p = 0; p < inputs.size(); ++p) {
+    if (shapes[p].IsNull()) {
+      result.diagnostics.push_back({Severity::Error, file, 0, -1, "part '" + inputs[p].name + "' has no shape; dropped"});
+      result.complete = false;
+      continue;
+    }
+    input_of.push_back(p);
+    nonempty_inputs.push_back(std::move(inputs[p]));
+  }
+  const std::vector<PartId> ids = add_brep_parts(result.model, nonempty_inputs, options.tessellation, options.lazy,
+                                                 result.diagnostics, result.complete);
+  std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
+  for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
+  for (Instance& instance : walker.instances) {
+    const PartId id = id_of_leaf[instance.part];
+    if (id == kInvalidId) continue;  // its part was dropped and reported above
+    instance.part = id;
+    result.model.instances.push_back(std::move(instance));
+  }
+}
+
+std::string cad_file_stem(const std::string& path) { return std::filesystem::path(path).stem().string(); }
+
+void prepare_occt_exchange() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
+    if (!messenger.IsNull()) messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+  });
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,57 @@
+// The parts of CAD import shared by the STEP, IGES and BREP readers: walking an XCAF document into
+// parts and instances, face tags from the transfer process, OCCT check lists as diagnostics.
+// Internal to cadclash::import.
+#pragma once
+
+#include "cadclash/import.h"
+
+#include <Interface_CheckIterator.hxx>
+#include <Interface_InterfaceModel.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopoDS_Shape.hxx>
+#include <Transfer_TransientProcess.hxx>
+
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace cadclash::detail {
+
+// What the file says about one face entity.
+struct FaceEntity {
+  std::int64_t id = -1;  // STEP #id / IGES directory entry number
+  std::string name;
+};
+
+// Face TShape → its entity, built once per file from every mapped entity of the transfer process.
+using FaceEntityMap = std::unordered_map<const void*, FaceEntity>;
+
+// Maps entity → (id, name) for an entity that is a face of the format; returns false to skip it.
+using FaceEntityFn = std::function<bool(const Handle(Standard_Transient)&, FaceEntity&)>;
+
+FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe);
+
+// The label number of an entity as the file writes it (#N for STEP, DE number for IGES); -1 if none.
+using EntityLabelFn = std::function<std::int64_t(const Handle(Standard_Transient)&)>;
+
+// Appends one diagnostic per fail (as Error) and, when `warnings`, per warning of `checks`, naming the
+// entity by `label`. At most `limit` are appended; a final line counts the rest. Returns the number of fails.
+std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(Interface_InterfaceModel)& model,
+                          const EntityLabelFn& label, const std::string& file, const std::string& what,
+                          bool warnings, std::vector<Diagnostic>& out, std::size_t limit = 40);
+
+// Walks the document's free shapes into `result`: one instance per leaf occurrence with its full path
+// and placement, one part per distinct leaf shape (shared by all its instances), tessellated as the
+// options say. Face tags come from `faces` (by TShape) and the document's colours.
+void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
+                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result);
+
+// The file's stem ("dir/part.brep" → "part").
+std::string cad_file_stem(const std::string& path);
+
+// Silences OCCT's default message printers: library code never prints, and every OCCT message that
+// matters reaches the caller through the check lists. Idempotent; call before reading.
+void prepare_occt_exchange();
+
+}  // namespace cadclash::detail

@@ -1,0 +1,41 @@
+// OCCT's native .brep through BRepTools::Read: one part named after the file, one instance.
+#include "cad_xcaf.h"
+#include "readers.h"
+
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <Standard_Failure.hxx>
+#include <TopoDS_Shape.hxx>
+
+namespace cadclash::detail {
+
+ImportResult read_brep(const std::string& path, const ImportOptions& options) {
+  prepare_occt_exchange();
+  ImportResult result;
+  try {
+    TopoDS_Shape shape;
+    BRep_Builder builder;
+    if (!BRepTools::Read(shape, path.c_str(), builder) || shape.IsNull())
+      return failed_import(path, "cannot read BREP file (not an OCCT .brep, or damaged)");
+    // Triangulations stored in the file were made with unknown settings; ours follow the options.
+    BRepTools::Clean(shape, Standard_True);
+    BrepPartInput in;
+    in.shape = &shape;
+    in.name = cad_file_stem(path);
+    in.source_file = path;
+    in.kind = SourceKind::BrepFace;
+    const std::vector<PartId> ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation,
+                                                   options.lazy, result.diagnostics, result.complete);
+    if (result.model.parts[ids[0]].surface_count == 0)
+      result.diagnostics.push_back({Severity::Warning, path, 0, -1, "the shape has no faces"});
+    Instance instance;
+    instance.path = "/" + in.name;
+    instance.part = ids[0];
+    result.model.instances.push_back(std::move(instance));
+  } catch (const Standard_Failure& e) {
+    return failed_import(path, std::string("OCCT failed while reading BREP: ") + e.GetMessageString());
+  }
+  return result;
+}
+
+}  // namespace cadclash::detail

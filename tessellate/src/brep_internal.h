@@ -1,0 +1,51 @@
+// Internal pieces of the B-rep tessellation shared by brep_source.cpp and brep_parts.cpp.
+#pragma once
+
+#include "cadclash/tessellate.h"
+
+#include <TopoDS_Face.hxx>
+#include <gp_Trsf.hxx>
+
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace cadclash {
+
+struct BrepSource::Impl {
+  std::string part_name;
+  std::string source_file;
+  std::vector<TopoDS_Face> faces;           // part-local, in face-index order
+  std::vector<std::int64_t> entity_ids;     // per face; -1 if unknown
+  std::vector<Aabb> boxes;                  // part-local box of each exact face
+  double default_deflection = 0.1;          // absolute, mm
+  double angular_deflection = 0.5;
+  bool verify_deflection = true;
+  mutable std::mutex mutex;                 // BRepMesh writes triangulations into the shared TShapes
+};
+
+namespace detail {
+
+// Runs BRepMesh_IncrementalMesh on `shape` (a face or a compound of faces) with an absolute linear
+// deflection. Returns false and fills `why` when OCCT throws.
+bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why);
+
+// Reads the face's triangulation into `out` (part-local, outward winding). When `measure` is set,
+// `achieved` is max(triangulation deflection, distance from each triangle centroid to the surface
+// point at its UV centroid); otherwise the triangulation's own deflection. False if no triangles.
+bool read_face_triangles(const TopoDS_Face& face, bool measure, TriangleMesh& out, double& achieved);
+
+// Makes the face's triangulation meet `target` (re-meshing when it has none or a coarser one, and
+// finer again when the measured error still exceeds target, up to 3 times) and reads it.
+bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool verify, TriangleMesh& out,
+                  double& achieved, std::string& why);
+
+// Part-local box enclosing the exact face: BRepBndLib::AddOptimal for analytic surfaces (cheap and
+// tight), BRepBndLib::Add (control polygons) for the rest.
+Aabb face_aabb(const TopoDS_Face& face);
+
+gp_Trsf to_trsf(const Pose& pose);
+Pose to_pose(const gp_Trsf& trsf);
+
+}  // namespace detail
+}  // namespace cadclash

@@ -1,0 +1,175 @@
+// add_brep_parts: B-rep shapes into parts and surfaces (healing, exact boxes, eager tessellation).
+#include "brep_internal.h"
+
+#include <BRepCheck_Analyzer.hxx>
+#include <BRep_Builder.hxx>
+#include <ShapeFix_Face.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+
+#include <cassert>
+#include <cstddef>
+
+namespace cadclash {
+namespace {
+
+bool face_is_valid(const TopoDS_Face& face) {
+  try {
+    BRepCheck_Analyzer analyzer(face, Standard_True);
+    return analyzer.IsValid() == Standard_True;
+  } catch (const Standard_Failure&) {
+    return false;
+  }
+}
+
+// ShapeFix_Face on an invalid face; returns true and replaces `face` when the fix changed it.
+bool heal_face(TopoDS_Face& face) {
+  try {
+    ShapeFix_Face fix(face);
+    fix.Perform();
+    TopoDS_Face fixed = fix.Face();
+    if (fixed.IsNull() || fixed.IsSame(face)) return false;
+    fixed.Orientation(face.Orientation());
+    face = fixed;
+    return true;
+  } catch (const Standard_Failure&) {
+    return false;
+  }
+}
+
+std::string failure_message(const BrepSource::Impl& impl, std::size_t face, const std::string& why) {
+  return "face " + std::to_string(face) + " of part '" + impl.part_name + "' could not be tessellated (" + why +
+         "); its surface is kept without triangles";
+}
+
+}  // namespace
+
+std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
+                                   const TessellationOptions& options, bool lazy,
+                                   std::vector<Diagnostic>& diagnostics, bool& complete) {
+  assert(options.linear_deflection > 0.0);
+  std::vector<PartId> ids;
+  ids.reserve(parts.size());
+  for (const BrepPartInput& in : parts) {
+    assert(in.shape != nullptr);
+    auto impl = std::make_unique<BrepSource::Impl>();
+    impl->part_name = in.name;
+    impl->source_file = in.source_file;
+    impl->angular_deflection = options.angular_deflection;
+    impl->verify_deflection = options.verify_deflection;
+
+    TopTools_IndexedMapOfShape map;
+    TopExp::MapShapes(*in.shape, TopAbs_FACE, map);
+    const auto n = static_cast<std::size_t>(map.Extent());
+    impl->faces.reserve(n);
+    for (Standard_Integer i = 1; i <= map.Extent(); ++i) impl->faces.push_back(TopoDS::Face(map(i)));
+    impl->entity_ids.resize(n, -1);
+    for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl->entity_ids[i] = in.tags[i].entity_id;
+
+    // Healing: only faces BRepCheck rejects are touched, one at a time, so face indices and the
+    // file's entity ids stay attached to the same faces.
+    std::vector<char> healed(n, 0);
+    bool whole_valid = false;
+    try {
+      whole_valid = BRepCheck_Analyzer(*in.shape, Standard_True).IsValid() == Standard_True;
+    } catch (const Standard_Failure&) {
+    }
+    if (!whole_valid) {
+      for (std::size_t i = 0; i < n; ++i)
+        if (!face_is_valid(impl->faces[i])) healed[i] = heal_face(impl->faces[i]) ? 1 : 0;
+    }
+
+    impl->boxes.resize(n);
+    Aabb part_box;
+#pragma omp parallel for schedule(dynamic, 8) if (options.parallel && n > 16)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i)
+      impl->boxes[static_cast<std::size_t>(i)] = detail::face_aabb(impl->faces[static_cast<std::size_t>(i)]);
+    for (const Aabb& b : impl->boxes)
+      if (!b.isEmpty()) part_box.extend(b);
+    double deflection = options.linear_deflection;
+    if (options.relative) {
+      const double diagonal = part_box.isEmpty() ? 0.0 : part_box.diagonal().norm();
+      deflection = diagonal > 0.0 ? options.linear_deflection * diagonal : options.linear_deflection;
+    }
+    impl->default_deflection = deflection;
+
+    const auto part_id = static_cast<PartId>(model.parts.size());
+    Part part;
+    part.name = in.name;
+    part.source_file = in.source_file;
+    part.first_surface = static_cast<SurfaceId>(model.surfaces.size());
+    part.surface_count = static_cast<std::uint32_t>(n);
+
+    std::vector<Surface> surfaces(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      Surface& s = surfaces[i];
+      s.name = "face" + std::to_string(i);
+      s.part = part_id;
+      s.provenance.kind = in.kind;
+      s.provenance.source_file = in.source_file;
+      s.provenance.face_index = static_cast<std::int32_t>(i);
+      s.provenance.healed = healed[i] != 0;
+      if (i < in.tags.size()) {
+        s.provenance.step_id = in.tags[i].entity_id;
+        s.provenance.source_name = in.tags[i].name;
+        s.provenance.colour = in.tags[i].colour;
+      }
+      s.aabb = impl->boxes[i];
+    }
+
+    if (!lazy && n > 0) {
+      // One BRepMesh call over all faces of the part: shared edges are discretised once and BRepMesh
+      // spreads the faces over threads.
+      TopoDS_Compound compound;
+      BRep_Builder builder;
+      builder.MakeCompound(compound);
+      for (const TopoDS_Face& f : impl->faces) builder.Add(compound, f);
+      std::string why;
+      const bool meshed = detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why);
+      (void)meshed;  // faces left without triangles are retried one by one below
+
+      std::vector<char> good(n, 0);
+#pragma omp parallel for schedule(dynamic, 4) if (options.parallel && n > 8)
+      for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        double achieved = 0.0;
+        if (detail::read_face_triangles(impl->faces[i], options.verify_deflection, surfaces[i].mesh, achieved) &&
+            (!options.verify_deflection || achieved <= deflection)) {
+          surfaces[i].deflection = achieved;
+          good[i] = 1;
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        if (good[i] == 0) {
+          double achieved = 0.0;
+          std::string face_why;
+          if (detail::mesh_face_to(impl->faces[i], deflection, options.angular_deflection, options.verify_deflection,
+                                   surfaces[i].mesh, achieved, face_why)) {
+            surfaces[i].deflection = achieved;
+            good[i] = 1;
+          } else {
+            surfaces[i].mesh = {};
+            diagnostics.push_back(Diagnostic{Severity::Error, in.source_file, 0, impl->entity_ids[i],
+                                             failure_message(*impl, i, face_why.empty() ? why : face_why)});
+            complete = false;
+          }
+        }
+        if (good[i] != 0) {
+          surfaces[i].has_triangles = true;
+          surfaces[i].aabb.extend(mesh_aabb(surfaces[i].mesh));
+        }
+      }
+    }
+
+    part.source = std::make_shared<BrepSource>(std::move(impl));
+    model.parts.push_back(std::move(part));
+    for (Surface& s : surfaces) model.surfaces.push_back(std::move(s));
+    ids.push_back(part_id);
+  }
+  return ids;
+}
+
+}  // namespace cadclash

@@ -1,0 +1,88 @@
+// BrepSource: the exact faces of one part, tessellated on demand and measured exactly.
+#include "brep_internal.h"
+
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <Standard_Failure.hxx>
+#include <TopLoc_Location.hxx>
+#include <TopoDS.hxx>
+
+#include <cassert>
+#include <mutex>
+
+namespace cadclash {
+namespace {
+
+Aabb placed_box(const Aabb& local, const Pose& pose) {
+  Aabb world;
+  if (local.isEmpty()) return world;
+  for (int corner = 0; corner < 8; ++corner) world.extend(pose * local.corner(static_cast<Aabb::CornerType>(corner)));
+  return world;
+}
+
+double box_distance(const Aabb& a, const Aabb& b) {
+  const Vec3 gap = (a.min() - b.max()).cwiseMax(b.min() - a.max()).cwiseMax(0.0);
+  return gap.norm();
+}
+
+}  // namespace
+
+BrepSource::BrepSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) { assert(impl_); }
+BrepSource::~BrepSource() = default;
+
+std::uint32_t BrepSource::face_count() const { return static_cast<std::uint32_t>(impl_->faces.size()); }
+
+const TopoDS_Face& BrepSource::face(std::uint32_t local_index) const {
+  assert(local_index < impl_->faces.size());
+  return impl_->faces[local_index];
+}
+
+double BrepSource::default_deflection() const { return impl_->default_deflection; }
+
+bool BrepSource::triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
+                             double& achieved_deflection, Diagnostic& error) {
+  assert(local_index < impl_->faces.size());
+  const double target = deflection > 0.0 ? deflection : impl_->default_deflection;
+  std::string why;
+  bool ok = false;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    ok = detail::mesh_face_to(impl_->faces[local_index], target, impl_->angular_deflection, impl_->verify_deflection,
+                              out, achieved_deflection, why);
+  }
+  if (!ok) {
+    error = Diagnostic{Severity::Error, impl_->source_file, 0, impl_->entity_ids[local_index],
+                       "face " + std::to_string(local_index) + " of part '" + impl_->part_name +
+                           "' could not be tessellated (" + why + ")"};
+  }
+  return ok;
+}
+
+std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
+                                                 std::uint32_t local_b, const Pose& pose_b,
+                                                 double max_distance) const {
+  const auto* other_brep = dynamic_cast<const BrepSource*>(&other);
+  if (other_brep == nullptr) return std::nullopt;
+  const Impl& a = *impl_;
+  const Impl& b = *other_brep->impl_;
+  assert(local_a < a.faces.size() && local_b < b.faces.size());
+
+  const double boxes_apart = box_distance(placed_box(a.boxes[local_a], pose_a), placed_box(b.boxes[local_b], pose_b));
+  if (!a.boxes[local_a].isEmpty() && !b.boxes[local_b].isEmpty() && boxes_apart > max_distance) return boxes_apart;
+
+  // Both parts' faces may be meshed by other threads; hold both (scoped_lock orders them).
+  std::unique_lock<std::mutex> lock_a(a.mutex, std::defer_lock);
+  std::unique_lock<std::mutex> lock_b(b.mutex, std::defer_lock);
+  if (&a == &b) lock_a.lock();
+  else std::lock(lock_a, lock_b);
+  try {
+    const TopoDS_Shape fa = a.faces[local_a].Moved(TopLoc_Location(detail::to_trsf(pose_a)));
+    const TopoDS_Shape fb = b.faces[local_b].Moved(TopLoc_Location(detail::to_trsf(pose_b)));
+    BRepExtrema_DistShapeShape dist(fa, fb, Extrema_ExtFlag_MIN);
+    if (!dist.IsDone() || dist.NbSolution() == 0) return std::nullopt;
+    return dist.Value();
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace cadclash

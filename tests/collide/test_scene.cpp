@@ -1,0 +1,204 @@
+// Prepared scenes: incremental poses, selections and exclusions, lazy tessellation, trajectories.
+#include "scene_fixtures.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+
+namespace cadclash {
+namespace {
+
+using namespace cadclash::testing;
+
+Model row_of_boxes(int n) {
+  Model m;
+  const PartId box = add_part(m, "box", box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1), 2));
+  for (int i = 0; i < n; ++i) add_instance(m, "/row/b" + std::to_string(i), box, translation(1.5 * i, 0, 0));
+  return m;
+}
+
+TEST(Scene, OnlyMovedInstancesGetNewWorldBoxes) {
+  Model m = row_of_boxes(5);
+  Scene scene(m);
+  CollideOptions o;
+  Report r = scene.check(o);
+  EXPECT_TRUE(r.pairs.empty());
+  EXPECT_EQ(r.counters.instance_pairs, 0u);
+  EXPECT_EQ(r.counters.aabb_updates, 5u);  // first check: every instance
+  r = scene.check(o);
+  EXPECT_EQ(r.counters.aabb_updates, 0u);  // nothing moved
+  scene.set_pose(2, translation(1.5 * 2 - 0.5, 0, 0));  // b2 now touches b1 face to face
+  r = scene.check(o);
+  ASSERT_FALSE(r.pairs.empty());
+  for (const SurfacePairResult& p : r.pairs) {
+    EXPECT_EQ(p.instance_a, 1u);
+    EXPECT_EQ(p.instance_b, 2u);
+    EXPECT_EQ(p.contact, ContactClass::Touching);
+  }
+  EXPECT_EQ(r.counters.instance_pairs, 1u);
+  // The moved scene answers like a fresh one built on the moved model, and like brute force.
+  Model moved = m;
+  moved.instances[2].pose = scene.pose(2);
+  Scene fresh(moved);
+  expect_same_pairs(r, fresh.check(o));
+  o.use_oaabb = false;
+  expect_same_pairs(r, fresh.check(o));
+}
+
+TEST(Scene, SelectionsAndExclusions) {
+  Model m = row_of_boxes(4);
+  for (InstanceId i = 0; i < 4; ++i) m.instances[i].pose = translation(0.3 * i, 0, 0);  // all overlap
+  m.instances[3].path = "/other/b3";
+  auto pairs_of = [&](SceneSelection sel) {
+    Scene scene(m, std::move(sel));
+    std::set<std::pair<InstanceId, InstanceId>> out;
+    for (const SurfacePairResult& p : scene.check().pairs) out.insert({p.instance_a, p.instance_b});
+    return out;
+  };
+  using Set = std::set<std::pair<InstanceId, InstanceId>>;
+  EXPECT_EQ(pairs_of({}), (Set{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}));
+  SceneSelection a_vs_b;
+  a_vs_b.set_a = {0};
+  a_vs_b.set_b = {2, 3};
+  EXPECT_EQ(pairs_of(a_vs_b), (Set{{0, 2}, {0, 3}}));
+  SceneSelection a_vs_all;
+  a_vs_all.set_a = {1};
+  EXPECT_EQ(pairs_of(a_vs_all), (Set{{0, 1}, {1, 2}, {1, 3}}));
+  SceneSelection named;
+  named.excluded_pairs = {{"/row/b2", "/row/b0"}};
+  EXPECT_EQ(pairs_of(named), (Set{{0, 1}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}));
+  SceneSelection sub;
+  sub.excluded_subassemblies = {"/row"};
+  EXPECT_EQ(pairs_of(sub), (Set{{0, 3}, {1, 3}, {2, 3}}));
+  SceneSelection prefix_only;
+  prefix_only.excluded_subassemblies = {"/ro"};  // a path prefix that is not a whole name excludes nothing
+  EXPECT_EQ(pairs_of(prefix_only).size(), 6u);
+}
+
+// A B-rep stand-in: triangles appear only when asked, and the asks are recorded.
+class LazyBoxes : public SurfaceSource {
+ public:
+  explicit LazyBoxes(std::vector<Surface> faces) : faces_(std::move(faces)) {}
+  bool triangulate(std::uint32_t local_index, double, TriangleMesh& out, double& achieved, Diagnostic& error) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    asked.push_back(local_index);
+    if (local_index == fail_index) {
+      error.message = "face " + std::to_string(local_index) + " failed to mesh";
+      return false;
+    }
+    out = faces_[local_index].mesh;
+    achieved = 0.0;
+    return true;
+  }
+  std::vector<std::uint32_t> asked;
+  std::uint32_t fail_index = kInvalidId;
+
+ private:
+  std::vector<Surface> faces_;
+  std::mutex mutex_;
+};
+
+TEST(Scene, TessellatesOnlySurvivingSurfaces) {
+  Model eager;
+  const PartId lazy_box = add_part(eager, "lazy", box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1), 2));
+  const PartId plain_box = add_part(eager, "plain", box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1), 2));
+  add_instance(eager, "/a", lazy_box);
+  add_instance(eager, "/b", plain_box, translation(0.9, 0.3, 0.3));  // meets A's x+ region only
+  Model lazy = eager;
+  auto source = std::make_shared<LazyBoxes>(box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1), 2));
+  lazy.parts[lazy_box].source = source;
+  for (SurfaceId s = 0; s < 6; ++s) {
+    lazy.surfaces[s].has_triangles = false;
+    lazy.surfaces[s].mesh = {};
+  }
+  const Report r = collide(lazy, 0, 1);
+  expect_same_pairs(r, collide(eager, 0, 1));
+  EXPECT_GT(r.counters.tessellated_surfaces, 0u);
+  EXPECT_LT(r.counters.tessellated_surfaces, 6u);  // not every face of A was needed
+  EXPECT_EQ(source->asked.size(), r.counters.tessellated_surfaces);
+  for (std::uint32_t f : source->asked) EXPECT_NE(lazy.surfaces[f].name, "x-");  // far side of A, far from B
+  EXPECT_FALSE(lazy.surfaces[0].has_triangles);
+}
+
+TEST(Scene, FailedTessellationIsADiagnostic) {
+  Model m;
+  const PartId box = add_part(m, "box", box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  add_instance(m, "/a", box);
+  add_instance(m, "/b", box, translation(0.9, 0.3, 0.3));
+  auto source = std::make_shared<LazyBoxes>(box_surfaces(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  source->fail_index = 1;  // x+
+  m.parts[0].source = source;
+  for (Surface& s : m.surfaces) {
+    s.has_triangles = false;
+    s.mesh = {};
+  }
+  const Report r = collide(m, 0, 1);
+  ASSERT_FALSE(r.diagnostics.empty());
+  EXPECT_NE(r.diagnostics[0].message.find("failed to mesh"), std::string::npos);
+  for (const SurfacePairResult& p : r.pairs) EXPECT_NE(m.surfaces[p.surface_a].name, "x+");
+  EXPECT_FALSE(r.pairs.empty());  // the other faces are still checked
+}
+
+TEST(Trajectory, ParsesRowsAndNamesBadLines) {
+  const std::string csv =
+      "step,instance_path,tx,ty,tz,qw,qx,qy,qz\n"
+      "0,/a,1,2,3,1,0,0,0\n"
+      "\n"
+      "# comment\n"
+      "1,/a,1,2,3,0,0,0,2\n"      // unnormalised: normalised to 180 degrees about z
+      "x,/a,1,2,3,1,0,0,0\n"      // line 6: step
+      "2,/a,1,2,nan,1,0,0,0\n"    // line 7: not finite
+      "3,/a,1,2,3,0,0,0,0\n"      // line 8: zero quaternion
+      "4,/a,1,2,3\n"              // line 9: fields
+      "5,,1,2,3,1,0,0,0\n";       // line 10: empty path
+  std::vector<Diagnostic> ds;
+  const auto rows = parse_trajectory(csv, "t.csv", ds);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].line, 2);
+  EXPECT_TRUE(rows[0].pose.translation().isApprox(Vec3(1, 2, 3)));
+  EXPECT_EQ(rows[1].step, 1);
+  EXPECT_TRUE((rows[1].pose.linear() * Vec3(1, 0, 0)).isApprox(Vec3(-1, 0, 0), 1e-12));
+  ASSERT_EQ(ds.size(), 5u);
+  const std::int64_t lines[] = {6, 7, 8, 9, 10};
+  for (std::size_t k = 0; k < 5; ++k) {
+    EXPECT_EQ(ds[k].line, lines[k]);
+    EXPECT_EQ(ds[k].file, "t.csv");
+    EXPECT_EQ(ds[k].severity, Severity::Error);
+  }
+  EXPECT_NE(format_diagnostic(ds[2]).find("t.csv:8"), std::string::npos);
+}
+
+TEST(Trajectory, ReplaysStepsAndMatchesStaticChecks) {
+  Model m = row_of_boxes(3);
+  const std::string csv =
+      "0,/row/b1,1.5,0,0,1,0,0,0\n"
+      "1,/row/b1,1.0,0,0,1,0,0,0\n"     // touches b0
+      "2,/row/b1,0.8,0.2,0.1,1,0,0,0\n"  // penetrates b0
+      "2,/row/b2,2.0,0,0,1,0,0,0\n"
+      "2,/nowhere,0,0,0,1,0,0,0\n";     // unknown: a warning, the row is skipped
+  std::vector<Diagnostic> ds;
+  const auto rows = parse_trajectory(csv, "p.csv", ds);
+  ASSERT_TRUE(ds.empty());
+  Scene scene(m);
+  const auto steps = replay_trajectory(scene, rows, CollideOptions{}, ds, "p.csv");
+  ASSERT_EQ(steps.size(), 3u);
+  ASSERT_EQ(ds.size(), 1u);
+  EXPECT_EQ(ds[0].severity, Severity::Warning);
+  EXPECT_EQ(ds[0].line, 5);
+  EXPECT_TRUE(steps[0].report.pairs.empty());
+  ASSERT_FALSE(steps[1].report.pairs.empty());
+  for (const auto& p : steps[1].report.pairs) EXPECT_EQ(p.contact, ContactClass::Touching);
+  bool penetrating = false;
+  for (const auto& p : steps[2].report.pairs) penetrating = penetrating || p.contact == ContactClass::Penetrating;
+  EXPECT_TRUE(penetrating);
+  // Step 2 equals a static check of the same placement.
+  Model placed = m;
+  placed.instances[1].pose = rows[2].pose;
+  placed.instances[2].pose = rows[3].pose;
+  Scene fresh(placed);
+  expect_same_pairs(steps[2].report, fresh.check());
+}
+
+}  // namespace
+}  // namespace cadclash

@@ -1,0 +1,78 @@
+// Generators of triangle pairs for the predicate tests and benchmarks: random, coplanar, touching,
+// shared features, far offsets, slivers, 1-ulp perturbations, degenerate, under rigid motions; and the
+// brute-force exact oracle (CGAL Epeck, exact constructions) they are checked against.
+#pragma once
+
+#include "cadclash/collide.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string_view>
+
+namespace cadclash::test {
+
+using Tri = std::array<Vec3, 3>;
+
+struct TriPair {
+  Tri a, b;
+};
+
+// splitmix64: portable, so every platform generates the same cases.
+class Rng {
+ public:
+  explicit Rng(std::uint64_t seed) : s_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (s_ += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }  // [0, 1)
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+  int integer(int lo, int hi) {  // [lo, hi]
+    return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1));
+  }
+  Vec3 vec(double lo, double hi) { return {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)}; }
+  Vec3 ivec(int lo, int hi) {
+    return {double(integer(lo, hi)), double(integer(lo, hi)), double(integer(lo, hi))};
+  }
+  Vec3 unit() {
+    for (;;) {
+      const Vec3 v = vec(-1, 1);
+      const double n = v.norm();
+      if (n > 0.1 && n <= 1.0) return v / n;
+    }
+  }
+
+ private:
+  std::uint64_t s_;
+};
+
+enum class Family {
+  RandomCube,      // vertices uniform in the unit cube (about half intersect)
+  RandomNear,      // small triangles near each other (mostly disjoint, many close calls)
+  CoplanarGrid,    // both triangles exactly in one plane on an integer lattice: overlap, touch, apart
+  SharedFeature,   // a shared vertex or a shared edge, the rest random or on the common plane
+  TouchingGrid,    // a vertex or edge of B exactly on an edge or the face of A, B otherwise off-plane
+  FarOffset,       // at 1e8 from the origin with 1e-3 features
+  Sliver,          // needles and caps with angles of 1e-12 against small random triangles
+  UlpPerturbed,    // a coplanar or touching pair with one coordinate moved by 1-4 ulps
+  Degenerate,      // collinear and repeated vertices, points, segments
+  RigidMotion,     // any of the above under a large rotation and translation (rounded)
+  kCount
+};
+
+std::string_view family_name(Family f);
+
+// The i-th case of family f for seed `seed` (deterministic).
+TriPair make_case(Family f, Rng& rng);
+
+// Applies a random large rigid motion (rotation, translation up to `max_shift`) to both triangles;
+// coordinates are rounded to doubles, as the tests check the rounded values.
+TriPair rigid_motion(const TriPair& p, Rng& rng, double max_shift);
+
+// The oracle: exact intersection of the closed point sets with CGAL's Epeck (exact constructions).
+bool oracle_intersect(const Tri& a, const Tri& b);
+
+}  // namespace cadclash::test

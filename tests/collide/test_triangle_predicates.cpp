@@ -1,0 +1,221 @@
+// triangles_intersect against a brute-force exact oracle (CGAL Epeck on the same doubles), on random
+// and adversarial families, plus hand-made cases with known answers.
+//
+// Default run: 100 000 pairs per family, 10 families = 10^6 pairs (Release). Builds without NDEBUG
+// (Debug, ASan) run a tenth of that to keep the sanitizer run short. The opt-in long run
+// (test_triangle_predicates_slow, CTest label `slow`) checks 10^7 pairs per family with other seeds:
+//   CADCLASH_SLOW_TESTS=1 ctest --test-dir build -L slow --output-on-failure
+#include "test_triangle_cases.h"
+#include "triangle_predicates.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+namespace cadclash {
+namespace {
+
+using detail::TrianglePredicateStats;
+using detail::triangles_intersect;
+using detail::triangles_intersect_exact;
+using test::Family;
+using test::Tri;
+using test::TriPair;
+
+// The long run's tests get their own names: CTest keys test properties (the `slow` label) by name.
+#ifdef CADCLASH_TRIANGLE_SLOW
+#define ORACLE_SUITE LongOracleAgreement
+constexpr long kPairsPerFamily = 10'000'000;
+constexpr std::uint64_t kSeedBase = 0x51'0000;
+#elif defined(NDEBUG)
+#define ORACLE_SUITE OracleAgreement
+constexpr long kPairsPerFamily = 100'000;
+constexpr std::uint64_t kSeedBase = 0;
+#else
+#define ORACLE_SUITE OracleAgreement
+constexpr long kPairsPerFamily = 10'000;
+constexpr std::uint64_t kSeedBase = 0;
+#endif
+
+bool intersect(const Tri& a, const Tri& b, TrianglePredicateStats& s) {
+  return triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2], s);
+}
+
+std::string describe(const TriPair& p) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "A = (%a %a %a) (%a %a %a) (%a %a %a)\nB = (%a %a %a) (%a %a %a) (%a %a %a)",
+                p.a[0].x(), p.a[0].y(), p.a[0].z(), p.a[1].x(), p.a[1].y(), p.a[1].z(), p.a[2].x(),
+                p.a[2].y(), p.a[2].z(), p.b[0].x(), p.b[0].y(), p.b[0].z(), p.b[1].x(), p.b[1].y(),
+                p.b[1].z(), p.b[2].x(), p.b[2].y(), p.b[2].z());
+  return buf;
+}
+
+class ORACLE_SUITE : public ::testing::TestWithParam<Family> {};
+
+TEST_P(ORACLE_SUITE, ZeroDisagreements) {
+#ifdef CADCLASH_TRIANGLE_SLOW
+  if (!std::getenv("CADCLASH_SLOW_TESTS")) GTEST_SKIP() << "opt-in: set CADCLASH_SLOW_TESTS=1";
+#endif
+  const Family f = GetParam();
+  test::Rng rng(kSeedBase + 1000 + static_cast<std::uint64_t>(f));
+  TrianglePredicateStats stats;
+  long disagreements = 0, exact_disagreements = 0, asymmetric = 0, hits = 0;
+  for (long i = 0; i < kPairsPerFamily; ++i) {
+    const TriPair p = test::make_case(f, rng);
+    const bool expected = test::oracle_intersect(p.a, p.b);
+    const bool got = intersect(p.a, p.b, stats);
+    hits += expected;
+    if (got != expected && ++disagreements <= 5)
+      ADD_FAILURE() << "pair " << i << ": got " << got << ", oracle " << expected << "\n" << describe(p);
+    const bool exact = triangles_intersect_exact(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2]);
+    if (exact != expected && ++exact_disagreements <= 5)
+      ADD_FAILURE() << "exact path, pair " << i << ": got " << exact << "\n" << describe(p);
+    TrianglePredicateStats unused;
+    if (intersect(p.b, p.a, unused) != got) ++asymmetric;
+  }
+  EXPECT_EQ(disagreements, 0);
+  EXPECT_EQ(exact_disagreements, 0);
+  EXPECT_EQ(asymmetric, 0);
+  EXPECT_EQ(stats.tests, static_cast<std::uint64_t>(kPairsPerFamily));
+  // Every family must exercise both answers, or it tests less than its name says.
+  EXPECT_GT(hits, 0);
+  EXPECT_LT(hits, kPairsPerFamily);
+  // The filters must actually filter: generic families never need the exact path, and under rigid
+  // motions the long-double stage certifies most signs the double stage leaves open.
+  if (f == Family::RandomCube || f == Family::RandomNear || f == Family::FarOffset) {
+    EXPECT_EQ(stats.exact_fallbacks, 0u);
+  }
+  if (f == Family::RigidMotion || f == Family::Sliver) {
+    EXPECT_GT(stats.extended_signs, 0u);
+    EXPECT_LT(stats.exact_fallbacks * 10, stats.tests);
+  }
+  std::printf("[ family   ] %-15s pairs %ld intersecting %.1f%% exact fallbacks %.2f%%\n",
+              std::string(test::family_name(f)).c_str(), kPairsPerFamily, 100.0 * hits / kPairsPerFamily,
+              100.0 * double(stats.exact_fallbacks) / double(stats.tests));
+}
+
+std::string family_test_name(const ::testing::TestParamInfo<Family>& p) {
+  return std::string(test::family_name(p.param));
+}
+
+INSTANTIATE_TEST_SUITE_P(Families, ORACLE_SUITE,
+                         ::testing::Values(Family::RandomCube, Family::RandomNear, Family::CoplanarGrid,
+                                           Family::SharedFeature, Family::TouchingGrid,
+                                           Family::FarOffset, Family::Sliver, Family::UlpPerturbed,
+                                           Family::Degenerate, Family::RigidMotion),
+                         family_test_name);
+
+#ifndef CADCLASH_TRIANGLE_SLOW
+
+// Hand-made cases with the answer known independently of any oracle.
+struct Known {
+  const char* what;
+  Tri a, b;
+  bool intersect;
+  // The float path must not decide: touching, coplanar or degenerate with overlapping boxes, except
+  // a shared vertex and two triangles in one coordinate plane, which it settles exactly itself.
+  bool needs_exact;
+};
+
+const Tri kUnit{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+
+const Known kKnown[] = {
+    {"crossing", kUnit, {Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(3, 2, 0.5)}, true, false},
+    {"above", kUnit, {Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(0, 1, 2)}, false, false},
+    {"plane crossed outside", kUnit, {Vec3(2, 2, -1), Vec3(2, 2, 1), Vec3(3, 2, 0)}, false, false},
+    {"coplanar overlapping", kUnit, {Vec3(0.2, 0.2, 0), Vec3(2, 0.2, 0), Vec3(0.2, 2, 0)}, true, false},
+    {"coplanar contained", kUnit, {Vec3(0.1, 0.1, 0), Vec3(0.2, 0.1, 0), Vec3(0.1, 0.2, 0)}, true, false},
+    {"coplanar shared vertex", kUnit, {Vec3(0, 0, 0), Vec3(-1, 0, 0), Vec3(0, -1, 0)}, true, false},
+    {"coplanar shared edge", kUnit, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)}, true, false},
+    {"coplanar touching edge", kUnit, {Vec3(0.5, 0.5, 0), Vec3(1, 1, 0), Vec3(0.5, 2, 0)}, true, true},
+    {"coplanar apart", kUnit, {Vec3(0.6, 0.6, 0), Vec3(1, 1, 0), Vec3(0.6, 2, 0)}, false, false},
+    {"vertex on face", kUnit, {Vec3(0.25, 0.25, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)}, true, true},
+    {"vertex on edge", kUnit, {Vec3(0.5, 0, 0), Vec3(0, -1, 1), Vec3(1, -1, 1)}, true, true},
+    {"edge on edge crossing", kUnit, {Vec3(0.5, -0.5, 0), Vec3(0.5, 0.5, 0), Vec3(0.5, 0, 1)}, true, true},
+    {"shared edge folded", kUnit, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 1)}, true, false},
+    {"shared vertex only", kUnit, {Vec3(0, 0, 0), Vec3(-1, 0, 1), Vec3(0, -1, 1)}, true, false},
+    {"segment through face", kUnit, {Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, 0.5)}, true, true},
+    {"segment beside face", kUnit, {Vec3(2, 2, -1), Vec3(2, 2, 1), Vec3(2, 2, 0)}, false, false},
+    {"point on face", kUnit, {Vec3(0.25, 0.5, 0), Vec3(0.25, 0.5, 0), Vec3(0.25, 0.5, 0)}, true, true},
+    {"point above face", kUnit, {Vec3(0.25, 0.5, 1e-300), Vec3(0.25, 0.5, 1e-300), Vec3(0.25, 0.5, 1e-300)},
+     false, false},
+    {"collinear segments overlapping", {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2)},
+     {Vec3(1.5, 1.5, 1.5), Vec3(3, 3, 3), Vec3(1.5, 1.5, 1.5)}, true, true},
+    {"collinear segments apart", {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(0.5, 0.5, 0.5)},
+     {Vec3(1.5, 1.5, 1.5), Vec3(3, 3, 3), Vec3(2, 2, 2)}, false, false},
+    {"skew segments crossing", {Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 0, 0)},
+     {Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(1, 0.5, 0)}, true, true},
+    {"skew segments apart", {Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 0, 0)},
+     {Vec3(1, -1, 1e-200), Vec3(1, 1, 1e-200), Vec3(1, 0.5, 1e-200)}, false, false},
+    {"coplanar segments, end on segment", {Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 0, 0)},
+     {Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(1, 1, 0)}, true, true},
+    {"x-plane overlapping", {Vec3(3, 0, 0), Vec3(3, 1, 0), Vec3(3, 0, 1)},
+     {Vec3(3, 0.25, 0.25), Vec3(3, 2, 0.25), Vec3(3, 0.25, 2)}, true, false},
+    {"y-plane apart", {Vec3(0, -2, 0), Vec3(1, -2, 0), Vec3(0, -2, 1)},
+     {Vec3(0.6, -2, 0.6), Vec3(2, -2, 0.6), Vec3(0.6, -2, 2)}, false, false},
+    {"z-plane touching at a vertex on an edge", kUnit,
+     {Vec3(0.5, 0.5, 0), Vec3(2, 1, 0), Vec3(1, 2, 0)}, true, true},
+    {"z-plane 1 ulp apart", kUnit,
+     {Vec3(0.5, std::nextafter(0.5, 1.0), 0), Vec3(2, 1, 0), Vec3(1, 2, 0)}, false, true},
+    {"z-plane at 1e8", {Vec3(1e8, 1e8, 1e8), Vec3(1e8 + 1e-3, 1e8, 1e8), Vec3(1e8, 1e8 + 1e-3, 1e8)},
+     {Vec3(1e8 + 4e-4, 1e8 + 4e-4, 1e8), Vec3(1e8 + 1, 1e8, 1e8), Vec3(1e8, 1e8 + 1, 1e8)}, true, false},
+    {"huge coordinates", {Vec3(1e300, 0, 0), Vec3(-1e300, 1e300, 0), Vec3(-1e300, -1e300, 0)},
+     {Vec3(0, 0, -1e300), Vec3(0, 0, 1e300), Vec3(1, 0, 1e300)}, true, true},
+};
+
+TEST(TrianglesIntersect, KnownCases) {
+  for (const Known& k : kKnown) {
+    for (int swap = 0; swap < 2; ++swap) {
+      const Tri& a = swap ? k.b : k.a;
+      const Tri& b = swap ? k.a : k.b;
+      TrianglePredicateStats stats;
+      EXPECT_EQ(intersect(a, b, stats), k.intersect) << k.what;
+      EXPECT_EQ(test::oracle_intersect(a, b), k.intersect) << k.what << " (oracle)";
+      EXPECT_EQ(stats.tests, 1u);
+      EXPECT_EQ(stats.exact_fallbacks, k.needs_exact ? 1u : 0u) << k.what;
+    }
+  }
+}
+
+// A vertex of B on A's plane, nudged by one ulp either way, flips between crossing, touching and
+// apart; the answers must follow the nudge, and exact touching must reach the exact path.
+TEST(TrianglesIntersect, OneUlpDecides) {
+  for (double base : {0.0, 1.0, 0.1, 1e8}) {
+    const Tri a{Vec3(0, 0, base), Vec3(4, 0, base), Vec3(0, 4, base)};
+    for (int dir : {-1, 0, 1}) {
+      const double zb = dir == 0 ? base : std::nextafter(base, dir * HUGE_VAL);
+      const Tri b{Vec3(1, 1, zb), Vec3(1, 2, base + 1), Vec3(2, 1, base + 1)};
+      TrianglePredicateStats stats;
+      EXPECT_EQ(intersect(a, b, stats), dir <= 0) << "base " << base << " dir " << dir;
+      if (dir == 0) {
+        EXPECT_EQ(stats.exact_fallbacks, 1u);
+      }
+    }
+  }
+}
+
+// The exact path (CGAL, with its rounding-mode switches) runs concurrently in the narrow phase.
+TEST(TrianglesIntersect, SameAnswersFromManyThreads) {
+  test::Rng rng(99);
+  std::vector<TriPair> pairs;
+  for (int i = 0; i < 20000; ++i) pairs.push_back(test::make_case(static_cast<Family>(i % 10), rng));
+  std::vector<char> serial(pairs.size()), parallel(pairs.size());
+  TrianglePredicateStats stats;
+  for (std::size_t i = 0; i < pairs.size(); ++i) serial[i] = intersect(pairs[i].a, pairs[i].b, stats);
+  const long n = static_cast<long>(pairs.size());
+#pragma omp parallel for schedule(dynamic, 64) num_threads(4)
+  for (long i = 0; i < n; ++i) {
+    TrianglePredicateStats local;
+    parallel[i] = intersect(pairs[i].a, pairs[i].b, local);
+  }
+  EXPECT_EQ(serial, parallel);
+  EXPECT_GT(stats.exact_fallbacks, 0u);
+}
+
+#endif  // CADCLASH_TRIANGLE_SLOW
+
+}  // namespace
+}  // namespace cadclash

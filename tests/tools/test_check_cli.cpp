@@ -1,0 +1,185 @@
+// `cadclash check` run as a process: exit codes, the table, the JSON report and its determinism.
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+struct Proc {
+  int code = -1;
+  std::string out;  // stdout and stderr together
+};
+
+Proc run(const std::string& args) {
+  const std::string cmd = std::string(CADCLASH_EXE) + " " + args + " 2>&1";
+  Proc r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string data(const std::string& name) { return std::string(CADCLASH_DATA_DIR) + "/collide/" + name; }
+
+std::string boxes() {
+  return data("box_a.obj") + " " + data("box_overlap.obj") + " " + data("box_touch.obj") + " " + data("box_near.obj");
+}
+
+std::string read(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string tmp(const std::string& name) { return std::string(CADCLASH_BINARY_DIR) + "/check_cli_" + name; }
+
+TEST(CheckCli, TableAndJsonReport) {
+  const std::string json = tmp("report.json");
+  const Proc r = run("check " + boxes() + " --clearance 0.6 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("/box_a.obj/box_a (box_a)  x  /box_overlap.obj/box_overlap (box_overlap)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("penetrating"), std::string::npos);
+  EXPECT_NE(r.out.find("18 penetrating, 41 touching, 89 clearance, 0 containment"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read(json));
+  EXPECT_EQ(j["schema"], "cadclash-check-report");
+  EXPECT_EQ(j["version"], 1);
+  EXPECT_EQ(j["summary"]["penetrating"], 18);
+  EXPECT_EQ(j["summary"]["touching"], 41);
+  EXPECT_EQ(j["settings"]["clearance"], 0.6);
+  EXPECT_TRUE(j.contains("timings"));
+  EXPECT_GT(j["counters"]["triangle_tests"].get<int>(), 0);
+  // Face-to-face contact of box_a's x+ with box_touch's x-, with provenance.
+  bool found = false;
+  for (const auto& p : j["pairs"])
+    if (p["a"]["instance"] == "/box_a.obj/box_a" && p["b"]["instance"] == "/box_touch.obj/box_touch" &&
+        p["a"]["surface"] == "x+" && p["b"]["surface"] == "x-") {
+      found = true;
+      EXPECT_EQ(p["class"], "touching");
+      EXPECT_EQ(p["distance"], 0.0);
+      EXPECT_EQ(p["a"]["kind"], "obj-group");
+    }
+  EXPECT_TRUE(found);
+}
+
+TEST(CheckCli, ReportIsByteIdenticalForAnyThreadCount) {
+  for (const std::string variant : {"--parallel v1", "--parallel v2 --all-triangles", "--schedule static"}) {
+    std::string first;
+    for (int threads : {1, 2, 4}) {
+      const std::string json = tmp("threads" + std::to_string(threads) + ".json");
+      const Proc r = run("check " + boxes() + " --clearance 0.4 --no-timings " + variant + " --threads " +
+                        std::to_string(threads) + " --json " + json);
+      ASSERT_EQ(r.code, 0) << r.out;
+      const std::string text = read(json);
+      EXPECT_EQ(text.find("timings"), std::string::npos);
+      if (threads == 1) first = text;
+      else EXPECT_EQ(text, first) << variant << " threads " << threads;
+    }
+  }
+}
+
+TEST(CheckCli, BruteForceGivesTheSamePairs) {
+  const Proc a = run("check " + boxes() + " --tolerance 0.01 --clearance 0.3 --all-triangles --json " + tmp("oaabb.json"));
+  const Proc b = run("check " + boxes() + " --tolerance 0.01 --clearance 0.3 --all-triangles --brute-force --json " +
+                    tmp("brute.json"));
+  ASSERT_EQ(a.code, 0) << a.out;
+  ASSERT_EQ(b.code, 0) << b.out;
+  const nlohmann::json ja = nlohmann::json::parse(read(tmp("oaabb.json")));
+  const nlohmann::json jb = nlohmann::json::parse(read(tmp("brute.json")));
+  EXPECT_EQ(ja["pairs"], jb["pairs"]);
+  EXPECT_EQ(ja["summary"], jb["summary"]);
+  EXPECT_LT(ja["counters"]["triangle_tests"].get<int>(), jb["counters"]["triangle_tests"].get<int>());
+}
+
+TEST(CheckCli, ExitCodes) {
+  EXPECT_EQ(run("check " + boxes() + " --fail-on-collision").code, 3);
+  EXPECT_EQ(run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --fail-on-collision").code, 0);
+  EXPECT_EQ(run("check " + data("box_a.obj") + " --no-such-option").code, 2);
+  EXPECT_EQ(run("check " + data("box_a.obj") + " --tolerance -1").code, 2);
+  EXPECT_EQ(run("check " + data("no_such_file.obj")).code, 2);
+  EXPECT_EQ(run("check").code, 2);
+  const Proc bad_select = run("check " + boxes() + " --select-a /nothing");
+  EXPECT_EQ(bad_select.code, 1) << bad_select.out;
+}
+
+TEST(CheckCli, TrajectoryReplay) {
+  const std::string json = tmp("path.json");
+  const Proc r = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_ok.csv") +
+                    " --no-timings --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("step 0: 0 penetrating, 0 touching"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("step 1: 0 penetrating, 21 touching"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read(json));
+  ASSERT_EQ(j["steps"].size(), 3u);
+  EXPECT_EQ(j["steps"][0]["summary"]["pairs"], 0);
+  EXPECT_GT(j["steps"][2]["summary"]["penetrating"].get<int>(), 0);
+}
+
+TEST(CheckCli, BadTrajectoryNamesTheLines) {
+  const Proc r = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_bad.csv"));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("path_bad.csv:3: error:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("path_bad.csv:4: error: quaternion"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("path_bad.csv:5: error: expected 9 fields"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// The real sample assembly: the OAABB answer equals brute force, and every fastener contact is found.
+TEST(CheckCliAs1, EqualsBruteForceAndFindsEveryFastenerContact) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!std::ifstream(step)) GTEST_SKIP() << "run scripts/setup.sh for " << step;
+  const std::string common = "check " + step + " --tolerance 0.01 --all-triangles --no-timings --json ";
+  const Proc fast = run(common + tmp("as1_oaabb.json"));
+  const Proc slow = run(common + tmp("as1_brute.json") + " --brute-force");
+  ASSERT_EQ(fast.code, 0) << fast.out;
+  ASSERT_EQ(slow.code, 0) << slow.out;
+  const nlohmann::json a = nlohmann::json::parse(read(tmp("as1_oaabb.json")));
+  const nlohmann::json b = nlohmann::json::parse(read(tmp("as1_brute.json")));
+  EXPECT_EQ(a["pairs"], b["pairs"]);
+  EXPECT_LT(a["counters"]["triangle_tests"].get<double>() * 20, b["counters"]["triangle_tests"].get<double>());
+
+  // Instance pairs in contact, keyed by the last two path components of each side.
+  std::set<std::string> contacts;
+  auto tail = [](const std::string& path) {
+    const auto last = path.rfind('/');
+    const auto prev = path.rfind('/', last - 1);
+    return path.substr(prev + 1);
+  };
+  for (const auto& p : a["pairs"]) {
+    EXPECT_EQ(p["class"], "touching") << p.dump();  // nothing in as1 really penetrates
+    contacts.insert(tail(p["a"]["instance"]) + " | " + tail(p["b"]["instance"]));
+  }
+  for (int k = 1; k <= 3; ++k) {
+    const std::string bolt = "NUT-BOLT-ASSEMBLY::" + std::to_string(k) + "/BOLT";
+    EXPECT_TRUE(contacts.count(bolt + " | NUT-BOLT-ASSEMBLY::" + std::to_string(k) + "/NUT::3")) << bolt;
+    EXPECT_TRUE(contacts.count(bolt + " | L-BRACKET-ASSEMBLY::1/L-BRACKET") ||
+                contacts.count(bolt + " | L-BRACKET-ASSEMBLY::2/L-BRACKET")) << bolt;
+  }
+  EXPECT_TRUE(contacts.count("ROD-ASSEMBLY/NUT::1 | ROD-ASSEMBLY/ROD"));
+  EXPECT_TRUE(contacts.count("ROD-ASSEMBLY/NUT::2 | ROD-ASSEMBLY/ROD"));
+  EXPECT_TRUE(contacts.count("ROD-ASSEMBLY/ROD | L-BRACKET-ASSEMBLY::1/L-BRACKET"));
+  std::size_t bolt_plate = 0;
+  for (const std::string& c : contacts) bolt_plate += (c.find("/BOLT") != std::string::npos && c.find("PLATE") != std::string::npos);
+  EXPECT_EQ(bolt_plate, 6u);  // every bolt passes through the plate
+  std::size_t nut_plate = 0;
+  for (const std::string& c : contacts) nut_plate += (c.find("NUT::3") != std::string::npos && c.find("PLATE") != std::string::npos);
+  EXPECT_EQ(nut_plate, 6u);  // and its nut sits on it
+  EXPECT_TRUE(contacts.count("ROD-ASSEMBLY/ROD | L-BRACKET-ASSEMBLY::2/L-BRACKET"));
+}
+
+}  // namespace
