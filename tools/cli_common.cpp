@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -29,13 +30,23 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.tessellation.linear_deflection = in.deflection;
   options.tessellation.relative = in.relative;
   options.tessellation.angular_deflection = in.angular;
+  if (!in.preset.empty()) {
+    if (const auto preset = parse_tessellation_preset(in.preset)) {
+      const TessellationOptions p = tessellation_preset(*preset);
+      options.tessellation.linear_deflection = p.linear_deflection;
+      options.tessellation.angular_deflection = p.angular_deflection;
+      options.tessellation.relative = false;
+    }
+  }
   options.lazy = in.lazy;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
   if (in.repair) {
     MeshRepairOptions repair_options;
     repair_options.fill_holes = in.fill_holes;
+    const auto start = std::chrono::steady_clock::now();
     MeshRepairReport r = repair_meshes(result.model, repair_options);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     print_diagnostics(r.diagnostics);
     std::size_t changed = 0;
     for (const SurfaceRepairStats& s : r.per_surface) changed += s.changed ? 1 : 0;
@@ -46,17 +57,19 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
               << " flipped, " << t.stitched_edges << " edges stitched, " << t.duplicated_vertices
               << " vertices duplicated";
     if (in.fill_holes) std::cerr << ", " << t.filled_holes << " holes filled with " << t.hole_faces << " triangles";
-    std::cerr << '\n';
+    std::cerr << " (" << took.count() << " s)\n";
     if (repair_report) *repair_report = std::move(r);
   }
   if (in.segment) {
     SegmentOptions segment_options;
     segment_options.sharp_angle_degrees = in.sharp_angle;
     segment_options.planar = in.planar;
+    const auto start = std::chrono::steady_clock::now();
     SegmentReport r = segment_surfaces(result.model, segment_options);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     print_diagnostics(r.diagnostics);
     std::cerr << "segment: " << r.surfaces_split << " of " << r.surfaces.size() << " surfaces split into " << r.patches
-              << " patches\n";
+              << " patches (" << took.count() << " s)\n";
     if (segment_report) *segment_report = std::move(r);
   }
   return result;

@@ -14,12 +14,17 @@ struct TessellateOptions {
 };
 
 int run_tessellate(TessellateOptions& o) {
+  // Progress: one line per phase, on a terminal only; pipes and logs get just the result line.
+  const bool progress = stderr_is_terminal();
+  if (progress) std::cerr << "reading " << o.in.files.size() << (o.in.files.size() == 1 ? " file\n" : " files\n");
   ImportResult r = import_inputs(o.in);
+  if (progress) std::cerr << "meshing " << r.model.surfaces.size() << " surfaces\n";
   // Writing needs every triangle, so a lazy import is completed here.
   std::vector<SurfaceId> all(r.model.surfaces.size());
   std::iota(all.begin(), all.end(), SurfaceId{0});
   std::vector<Diagnostic> mesh_errors = require_triangles(r.model, all);
   print_diagnostics(mesh_errors);
+  if (progress) std::cerr << "writing " << o.output << '\n';
   std::vector<Diagnostic> written = export_model(r.model, o.output);
   print_diagnostics(written);
   if (has_error(written)) return kExitInputError;

@@ -3,6 +3,7 @@
 #include "box_util.h"
 #include "triangle_predicates.h"
 
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -19,24 +20,36 @@ double straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, 
   const Vec3 n = (p1 - p0).cross(p2 - p0);
   const double len = n.norm();
   if (!(len > 0.0)) return 0.0;
-  std::vector<Vec3> poly{v0, v1, v2}, next;
+  {  // Clipping only shrinks the straddle: a triangle wholly on one side needs no clipping.
+    double up = 0.0, down = 0.0;
+    for (const Vec3* v : {&v0, &v1, &v2}) {
+      const double h = n.dot(*v - p0);
+      up = std::max(up, h);
+      down = std::max(down, -h);
+    }
+    if (!(up > 0.0 && down > 0.0)) return 0.0;
+  }
+  // Each clip adds at most one vertex: 3 + 3.
+  std::array<Vec3, 6> poly{v0, v1, v2}, next;
+  std::size_t np = 3;
   const Vec3* corners[3] = {&p0, &p1, &p2};
-  for (int e = 0; e < 3 && !poly.empty(); ++e) {
+  for (int e = 0; e < 3 && np > 0; ++e) {
     const Vec3& a = *corners[e];
     const Vec3 inward = n.cross(*corners[(e + 1) % 3] - a);  // side plane through the edge, facing P
-    next.clear();
-    for (std::size_t k = 0; k < poly.size(); ++k) {
+    std::size_t nn = 0;
+    for (std::size_t k = 0; k < np; ++k) {
       const Vec3& x = poly[k];
-      const Vec3& y = poly[(k + 1) % poly.size()];
+      const Vec3& y = poly[(k + 1) % np];
       const double dx = inward.dot(x - a), dy = inward.dot(y - a);
-      if (dx >= 0.0) next.push_back(x);
-      if ((dx >= 0.0) != (dy >= 0.0)) next.push_back(x + (y - x) * (dx / (dx - dy)));
+      if (dx >= 0.0 && nn < next.size()) next[nn++] = x;
+      if ((dx >= 0.0) != (dy >= 0.0) && nn < next.size()) next[nn++] = x + (y - x) * (dx / (dx - dy));
     }
-    poly.swap(next);
+    poly = next;
+    np = nn;
   }
   double up = 0.0, down = 0.0;
-  for (const Vec3& v : poly) {
-    const double h = n.dot(v - p0) / len;
+  for (std::size_t k = 0; k < np; ++k) {
+    const double h = n.dot(poly[k] - p0) / len;
     up = std::max(up, h);
     down = std::max(down, -h);
   }

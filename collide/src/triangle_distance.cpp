@@ -69,14 +69,29 @@ inline double edge_edge_interior2(const Edge& e, const Edge& f) {
   return norm2(ps - (f.a + t * f.d));
 }
 
-// Squared distance from p to the interior of triangle (o, o+e1, o+e2) when p projects inside it;
-// +inf otherwise (the edges then hold the minimum). n = e1 x e2, nn = |n|^2 > 0.
-inline double point_face2(const P3& p, const P3& o, const P3& e1, const P3& e2, const P3& n, double nn) {
-  const P3 w = p - o;
-  const double l1 = dot(cross(w, e2), n) / nn;
-  const double l2 = dot(cross(e1, w), n) / nn;
+// A triangle o + l1 e1 + l2 e2 prepared for projecting points: l1 = (p - o) · m1, l2 = (p - o) · m2
+// with m1 = (e2 x n) / |n|^2, m2 = (n x e1) / |n|^2, n = e1 x e2 (scalar triple products of the
+// barycentric formulas, hoisted out of the per-vertex work).
+struct Face {
+  P3 o, e1, e2, m1, m2;
+  bool proper;  // |n| > 0; a degenerate triangle has no interior, its edges hold the minimum
+};
+
+inline Face make_face(const P3& o, const P3& e1, const P3& e2) {
+  const P3 n = cross(e1, e2);
+  const double nn = norm2(n);
+  if (!(nn > 0.0)) return {o, e1, e2, {}, {}, false};
+  const double inv = 1.0 / nn;
+  return {o, e1, e2, inv * cross(e2, n), inv * cross(n, e1), true};
+}
+
+// Squared distance from p to the face when p projects inside it; +inf otherwise (the edges then
+// hold the minimum). The foot point is rebuilt from l1, l2, so the result is an actual distance.
+inline double point_face2(const P3& p, const Face& f) {
+  const P3 w = p - f.o;
+  const double l1 = dot(w, f.m1), l2 = dot(w, f.m2);
   if (!(l1 >= 0.0 && l2 >= 0.0 && l1 + l2 <= 1.0)) return std::numeric_limits<double>::infinity();
-  return norm2(w - (l1 * e1 + l2 * e2));
+  return norm2(w - (l1 * f.e1 + l2 * f.e2));
 }
 
 // Squared distance between the closed triangles, assuming they do not intersect. Stops as soon as
@@ -102,12 +117,12 @@ double disjoint_distance2(const Vec3& a0, const Vec3& a1, const Vec3& a2, const 
     for (int j = 0; j < 3; ++j) best = std::min(best, edge_edge_interior2(ea[i], eb[j]));
   if (best <= stop2) return best;
   // Vertex–face interiors.
-  const P3 na = cross(ea[0].d, A[2] - A[0]), nb = cross(eb[0].d, B[2] - B[0]);
-  const double nna = norm2(na), nnb = norm2(nb);
-  if (nna > 0.0)
-    for (int i = 0; i < 3; ++i) best = std::min(best, point_face2(B[i], A[0], ea[0].d, A[2] - A[0], na, nna));
-  if (nnb > 0.0)
-    for (int i = 0; i < 3; ++i) best = std::min(best, point_face2(A[i], B[0], eb[0].d, B[2] - B[0], nb, nnb));
+  const Face fa = make_face(A[0], ea[0].d, A[2] - A[0]);
+  const Face fb = make_face(B[0], eb[0].d, B[2] - B[0]);
+  if (fa.proper)
+    for (const P3& v : B) best = std::min(best, point_face2(v, fa));
+  if (fb.proper)
+    for (const P3& v : A) best = std::min(best, point_face2(v, fb));
   return best;
 }
 

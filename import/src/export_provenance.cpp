@@ -18,6 +18,9 @@ nlohmann::json surface_provenance_json(const Surface& s) {
                    {"repaired", p.repaired}};
   if (p.parent != kInvalidId) j["parent"] = p.parent;
   if (p.colour) j["colour"] = *p.colour;
+  // B-rep surfaces carry a box around the exact surface, larger than their triangles' box.
+  if (!s.aabb.isEmpty())
+    j["aabb"] = {s.aabb.min().x(), s.aabb.min().y(), s.aabb.min().z(), s.aabb.max().x(), s.aabb.max().y(), s.aabb.max().z()};
   return j;
 }
 
@@ -42,6 +45,12 @@ void surface_provenance_from_json(const nlohmann::json& j, Surface& s) {
   p.parent = j.contains("parent") ? j.at("parent").get<SurfaceId>() : kInvalidId;
   if (j.contains("colour")) p.colour = j.at("colour").get<std::array<float, 3>>();
   else p.colour.reset();
+  if (j.contains("aabb")) {
+    const auto b = j.at("aabb").get<std::array<double, 6>>();
+    s.aabb = Aabb(Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]));
+  } else {
+    s.aabb.setEmpty();
+  }
 }
 
 }  // namespace cadclash::detail

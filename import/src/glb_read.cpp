@@ -176,7 +176,7 @@ ImportResult read_cadclash_glb(const std::string& path, const ImportOptions&) {
           for (const Vec3& v : s.mesh.vertices)
             if (!v.allFinite()) throw std::runtime_error("a position is not finite");
           s.has_triangles = true;
-          s.aabb = mesh_aabb(s.mesh);
+          if (s.aabb.isEmpty()) s.aabb = mesh_aabb(s.mesh);
           model.surfaces.push_back(std::move(s));
         }
       }

@@ -17,7 +17,7 @@
 #include <bit>
 #include <cmath>
 #include <unordered_map>
-#include <unordered_set>
+#include <string_view>
 
 namespace cadclash::detail {
 namespace {
@@ -66,10 +66,15 @@ struct Walker {
     surface.provenance.kind = SourceKind::MeshFile;
     surface.provenance.source_name = mesh.mName.C_Str();
     surface.provenance.face_index = static_cast<std::int32_t>(mesh_index);
-    if (mesh.mColors[0] == nullptr && scene->mMaterials != nullptr && mesh.mMaterialIndex < scene->mNumMaterials) {
+    // A colour only from a material the file defines: assimp invents a white "DefaultMaterial" (or an
+    // unnamed one) for formats without materials, such as STL.
+    if (scene->mMaterials != nullptr && mesh.mMaterialIndex < scene->mNumMaterials) {
+      const aiMaterial& material = *scene->mMaterials[mesh.mMaterialIndex];
+      aiString material_name;
       aiColor4D c;
-      if (scene->mMaterials[mesh.mMaterialIndex]->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS &&
-          !(c.r == 0.6f && c.g == 0.6f && c.b == 0.6f))  // assimp's default grey is not the file's colour
+      if (material.Get(AI_MATKEY_NAME, material_name) == AI_SUCCESS && material_name.length > 0 &&
+          std::string_view(material_name.C_Str()) != AI_DEFAULT_MATERIAL_NAME &&
+          material.Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
         surface.provenance.colour = std::array<float, 3>{c.r, c.g, c.b};
     }
 

@@ -115,7 +115,7 @@ bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool v
                   double& achieved, std::string& why) {
   double param = target;
   bool have = false;
-  for (int attempt = 0; attempt < 4; ++attempt) {
+  for (int attempt = 0; attempt < 2; ++attempt) {
     TopLoc_Location loc;
     const Handle(Poly_Triangulation)& tri = BRep_Tool::Triangulation(face, loc);
     // BRepMesh accepts an existing triangulation up to ~1.1x the requested deflection; a refinement
@@ -139,7 +139,7 @@ bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool v
     if (!verify || achieved <= target) return true;
     param *= 0.5;
   }
-  return true;  // still above target after 3 refinements: achieved says so honestly
+  return true;  // still above target after the refinement: achieved says so honestly
 }
 
 Aabb face_aabb(const TopoDS_Face& face) {

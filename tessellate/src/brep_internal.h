@@ -36,7 +36,7 @@ bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, 
 bool read_face_triangles(const TopoDS_Face& face, bool measure, TriangleMesh& out, double& achieved);
 
 // Makes the face's triangulation meet `target` (re-meshing when it has none or a coarser one, and
-// finer again when the measured error still exceeds target, up to 3 times) and reads it.
+// finer once more, at half, when the measured error still exceeds target) and reads it.
 bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool verify, TriangleMesh& out,
                   double& achieved, std::string& why);
 

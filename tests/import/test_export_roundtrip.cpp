@@ -57,6 +57,7 @@ Model sample_model() {
     s->has_triangles = true;
     s->aabb = mesh_aabb(s->mesh);
   }
+  s0.aabb.extend(Vec3(1000, -1, -1));  // as a B-rep face's box around its exact surface
   m.surfaces = {s0, s1, s2};
 
   Pose p1 = Pose::Identity();
@@ -95,7 +96,8 @@ void expect_same_model(const Model& a, const Model& b) {
     EXPECT_TRUE(y.has_triangles);
     EXPECT_EQ(x.mesh.vertices, y.mesh.vertices);  // exact: the .glb carries float64 positions too
     EXPECT_EQ(x.mesh.triangles, y.mesh.triangles);
-    EXPECT_TRUE(x.aabb.isApprox(y.aabb, 0.0) || (x.aabb.min() == y.aabb.min() && x.aabb.max() == y.aabb.max()));
+    EXPECT_EQ(x.aabb.min(), y.aabb.min());
+    EXPECT_EQ(x.aabb.max(), y.aabb.max());
   }
   ASSERT_EQ(a.instances.size(), b.instances.size());
   for (std::size_t i = 0; i < a.instances.size(); ++i) {

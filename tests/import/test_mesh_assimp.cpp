@@ -62,6 +62,7 @@ TEST(MeshStl, AsciiAndBinaryCubesAreOneClosedSurface) {
     const Surface& s = m.surfaces[0];
     EXPECT_EQ(s.provenance.kind, SourceKind::MeshFile);
     EXPECT_EQ(s.provenance.source_file, path);
+    EXPECT_FALSE(s.provenance.colour.has_value());  // not assimp's invented default material
     EXPECT_EQ(s.mesh.triangles.size(), 12u);
     EXPECT_EQ(s.mesh.vertices.size(), 8u);  // per-facet corners merged by position
     EXPECT_EQ(open_edges(s.mesh), 0u);

@@ -1,4 +1,5 @@
-// Repair and segmentation of the real STL meshes occt-misc ships (data/external, see scripts/setup.sh).
+// Repair and segmentation of files read by import_file: the real STL meshes occt-misc ships
+// (data/external, see scripts/setup.sh) and a broken OBJ with groups written here (data/repair).
 #include "cadclash/import.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,35 @@
 
 namespace cadclash {
 namespace {
+
+// Each OBJ group is one surface; repair counts land on the group they were built into.
+TEST(MeshRepairObj, FlippedBoxGroupsKeepTheirCounts) {
+  ImportResult imported = import_file(std::string(CADCLASH_DATA_DIR) + "/repair/flipped_box.obj");
+  ASSERT_FALSE(has_error(imported.diagnostics));
+  Model& model = imported.model;
+  ASSERT_EQ(model.surfaces.size(), 6u);
+  ASSERT_EQ(triangle_count(model), 13u);
+  const MeshRepairReport r = repair_meshes(model);
+  ASSERT_TRUE(r.diagnostics.empty());
+  ASSERT_EQ(r.per_surface.size(), 6u);
+  for (const SurfaceRepairStats& s : r.per_surface) {
+    const std::string& name = model.surfaces[s.surface].name;
+    EXPECT_EQ(s.flipped_faces, name == "top" ? 2u : 0u) << name;
+    EXPECT_EQ(s.duplicate_faces, name == "front" ? 1u : 0u) << name;
+    EXPECT_EQ(s.degenerate_faces, 0u) << name;
+    EXPECT_EQ(s.triangles_after, 2u) << name;
+  }
+  std::set<std::string> names;
+  double volume6 = 0.0;
+  for (const Surface& s : model.surfaces) {
+    names.insert(s.name);
+    EXPECT_EQ(s.provenance.kind, SourceKind::ObjGroup);
+    for (const auto& t : s.mesh.triangles)
+      volume6 += s.mesh.vertices[t[0]].dot(s.mesh.vertices[t[1]].cross(s.mesh.vertices[t[2]]));
+  }
+  EXPECT_EQ(names, (std::set<std::string>{"bottom", "top", "front", "back", "left", "right"}));
+  EXPECT_DOUBLE_EQ(volume6, 6.0);  // closed unit box, outward
+}
 
 class RealStl : public ::testing::TestWithParam<const char*> {};
 

@@ -7,6 +7,40 @@
 //   .off                                                one surface per distinct face colour (CGAL)
 //   .stl .ply .gltf .glb and other assimp formats       one surface per mesh; a .glb written by cadclash
 //                                                       gives back its surfaces, names and ids
+//
+// Mesh files give one part named after the file stem, placed once at identity as "/<stem>".
+// - OBJ: the latest `g` or `o` name is the surface of a face ("default" before any); a name that
+//   recurs is the same surface; `usemtl` does not split surfaces. face_index = order of first use.
+//   Coordinates stay double precision. `l`/`p` elements and free-form geometry are listed and ignored.
+// - OFF: surfaces are named "colour-RRGGBB" (or "colour-index-N", or "uncoloured"), in order of first
+//   use; a colour with '.' or an exponent is 0..1, otherwise 0..255.
+// - Polygons: a fan when strictly convex, else ear clipping in the polygon's plane; the winding is kept.
+//   No triangle is dropped for being small.
+// - Damage: a bad vertex (NaN, Inf, malformed) or a bad face (index out of range, < 3 corners) is
+//   dropped with an error naming file and line; the rest is kept and complete = false. At most 20
+//   messages per kind are listed, then a count of the rest.
+//
+// CAD files (STEP, IGES through XCAF; BREP) give one part per distinct leaf shape, shared by all its
+// instances (tessellated once), and one instance per leaf occurrence:
+// - Instance path: "/" + the names of each level from the root to the leaf, joined by "/". A level's
+//   name is the occurrence's own name when the file gives one (STEP: the NEXT_ASSEMBLY_USAGE_OCCURRENCE
+//   name), else its product's name; a root's is its product's name. '/' inside a name becomes '_', an
+//   empty name "unnamed". Occurrence rule: among the children of one node (and among the roots), a
+//   name that occurs more than once gets "::k" on every occurrence, k = 1, 2, ... in file order,
+//   skipping any k whose result equals another sibling's name; a name that occurs once is left as is.
+//   as1-tu-203.stp: "/as1/L-BRACKET-ASSEMBLY::2/NUT-BOLT-ASSEMBLY::1/BOLT" (the "::k" there is the
+//   file's own). BREP: one part and one instance "/<file stem>".
+// - Pose: the composed placements of the levels, in millimetres (OCCT converts the file's length unit).
+// - Surfaces: one per face, in TopExp::MapShapes order of the part's shape (face_index). step_id is
+//   the face entity's label as written in the file (STEP #N of its ADVANCED_FACE; IGES directory entry
+//   number), found through one shape→entity map per file; source_name is the entity's name; colour
+//   is the face's XCAF colour, else its enclosing shell's/solid's/part's. Faces BRepCheck rejects are
+//   fixed with ShapeFix_Face first (provenance.healed). Lazy: see ImportOptions::lazy.
+// - Damage: OCCT's syntax and transfer check lists become diagnostics naming the file and the entity
+//   (#N); entities that cannot be made are left out, every face that could be made is kept, and
+//   complete = false. A STEP FILE_SCHEMA that is not AP203/AP214/AP242 is an error (read anyway). A
+//   truncated STEP file is read up to its last complete entity. A face that fails to mesh keeps its
+//   surface without triangles, with an error naming its #id and part.
 #pragma once
 
 #include "cadclash/collide.h"
@@ -40,6 +74,14 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
 // Writes `model` to `path`: .obj (one `g` per surface) or .glb (glTF 2.0 binary, one primitive per
 // surface, instances as nodes, provenance in `extras`). Surfaces without triangles are written
 // empty-free: they are skipped and listed. Returns diagnostics; an error means nothing usable was written.
+// - .obj: every instance's copy of every surface, placed in world coordinates, as
+//   `g <instance path>/<surface name>` (whitespace and '#' become '_') preceded by a comment
+//   `# cadclash-surface {json}` with the exact name, part, surface id and provenance. Coordinates are
+//   written to read back bit-exact. Reading it back gives one surface per group, in the same order.
+// - .glb: one mesh per part, one primitive per surface (part-local float32 POSITION with min/max,
+//   uint32 indices), one node per instance (name = path, column-major matrix). Provenance is in
+//   each primitive's extras.cadclash, with a float64 copy of the positions, so importing our .glb
+//   gives back exactly the same parts, surfaces, names, ids, vertices, instances and poses.
 std::vector<Diagnostic> export_model(const Model& model, const std::string& path);
 
 }  // namespace cadclash

@@ -32,9 +32,12 @@ struct TessellationOptions {
   bool relative = false;            // linear_deflection is relative to each part's bounding-box diagonal
   double angular_deflection = 0.5;  // radians between adjacent normals along a curve
   bool parallel = true;             // let BRepMesh mesh faces of one part in parallel
-  // Measure each face's chord error at its triangle centroids (one surface evaluation per triangle)
-  // and re-mesh finer (up to 3 times) where it exceeds the requested deflection. The stored achieved
-  // deflection is then max(BRepMesh's own figure, the measured error).
+  // Measure each face's chord error at its triangle centroids (a few surface evaluations per
+  // triangle) and re-mesh that face once, at half the deflection, where it exceeds the request (at
+  // import: only where it exceeds it by less than 4x, since a much finer BRepMesh of a large trimmed
+  // NURBS face can take minutes; triangulate() always tries). The
+  // stored achieved deflection is max(BRepMesh's own figure, the measured error), so it may exceed
+  // the request where even the finer mesh did not meet it: it is what collide should trust.
   bool verify_deflection = true;
 };
 
@@ -226,8 +229,9 @@ struct SegmentReport {
 };
 
 // Cuts every mesh surface into CAD-like patches: faces joined across edges that are not sharp
-// (sharp_edges_segmentation; adjacency through points equal bit-for-bit), optionally refined by
-// planar region growing. A surface with one patch is kept as it is. A surface with k > 1 patches is
+// (the steps of CGAL's sharp_edges_segmentation: detect_sharp_edges, then connected components
+// across the other edges, on the surface's triangles joined at points equal bit-for-bit and
+// oriented consistently), optionally refined by planar region growing. A surface with one patch is kept as it is. A surface with k > 1 patches is
 // replaced, in place, by k surfaces named "<name>/patch-<j>" (j = 0..k-1) ordered by the lowest
 // input triangle index each patch holds; triangles keep their input order and winding. A patch's
 // provenance is its parent's (source file, step_id, face_index, source_name, colour, repaired) with
