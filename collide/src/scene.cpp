@@ -23,6 +23,8 @@ using detail::PreparedPair;
 constexpr std::size_t kV2Block = 64;
 // Fewer work items than this run on the calling thread: waking a team costs more than they do.
 constexpr std::ptrdiff_t kMinParallel = 4;
+// The object and surface levels of one instance pair take microseconds: only many pairs pay a team.
+constexpr std::ptrdiff_t kMinParallelPairs = 64;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -310,7 +312,7 @@ Report Scene::check(const CollideOptions& o) {
   // 2. Object and surface levels, parallel over instance pairs.
   const auto t1 = std::chrono::steady_clock::now();
   const auto npairs = static_cast<std::ptrdiff_t>(pairs.size());
-#pragma omp parallel for num_threads(threads) schedule(runtime) if (npairs >= kMinParallel)
+#pragma omp parallel for num_threads(threads) schedule(runtime) if (npairs >= kMinParallelPairs)
   for (std::ptrdiff_t k = 0; k < npairs; ++k) s.surface_level(pairs[static_cast<std::size_t>(k)], o);
   std::vector<Task> tasks;
   std::vector<SurfaceId> needed;
@@ -335,8 +337,11 @@ Report Scene::check(const CollideOptions& o) {
 
   // 3. Lazy tessellation of exactly the surviving surfaces, then their BVHs (built once per surface).
   const auto t2 = std::chrono::steady_clock::now();
-  for (SurfaceId sid : needed) total.tessellated_surfaces += model.surfaces[sid].has_triangles ? 0 : 1;
-  report.diagnostics = require_triangles(model, needed, o.tessellation_deflection);
+  std::vector<SurfaceId> missing;
+  for (SurfaceId sid : needed)
+    if (!model.surfaces[sid].has_triangles) missing.push_back(sid);
+  total.tessellated_surfaces = missing.size();
+  if (!missing.empty()) report.diagnostics = require_triangles(model, missing, o.tessellation_deflection);
   std::vector<SurfaceId> to_build;
   for (SurfaceId sid : needed)
     if (!s.bvh_ready[sid] && model.surfaces[sid].has_triangles) to_build.push_back(sid);

@@ -1,6 +1,7 @@
 // One B-rep face: BRepMesh, reading its triangulation, measuring its chord error, its exact box.
 #include "brep_internal.h"
 
+#include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
@@ -8,9 +9,12 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <IMeshTools_Parameters.hxx>
+#include <Poly_PolygonOnTriangulation.hxx>
 #include <Poly_Triangulation.hxx>
 #include <Standard_Failure.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopLoc_Location.hxx>
+#include <TopoDS.hxx>
 #include <gp_Vec.hxx>
 
 #include <algorithm>
@@ -46,6 +50,44 @@ double centroid_gap(const BRepAdaptor_Surface& surface, const Vec3& centroid, do
     v = std::clamp(v + (a11 * b2 - a12 * b1) / det, v0, v1);
   }
   return best;
+}
+
+// How far the face's boundary polygons stray from its exact edges. A planar face bounded by a circle
+// has a perfect interior (every triangle lies in the plane) yet its outline is a polygon whose chords
+// cut up to the sagitta inside the arc: a bolt in a nut's hole is then seen apart or crossing by that
+// much. Measured at chord midpoints against the curve at the mid parameter (exact for circles); where
+// it cannot be measured, BRepMesh's own (requested, so pessimistic) figure for the edge stands.
+double boundary_gap(const TopoDS_Face& face, const Handle(Poly_Triangulation)& tri, const TopLoc_Location& loc,
+                    bool measure) {
+  double worst = 0.0;
+  for (TopExp_Explorer ex(face, TopAbs_EDGE); ex.More(); ex.Next()) {
+    const TopoDS_Edge& edge = TopoDS::Edge(ex.Current());
+    if (BRep_Tool::Degenerated(edge)) continue;
+    const Handle(Poly_PolygonOnTriangulation) poly = BRep_Tool::PolygonOnTriangulation(edge, tri, loc);
+    if (poly.IsNull()) continue;
+    if (!measure || !poly->HasParameters() || poly->NbNodes() < 2) {
+      worst = std::max(worst, poly->Deflection());
+      continue;
+    }
+    try {
+      const BRepAdaptor_Curve curve(edge);  // in the face's frame, as the triangulation nodes are
+      const gp_Trsf& trsf = loc.Transformation();
+      const bool moved = !loc.IsIdentity();
+      gp_Pnt prev = tri->Node(poly->Node(1));
+      if (moved) prev.Transform(trsf);
+      for (Standard_Integer i = 2; i <= poly->NbNodes(); ++i) {
+        gp_Pnt next = tri->Node(poly->Node(i));
+        if (moved) next.Transform(trsf);
+        const double t = 0.5 * (poly->Parameter(i - 1) + poly->Parameter(i));
+        const gp_Pnt mid((prev.XYZ() + next.XYZ()) * 0.5);
+        worst = std::max(worst, mid.Distance(curve.Value(t)));
+        prev = next;
+      }
+    } catch (const Standard_Failure&) {
+      worst = std::max(worst, poly->Deflection());  // no evaluable curve: BRepMesh's own figure
+    }
+  }
+  return worst;
 }
 
 }  // namespace
@@ -91,7 +133,7 @@ bool read_face_triangles(const TopoDS_Face& face, bool measure, TriangleMesh& ou
     out.triangles.push_back({static_cast<std::uint32_t>(a - 1), static_cast<std::uint32_t>(b - 1),
                              static_cast<std::uint32_t>(c - 1)});
   }
-  achieved = tri->Deflection();
+  achieved = std::max(tri->Deflection(), boundary_gap(face, tri, loc, measure));
   if (!measure || !tri->HasUVNodes()) return true;
   try {
     const BRepAdaptor_Surface surface(face, Standard_False);  // applies the face's location

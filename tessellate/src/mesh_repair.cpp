@@ -81,7 +81,13 @@ void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, Mes
     }
   }
 
-  detail::MeshStageResult r = detail::repair_soup_cgal(soup, n_tags, options);
+  detail::MeshStageResult r;
+  if (soup.triangles.empty()) {  // nothing left for CGAL: every surface ends up empty
+    r.ok = true;
+    r.counts.assign(n_tags, detail::TagCounts{});
+  } else {
+    r = detail::repair_soup_cgal(soup, n_tags, options);
+  }
   if (!r.ok) {
     report.diagnostics.push_back({Severity::Warning, part.source_file, 0, -1,
                                   "part '" + part.name + "' left unrepaired: " + r.error});

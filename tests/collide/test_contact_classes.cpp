@@ -49,7 +49,8 @@ TEST(ContactClass, OverlappingBoxesPenetrate) {
   EXPECT_FALSE(p->triangle_pairs.empty());
   // A tolerance above the crossing depth turns the same contact into touching.
   o.tolerance = 0.2;
-  p = find(m, collide(m, 0, 1, o), "x+", "y-");
+  const Report loose = collide(m, 0, 1, o);
+  p = find(m, loose, "x+", "y-");
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(p->contact, ContactClass::Touching);
 }

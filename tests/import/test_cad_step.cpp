@@ -145,7 +145,9 @@ TEST_P(CadStepFaceCounts, MatchOcctAndEveryFaceIsMeshedOrReported) {
   }
   for (const Surface& s : r.model.surfaces) {
     EXPECT_TRUE(s.has_triangles || reported.count(s.provenance.step_id)) << s.name;
-    if (s.provenance.step_id >= 0) EXPECT_TRUE(faces_in_file.count(s.provenance.step_id)) << s.provenance.step_id;
+    if (s.provenance.step_id >= 0) {
+      EXPECT_TRUE(faces_in_file.count(s.provenance.step_id)) << s.provenance.step_id;
+    }
   }
   EXPECT_EQ(r.complete, !has_error(r.diagnostics));
   EXPECT_FALSE(r.model.instances.empty());
@@ -154,8 +156,8 @@ TEST_P(CadStepFaceCounts, MatchOcctAndEveryFaceIsMeshedOrReported) {
 INSTANTIATE_TEST_SUITE_P(RealFiles, CadStepFaceCounts,
                          ::testing::Values(FaceCountCase{"linkrods.step"}, FaceCountCase{"screw.step"},
                                            FaceCountCase{"frame.step"}, FaceCountCase{"component8.step"}),
-                         [](const auto& info) {
-                           std::string n = info.param.file;
+                         [](const auto& param_info) {
+                           std::string n = param_info.param.file;
                            return n.substr(0, n.find('.'));
                          });
 

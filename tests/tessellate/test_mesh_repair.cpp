@@ -193,6 +193,22 @@ TEST(MeshRepair, CleanMeshIsLeftAlone) {
   EXPECT_EQ(r.parts_repaired, 0u);
 }
 
+TEST(MeshRepair, SurfaceOfOnlyDegenerateTrianglesEndsEmpty) {
+  TriangleMesh m;
+  m.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 0)};
+  m.triangles = {{0, 1, 2}, {0, 0, 1}};
+  Model model = one_part_model({m, TriangleMesh{}});
+  const MeshRepairReport r = repair_meshes(model);
+  ASSERT_EQ(r.per_surface.size(), 2u);
+  EXPECT_EQ(r.per_surface[0].degenerate_faces, 2u);
+  EXPECT_EQ(r.per_surface[0].merged_points, 1u);
+  EXPECT_EQ(r.per_surface[0].triangles_after, 0u);
+  EXPECT_TRUE(model.surfaces[0].mesh.triangles.empty());
+  EXPECT_TRUE(model.surfaces[0].provenance.repaired);
+  EXPECT_FALSE(r.per_surface[1].changed);
+  EXPECT_EQ(segment_surfaces(model).surfaces_split, 0u);
+}
+
 // A part with a SurfaceSource (a B-rep part) is not a mesh part: repair leaves it alone.
 class NullSource final : public SurfaceSource {
  public:
