@@ -11,8 +11,9 @@
 //    before any group "defaultobject", accepts faces with two corners, and rejects the whole file for
 //    one index out of range. Its positions are float32, so the normalised copy carries each vertex's
 //    number in x and y (exact in float) and the coordinates come from the scan.
-// Polygons are triangulated by triangulate_polygon (fan when convex, ear clipping otherwise); assimp's
-// aiProcess_Triangulate is not used because it flips the winding of some ears of concave polygons.
+// Polygons are triangulated by triangulate_polygon (fan when convex, ear clipping otherwise) on the
+// double coordinates: aiProcess_Triangulate handles concave polygons too, but it only sees the vertex
+// numbers here.
 // Nothing is filtered by area: a degenerate triangle stays, as no tolerance here would fit all units.
 #include "mesh_common.h"
 #include "mesh_polygon.h"

@@ -55,7 +55,7 @@ TEST(MeshObj, ConcavePolygonIsTriangulatedExactly) {
   EXPECT_EQ(mesh.vertices.size(), 6u);
   double signed_sum = 0;
   for (const auto& t : mesh.triangles) {
-    // assimp's aiProcess_Triangulate gets this wrong: two of its four triangles are clockwise.
+    // Every triangle keeps the polygon's counter-clockwise winding.
     EXPECT_GT(signed_area_xy(mesh, t), 0.0);
     signed_sum += signed_area_xy(mesh, t);
   }
