@@ -8,7 +8,7 @@
 namespace cadclash::cli {
 
 void add_input_options(CLI::App& cmd, InputOptions& in) {
-  cmd.add_option("files", in.files, "Input files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF)")->required()->check(CLI::ExistingFile);
+  cmd.add_option("files", in.files, "Input files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF)")->required();  // a missing file is an input error (exit 1), reported by the importer
   cmd.add_option("--deflection", in.deflection, "Linear deflection of the tessellation, mm (or relative with --relative)")
       ->check(CLI::PositiveNumber);
   cmd.add_flag("--relative", in.relative, "Deflection is a fraction of each part's size");

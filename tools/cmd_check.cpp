@@ -321,8 +321,7 @@ void register_check(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", o->threads, "OpenMP threads (default: all)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz")
-      ->check(CLI::ExistingFile);
+  cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz");
   cmd->add_option("--repeat", o->repeat, "Run the query this many times on the prepared scene; report the last (benchmarking)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--all-triangles", o->all_triangles, "List every intersecting triangle pair (no early exit)");

@@ -3,6 +3,7 @@
 #include "test_mesh_util.h"
 
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -13,7 +14,7 @@
 namespace cadclash::test {
 namespace {
 
-std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/" + name; }
+std::string temp_path(const std::string& name) { return cadclash::testing::scratch_dir() + "/" + name; }
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -3,6 +3,7 @@
 #include "test_mesh_util.h"
 
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 
 #include <cstring>
 #include <filesystem>
@@ -80,7 +81,7 @@ TEST(MeshStl, GarbageIsAnErrorNotACrash) {
 }
 
 TEST(MeshStl, EmptyAndTruncatedBinary) {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cadclash::testing::scratch_dir();
   const std::string empty = dir + "/empty.stl";
   std::ofstream(empty, std::ios::binary).flush();
   EXPECT_TRUE(has_error(import_file(empty).diagnostics));
@@ -98,7 +99,7 @@ TEST(MeshStl, EmptyAndTruncatedBinary) {
 }
 
 TEST(MeshPly, PolygonsAreTriangulated) {
-  const std::string path = ::testing::TempDir() + "/square.ply";
+  const std::string path = cadclash::testing::scratch_dir() + "/square.ply";
   std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n"
                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
                          "0 0 0\n3 0 0\n3 1 0\n1 1 0\n1 3 0\n0 3 0\n6 0 1 2 3 4 5\n";

@@ -3,6 +3,7 @@
 #include "test_mesh_util.h"
 
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 
 #include <filesystem>
 #include <fstream>
@@ -145,7 +146,7 @@ TEST(MeshObj, NonFiniteVerticesAndTheFacesUsingThemAreListed) {
 class MeshObjTemp : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+    const std::string path = (std::filesystem::path(cadclash::testing::scratch_dir()) / name).string();
     std::ofstream(path, std::ios::binary) << text;
     return path;
   }

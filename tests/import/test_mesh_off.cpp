@@ -2,6 +2,7 @@
 #include "test_mesh_util.h"
 
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 
 #include <filesystem>
 #include <fstream>
@@ -97,7 +98,7 @@ TEST(MeshOff, NanVertexDropsTheFacesUsingIt) {
 class MeshOffTemp : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+    const std::string path = (std::filesystem::path(cadclash::testing::scratch_dir()) / name).string();
     std::ofstream(path, std::ios::binary) << text;
     return path;
   }

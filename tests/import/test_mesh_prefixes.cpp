@@ -3,6 +3,7 @@
 #include "test_mesh_util.h"
 
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 
 #include <fstream>
 
@@ -19,7 +20,7 @@ std::string read_bytes(const std::string& path) {
 }
 
 void check_damaged(const std::string& name, const std::string& bytes) {
-  const std::string path = ::testing::TempDir() + "/damaged_" + name;
+  const std::string path = cadclash::testing::scratch_dir() + "/damaged_" + name;
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
   const ImportResult r = import_file(path);
   expect_well_formed(r.model);

@@ -108,7 +108,9 @@ TEST(CheckCli, ExitCodes) {
   EXPECT_EQ(run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --fail-on-collision").code, 0);
   EXPECT_EQ(run("check " + data("box_a.obj") + " --no-such-option").code, 2);
   EXPECT_EQ(run("check " + data("box_a.obj") + " --tolerance -1").code, 2);
-  EXPECT_EQ(run("check " + data("no_such_file.obj")).code, 2);
+  const Proc missing = run("check " + data("no_such_file.obj"));  // an input error, not a usage error
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.out.find("no_such_file.obj: error: no such file"), std::string::npos) << missing.out;
   EXPECT_EQ(run("check").code, 2);
   const Proc bad_select = run("check " + boxes() + " --select-a /nothing");
   EXPECT_EQ(bad_select.code, 1) << bad_select.out;

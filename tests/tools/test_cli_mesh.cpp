@@ -1,5 +1,6 @@
 // The `cadclash` binary on mesh files: info, info --json, tessellate, exit codes and messages.
 #include <gtest/gtest.h>
+#include "../test_temp.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -22,7 +23,7 @@ std::string slurp(const std::string& path) {
 
 // Runs `cadclash <args>` with stdout and stderr sent to files (so never a terminal).
 CliRun cadclash(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cadclash::testing::scratch_dir();
   const std::string out = dir + "/cli_out.txt", err = dir + "/cli_err.txt";
   const std::string command = std::string("'") + CADCLASH_EXE + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
   const int status = std::system(command.c_str());
@@ -35,7 +36,7 @@ CliRun cadclash(const std::string& args) {
 
 std::string mesh(const std::string& name) { return std::string("'") + CADCLASH_DATA_DIR + "/mesh/" + name + "'"; }
 std::string bad(const std::string& name) { return std::string("'") + CADCLASH_DATA_DIR + "/bad/" + name + "'"; }
-std::string temp(const std::string& name) { return ::testing::TempDir() + "/" + name; }
+std::string temp(const std::string& name) { return cadclash::testing::scratch_dir() + "/" + name; }
 
 // (name, kind, face_index, triangles) of every surface of every part.
 std::vector<std::tuple<std::string, std::string, int, std::size_t>> surfaces_of(const nlohmann::json& info) {
