@@ -33,6 +33,7 @@ struct CheckOptions {
   bool fail_on_collision = false;
   bool brute_force = false;
   bool no_containment = false;
+  bool exact = false;
   std::string parallel = "v1";
   std::string schedule = "guided";
   std::string triangle_level = "auto";
@@ -68,6 +69,7 @@ CollideOptions collide_options(const CheckOptions& o) {
                                                  : TriangleLevel::Auto;
   c.use_oaabb = !o.brute_force;
   c.detect_containment = !o.no_containment;
+  c.exact_verification = o.exact;
   if (!o.in.relative) {
     c.deflection_hint = o.in.deflection;
     c.tessellation_deflection = o.in.deflection;
@@ -172,7 +174,9 @@ void print_table(const Model& m, const Report& r, std::ostream& os) {
     };
     std::string dist = p.contact == ContactClass::Penetrating ? "-" + fmt(p.penetration) : fmt(p.distance);
     os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(11) << dist
-       << std::setw(34) << side(p.surface_a) << side(p.surface_b) << '\n';
+       << std::setw(34) << side(p.surface_a) << side(p.surface_b);
+    if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
+    os << '\n';
   }
 }
 
@@ -249,6 +253,7 @@ int run_check(const CheckOptions& o) {
                    {"triangle_level", o.triangle_level},
                    {"oaabb", !o.brute_force},
                    {"containment", !o.no_containment},
+                   {"exact_verification", o.exact},
                    {"exclude_under", o.exclude_under},
                    {"select_a", o.select_a},
                    {"select_b", o.select_b}};
@@ -331,6 +336,8 @@ void register_check(CLI::App& app) {
                 "Exit 3 when a penetrating, touching or containment pair is found");
   cmd->add_flag("--brute-force", o->brute_force, "Test every triangle pair, no OAABB culling (for comparison)");
   cmd->add_flag("--no-containment", o->no_containment, "Skip the point-in-part containment test");
+  cmd->add_flag("--exact", o->exact,
+                "Verify touching/clearance pairs on the exact B-rep faces (OCCT distance) and show that distance");
   cmd->add_option("--parallel", o->parallel, "Parallel version: v1 (per surface pair) or v2 (flattened)")
       ->check(CLI::IsMember({"v1", "v2"}));
   cmd->add_option("--schedule", o->schedule, "OpenMP schedule")->check(CLI::IsMember({"guided", "dynamic", "static"}));

@@ -86,6 +86,22 @@ bool parse_int(std::string_view token, std::int64_t& value) {
   return ec == std::errc{} && ptr == token.data() + token.size() && !token.empty();
 }
 
+std::string printable_token(std::string_view token) {
+  static const char* const hex = "0123456789ABCDEF";
+  std::string out;
+  for (const char c : token.substr(0, 32)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7F) {
+      out += c;
+    } else {
+      out += "\\x";
+      out += hex[byte >> 4];
+      out += hex[byte & 0xF];
+    }
+  }
+  return out;
+}
+
 bool find_binary_byte(std::string_view text, std::int64_t& line) {
   std::int64_t current = 1;
   for (std::size_t i = 0; i < text.size(); ++i) {

@@ -45,6 +45,10 @@ bool parse_int(std::string_view token, std::int64_t& value);
 // Sets `line` to the 1-based line of the first one.
 bool find_binary_byte(std::string_view text, std::int64_t& line);
 
+// A token from the file as it may be quoted in a message: at most its first 32 bytes, with every byte
+// outside printable ASCII written as \xNN, so messages stay valid UTF-8 (the JSON report needs it).
+std::string printable_token(std::string_view token);
+
 // Collects diagnostics, listing at most `cap` per category and summarising the rest, so a file
 // with a million bad faces gives a readable report that still counts everything dropped.
 class DiagnosticCollector {

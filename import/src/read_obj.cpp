@@ -122,12 +122,12 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
           if (st == NumberStatus::Invalid) {
             diags.add(Severity::Error, line_no, "bad vertices",
                       "malformed vertex " + std::to_string(scan.vertices.size() + 1) + ": '" +
-                          std::string(tokens[static_cast<std::size_t>(c)]) + "' is not a number");
+                          printable_token(tokens[static_cast<std::size_t>(c)]) + "' is not a number");
             bad = line_no;
           } else if (st == NumberStatus::NotFinite) {
             diags.add(Severity::Error, line_no, "bad vertices",
                       "vertex " + std::to_string(scan.vertices.size() + 1) + " has a coordinate that is not finite ('" +
-                          std::string(tokens[static_cast<std::size_t>(c)]) + "')");
+                          printable_token(tokens[static_cast<std::size_t>(c)]) + "')");
             bad = line_no;
           }
         }
@@ -142,7 +142,7 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
         const std::string_view index_text = t.substr(0, t.find('/'));
         std::int64_t index = 0;
         if (!parse_int(index_text, index)) {
-          problem = "'" + std::string(t) + "' is not a vertex reference";
+          problem = "'" + printable_token(t) + "' is not a vertex reference";
           break;
         }
         if (index == 0) {
@@ -182,11 +182,11 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
       ++scan.ignored_lines_points;
     } else if (is_freeform_keyword(key)) {
       diags.add(Severity::Warning, line_no, "free-form statements ignored",
-                "free-form geometry ('" + std::string(key) + "') is not supported; ignored");
+                "free-form geometry ('" + printable_token(key) + "') is not supported; ignored");
       dropped = true;
     } else if (!is_ignored_keyword(key)) {
       diags.add(Severity::Warning, line_no, "unknown statements ignored",
-                "unknown statement '" + std::string(key.substr(0, 32)) + "' ignored");
+                "unknown statement '" + printable_token(key) + "' ignored");
     }
   }
 }

@@ -67,7 +67,7 @@ bool parse_face_colour(std::span<const std::string_view> t, FaceColour& out, std
   if (t.size() == 1) {
     std::int64_t index = 0;
     if (!parse_int(t[0], index) || index < 0) {
-      problem = "colour map index '" + std::string(t[0]) + "' is not a non-negative integer";
+      problem = "colour map index '" + printable_token(t[0]) + "' is not a non-negative integer";
       return false;
     }
     out.key = "colour-index-" + std::to_string(index);
@@ -83,7 +83,7 @@ bool parse_face_colour(std::span<const std::string_view> t, FaceColour& out, std
   for (std::size_t c = 0; c < 3; ++c) {
     double v = 0;
     if (parse_double(t[c], v) != NumberStatus::Ok) {
-      problem = "colour component '" + std::string(t[c]) + "' is not a finite number";
+      problem = "colour component '" + printable_token(t[c]) + "' is not a finite number";
       return false;
     }
     const double unit = std::clamp(floats ? v : v / 255.0, 0.0, 1.0);
@@ -131,7 +131,7 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
   bool n_dimension = false;
   if (!parse_off_keyword(tokens[0], header, n_dimension))
     return fail_at(lines.line_number(), "not an OFF file: the first word is not an OFF keyword ('" +
-                                            std::string(tokens[0].substr(0, 32)) + "')");
+                                            printable_token(tokens[0]) + "')");
   if (tokens.size() > 1 && tokens[1] == "BINARY") return fail_at(lines.line_number(), "binary OFF is not supported");
   if (std::int64_t line = 0; find_binary_byte(text, line)) return fail_at(line, "binary data: not a text OFF file");
   std::vector<std::string_view> counts(tokens.begin() + 1, tokens.end());
@@ -226,7 +226,7 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
     std::string problem;
     OffFace face{line_no, {}, 0};
     if (!parse_int(tokens[0], n) || n < 0) {
-      problem = "'" + std::string(tokens[0].substr(0, 32)) + "' is not a corner count";
+      problem = "'" + printable_token(tokens[0]) + "' is not a corner count";
     } else if (n < 3) {
       problem = "a face needs at least 3 vertices, found " + std::to_string(n);
     } else if (tokens.size() < static_cast<std::size_t>(n) + 1) {
@@ -235,7 +235,7 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
       for (std::int64_t k = 1; k <= n && problem.empty(); ++k) {
         std::int64_t index = 0;
         if (!parse_int(tokens[static_cast<std::size_t>(k)], index))
-          problem = "'" + std::string(tokens[static_cast<std::size_t>(k)].substr(0, 32)) + "' is not a vertex index";
+          problem = "'" + printable_token(tokens[static_cast<std::size_t>(k)]) + "' is not a vertex index";
         else if (index < 0 || index >= nv)
           problem = "vertex index " + std::to_string(index) + " is out of range (the file has " + std::to_string(nv) +
                     " vertices, numbered from 0)";

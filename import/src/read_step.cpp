@@ -8,7 +8,13 @@
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <StepData_StepModel.hxx>
+#include <StepBasic_ProductDefinition.hxx>
+#include <StepRepr_HArray1OfRepresentationItem.hxx>
+#include <StepRepr_NextAssemblyUsageOccurrence.hxx>
+#include <StepRepr_MappedItem.hxx>
+#include <StepRepr_Representation.hxx>
 #include <StepRepr_RepresentationItem.hxx>
+#include <StepRepr_RepresentationMap.hxx>
 #include <StepShape_Face.hxx>
 #include <TCollection_HAsciiString.hxx>
 #include <TDocStd_Document.hxx>
@@ -25,6 +31,8 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 namespace cadclash::detail {
@@ -157,6 +165,144 @@ struct DocumentGuard {
   }
 };
 
+// OCCT transfers a MAPPED_ITEM by recursing into the representation it maps, three stack frames per
+// level, so a long (or cyclic) chain of MAPPED_ITEMs overflows the stack. Before the transfer, every
+// MAPPED_ITEM that heads a chain deeper than this is taken out of the representations that hold it.
+constexpr int kMaxMappedItemNesting = 64;
+
+using StepItems = Handle(StepRepr_HArray1OfRepresentationItem);
+
+// Mapped items held directly by the representation that `item` maps.
+std::vector<const StepRepr_MappedItem*> mapped_children(const StepRepr_MappedItem* item) {
+  std::vector<const StepRepr_MappedItem*> out;
+  const Handle(StepRepr_RepresentationMap) source = item->MappingSource();
+  if (source.IsNull() || source->MappedRepresentation().IsNull()) return out;
+  const StepItems items = source->MappedRepresentation()->Items();
+  if (items.IsNull()) return out;
+  for (Standard_Integer i = items->Lower(); i <= items->Upper(); ++i)
+    if (const auto* child = dynamic_cast<const StepRepr_MappedItem*>(items->Value(i).get())) out.push_back(child);
+  return out;
+}
+
+void cut_deep_mapped_items(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
+                           ImportResult& result) {
+  // Height of each mapped item (longest chain of mapped items below and including it), found without
+  // recursion; an item met again while still open lies on a cycle and counts as infinitely deep.
+  constexpr int kCycle = 1 << 30;
+  std::unordered_map<const StepRepr_MappedItem*, int> height;
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+    const auto* root = dynamic_cast<const StepRepr_MappedItem*>(model->Value(e).get());
+    if (root == nullptr || height.count(root)) continue;
+    struct Frame { const StepRepr_MappedItem* item; std::vector<const StepRepr_MappedItem*> children; std::size_t next; int best; };
+    std::vector<Frame> stack{{root, mapped_children(root), 0, 1}};
+    height[root] = -1;  // open
+    while (!stack.empty()) {
+      Frame& top = stack.back();
+      if (top.next < top.children.size()) {
+        const StepRepr_MappedItem* child = top.children[top.next++];
+        const auto found = height.find(child);
+        if (found == height.end()) {
+          height[child] = -1;
+          stack.push_back({child, mapped_children(child), 0, 1});
+        } else {
+          top.best = std::max(top.best, found->second < 0 ? kCycle : std::min(kCycle, found->second + 1));
+        }
+        continue;
+      }
+      const int h = top.best;
+      height[top.item] = h;
+      stack.pop_back();
+      if (!stack.empty()) stack.back().best = std::max(stack.back().best, std::min(kCycle, h + 1));
+    }
+  }
+  std::unordered_set<const StepRepr_MappedItem*> cut, below_cut;
+  for (const auto& [item, h] : height)
+    if (h > kMaxMappedItemNesting) {
+      cut.insert(item);
+      for (const StepRepr_MappedItem* child : mapped_children(item)) below_cut.insert(child);
+    }
+  if (cut.empty()) return;
+  // Report the heads of the cut chains, in file order; on a pure cycle every cut item lies below
+  // another, so the first one in the file is reported instead.
+  std::vector<Standard_Integer> heads;
+  Standard_Integer first = 0;
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+    const auto* item = dynamic_cast<const StepRepr_MappedItem*>(model->Value(e).get());
+    if (item == nullptr || !cut.count(item)) continue;
+    if (first == 0) first = e;
+    if (!below_cut.count(item)) heads.push_back(e);
+  }
+  if (heads.empty()) heads.push_back(first);
+  for (const Standard_Integer e : heads) {
+    const int h = height[dynamic_cast<const StepRepr_MappedItem*>(model->Value(e).get())];
+    result.diagnostics.push_back({Severity::Error, path, 0, label(model->Value(e)),
+                                  h >= kCycle ? std::string("MAPPED_ITEM is part of a cycle of mapped representations; its shape is dropped")
+                                              : "MAPPED_ITEM nests " + std::to_string(h) + " levels of mapped representations (more than " +
+                                                    std::to_string(kMaxMappedItemNesting) + "); its shape is dropped"});
+  }
+  result.complete = false;
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+    const Handle(StepRepr_Representation) rep = Handle(StepRepr_Representation)::DownCast(model->Value(e));
+    if (rep.IsNull() || rep->Items().IsNull()) continue;
+    const StepItems items = rep->Items();
+    std::vector<Handle(StepRepr_RepresentationItem)> kept;
+    for (Standard_Integer i = items->Lower(); i <= items->Upper(); ++i)
+      if (!cut.count(dynamic_cast<const StepRepr_MappedItem*>(items->Value(i).get()))) kept.push_back(items->Value(i));
+    if (kept.size() == static_cast<std::size_t>(items->Length())) continue;
+    StepItems shorter;
+    if (!kept.empty()) {
+      shorter = new StepRepr_HArray1OfRepresentationItem(1, static_cast<Standard_Integer>(kept.size()));
+      for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
+    }
+    rep->SetItems(shorter);
+  }
+}
+
+// A NEXT_ASSEMBLY_USAGE_OCCURRENCE that makes a product its own ancestor: OCCT's transfer then drops
+// the products on the cycle and every root that reaches it without a word, so name each usage that
+// closes a cycle (found by an iterative depth-first walk, in file order, so the report is stable).
+void report_assembly_cycles(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
+                            ImportResult& result) {
+  using Pd = const StepBasic_ProductDefinition*;
+  std::unordered_map<Pd, std::vector<std::pair<Pd, Standard_Integer>>> children;  // child, usage entity
+  std::vector<Pd> parents;
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+    const Handle(StepRepr_NextAssemblyUsageOccurrence) usage = Handle(StepRepr_NextAssemblyUsageOccurrence)::DownCast(model->Value(e));
+    if (usage.IsNull() || usage->RelatingProductDefinition().IsNull() || usage->RelatedProductDefinition().IsNull()) continue;
+    const Pd parent = usage->RelatingProductDefinition().get();
+    if (!children.count(parent)) parents.push_back(parent);
+    children[parent].emplace_back(usage->RelatedProductDefinition().get(), e);
+  }
+  enum class Mark { Open, Done };
+  std::unordered_map<Pd, Mark> mark;
+  for (const Pd root : parents) {
+    if (mark.count(root)) continue;
+    std::vector<std::pair<Pd, std::size_t>> stack{{root, 0}};
+    mark[root] = Mark::Open;
+    while (!stack.empty()) {
+      auto& [pd, next] = stack.back();
+      const auto found = children.find(pd);
+      if (found == children.end() || next == found->second.size()) {
+        mark[pd] = Mark::Done;
+        stack.pop_back();
+        continue;
+      }
+      const auto [child, usage] = found->second[next++];
+      const auto seen = mark.find(child);
+      if (seen == mark.end()) {
+        mark[child] = Mark::Open;
+        stack.emplace_back(child, 0);
+      } else if (seen->second == Mark::Open) {
+        result.diagnostics.push_back({Severity::Error, path, 0, label(model->Value(usage)),
+                                      "NEXT_ASSEMBLY_USAGE_OCCURRENCE closes a cycle: it makes product definition #" +
+                                          std::to_string(label(Handle(Standard_Transient)(const_cast<StepBasic_ProductDefinition*>(child)))) +
+                                          " its own ancestor; the products on the cycle and the roots above them are dropped"});
+        result.complete = false;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ImportResult read_step(const std::string& path, const ImportOptions& options) {
@@ -224,6 +370,9 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       result.complete = false;
       return result;
     }
+
+    cut_deep_mapped_items(model, label, path, result);
+    report_assembly_cycles(model, label, path, result);
 
     DocumentGuard guard;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", guard.doc);

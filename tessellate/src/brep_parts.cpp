@@ -42,6 +42,14 @@ bool heal_face(TopoDS_Face& face) {
   }
 }
 
+// Why the face's triangles may not match the file exactly: it failed BRepCheck, and ShapeFix_Face
+// changed it (valid now or not) or could not.
+std::string heal_message(const std::string& part, std::size_t face, bool changed, bool valid) {
+  std::string m = "face " + std::to_string(face) + " of part '" + part + "' failed BRepCheck; ";
+  if (!changed) return m + "ShapeFix_Face could not change it, so it is tessellated as read";
+  return m + (valid ? "healed with ShapeFix_Face" : "ShapeFix_Face changed it but it is still invalid");
+}
+
 std::string failure_message(const BrepSource::Impl& impl, std::size_t face, const std::string& why) {
   return "face " + std::to_string(face) + " of part '" + impl.part_name + "' could not be tessellated (" + why +
          "); its surface is kept without triangles";
@@ -80,8 +88,13 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     } catch (const Standard_Failure&) {
     }
     if (!whole_valid) {
-      for (std::size_t i = 0; i < n; ++i)
-        if (!face_is_valid(impl->faces[i])) healed[i] = heal_face(impl->faces[i]) ? 1 : 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (face_is_valid(impl->faces[i])) continue;
+        healed[i] = heal_face(impl->faces[i]) ? 1 : 0;
+        const bool fixed = healed[i] != 0 && face_is_valid(impl->faces[i]);
+        diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl->entity_ids[i],
+                                         heal_message(in.name, i, healed[i] != 0, fixed)});
+      }
     }
 
     impl->boxes.resize(n);

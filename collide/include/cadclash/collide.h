@@ -88,7 +88,7 @@ struct Provenance {
   std::int32_t face_index = -1;     // index of the face / group / colour within its part, as read
   std::string source_name;          // the file's own name for it (group name, STEP face name); may be empty
   SurfaceId parent = kInvalidId;    // for Segment: the surface this patch was cut from
-  std::optional<std::array<float, 3>> colour;  // RGB in [0,1] when the file gives one
+  std::optional<std::array<float, 3>> colour;  // RGB in [0,1] as the file writes it (STEP: sRGB, not linearised)
   bool healed = false;              // OCCT shape fixing changed the face before tessellation
   bool repaired = false;            // mesh repair changed the surface's triangles
 };

@@ -1,0 +1,94 @@
+// The `cadclash` binary on a real STEP assembly: tessellate to .glb, and the .glb read back by
+// `info --json` keeps the instances and every surface's STEP id of the direct import.
+#include <gtest/gtest.h>
+#include "../test_temp.h"
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Runs `cadclash <args>` with stdout and stderr sent to files in this process's scratch folder.
+CliRun cadclash(const std::string& args) {
+  const std::string dir = cadclash::testing::scratch_dir();
+  const std::string out = dir + "/cli_cad_out.txt", err = dir + "/cli_cad_err.txt";
+  const std::string command = std::string("'") + CADCLASH_EXE + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+  const int status = std::system(command.c_str());
+  CliRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+struct SurfaceView {
+  std::int64_t step_id = -1;
+  std::size_t triangles = 0;
+  bool operator==(const SurfaceView&) const = default;
+};
+
+// Instance path → the surfaces of its part, in face order.
+std::map<std::string, std::vector<SurfaceView>> instances_of(const nlohmann::json& info) {
+  std::map<std::string, std::vector<SurfaceView>> out;
+  for (const auto& i : info.at("instances")) {
+    std::vector<SurfaceView>& surfaces = out[i.at("path").get<std::string>()];
+    for (const auto& s : info.at("parts").at(i.at("part").get<std::size_t>()).at("surfaces"))
+      surfaces.push_back({s.value("step_id", std::int64_t{-1}), s.at("triangles").get<std::size_t>()});
+  }
+  return out;
+}
+
+TEST(CliCad, TessellateAs1ToGlbKeepsInstancesAndStepIds) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!std::filesystem::exists(step)) GTEST_SKIP() << step << " missing: run scripts/setup.sh";
+  const std::string glb = cadclash::testing::scratch_dir() + "/as1.glb";
+  std::filesystem::remove(glb);
+
+  const CliRun t = cadclash("tessellate '" + step + "' -o '" + glb + "' --deflection 0.05");
+  ASSERT_EQ(t.code, 0) << t.err;
+  ASSERT_TRUE(std::filesystem::exists(glb));
+
+  const CliRun back = cadclash("info '" + glb + "' --json");
+  ASSERT_EQ(back.code, 0) << back.err;
+  const nlohmann::json from_glb = nlohmann::json::parse(back.out);
+  const CliRun direct = cadclash("info '" + step + "' --json --deflection 0.05");
+  ASSERT_EQ(direct.code, 0) << direct.err;
+  const nlohmann::json from_step = nlohmann::json::parse(direct.out);
+
+  EXPECT_EQ(from_glb.at("instances").size(), 18u);
+  EXPECT_EQ(from_step.at("instances").size(), 18u);
+  const auto glb_instances = instances_of(from_glb);
+  const auto step_instances = instances_of(from_step);
+  EXPECT_EQ(glb_instances.size(), 18u);  // paths unique
+  std::size_t faces = 0;
+  for (const auto& [path, surfaces] : step_instances) {
+    faces += surfaces.size();
+    const auto it = glb_instances.find(path);
+    ASSERT_NE(it, glb_instances.end()) << path << " is missing from the .glb";
+    // Same STEP id per surface in face order, and the same triangles (same deflection).
+    EXPECT_EQ(it->second, surfaces) << path;
+    for (const SurfaceView& s : surfaces) {
+      EXPECT_GT(s.step_id, 0) << path;
+      EXPECT_GT(s.triangles, 0u) << path << " #" << s.step_id;
+    }
+  }
+  EXPECT_EQ(faces, 160u);
+}
+
+}  // namespace
