@@ -7,12 +7,30 @@
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
 
+#include <fstream>
+#include <string>
+
 namespace cadclash::detail {
+namespace {
+
+// BRepTools::Read prints "File was not written with this version of the topology" to stdout (which
+// would corrupt `info --json`) when it finds no topology header, so look for that header first.
+bool has_topology_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head.find("CASCADE Topology V") != std::string::npos;
+}
+
+}  // namespace
 
 ImportResult read_brep(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
   ImportResult result;
   try {
+    if (!has_topology_header(path))
+      return failed_import(path, "not an OCCT .brep: no 'CASCADE Topology' header in its first 64 KB");
     TopoDS_Shape shape;
     BRep_Builder builder;
     if (!BRepTools::Read(shape, path.c_str(), builder) || shape.IsNull())

@@ -170,7 +170,9 @@ TEST(CadMeshFailure, DegenerateStepFaceKeptAndReportedWithItsId) {
   const Surface failed = expect_one_face_unmeshed(path, r);
   EXPECT_EQ(failed.provenance.step_id, 132);
   for (const Surface& s : r.model.surfaces) {
-    if (s.has_triangles) EXPECT_EQ(s.provenance.step_id, 39);
+    if (s.has_triangles) {
+      EXPECT_EQ(s.provenance.step_id, 39);
+    }
   }
 }
 
