@@ -7,10 +7,18 @@
 namespace cadclash {
 
 std::string format_diagnostic(const Diagnostic& d) {
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string.
   std::string out = d.file.empty() ? std::string("<input>") : d.file;
-  if (d.line > 0) out += ":" + std::to_string(d.line);
+  if (d.line > 0) {
+    out += ':';
+    out += std::to_string(d.line);
+  }
   out += ": ";
-  if (d.step_id >= 0) out += "#" + std::to_string(d.step_id) + ": ";
+  if (d.step_id >= 0) {
+    out += '#';
+    out += std::to_string(d.step_id);
+    out += ": ";
+  }
   out += d.severity == Severity::Error ? "error: " : "warning: ";
   out += d.message;
   return out;
