@@ -306,7 +306,7 @@ int run_check(const CheckOptions& o) {
 
   if (!o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);
-    f << j.dump(2) << '\n';
+    f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
     if (!f) {
       std::cerr << o.json << ": error: cannot write the report\n";
       return kExitInputError;

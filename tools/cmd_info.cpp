@@ -85,7 +85,8 @@ int run_info(const InfoOptions& o) {
     if (o.in.segment) j["segment"] = {{"surfaces_split", segment.surfaces_split}, {"patches", segment.patches}};
     for (const Instance& i : m.instances) j["instances"].push_back({{"path", i.path}, {"part", i.part}});
     for (const Diagnostic& d : r.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
-    std::cout << j.dump(2) << '\n';
+    // File text quoted in names and messages need not be UTF-8; never abort on it.
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   } else {
     std::size_t instance_faces = 0;
     for (const Instance& i : m.instances) instance_faces += m.parts[i.part].surface_count;

@@ -129,6 +129,16 @@ def step_deep_entity_chain(length=5000):
     write("step_deep_entity_chain.step", head + "".join(body) + tail)
 
 
+def step_mapped_cycle():
+    # The first part's shape is a MAPPED_ITEM whose representation holds that same MAPPED_ITEM.
+    head, tail = step_parts()
+    head = head.replace("#3 = SHAPE_DEFINITION_REPRESENTATION(#4,#10);", "#3 = SHAPE_DEFINITION_REPRESENTATION(#4,#20000);")
+    body = ("#20000 = SHAPE_REPRESENTATION('loop',(#11,#20001),#345);\n"
+            "#20001 = MAPPED_ITEM('',#20002,#11);\n"
+            "#20002 = REPRESENTATION_MAP(#11,#20000);\n")
+    write("step_mapped_item_cycle.step", head + body + tail)
+
+
 def garbage():
     # Deterministic binary noise under each text format's extension.
     import random
@@ -144,3 +154,4 @@ if __name__ == "__main__":
     step_deep()
     step_no_units()
     step_deep_entity_chain()
+    step_mapped_cycle()

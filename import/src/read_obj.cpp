@@ -142,7 +142,10 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
         const std::string_view index_text = t.substr(0, t.find('/'));
         std::int64_t index = 0;
         if (!parse_int(index_text, index)) {
-          problem = "'" + printable_token(t) + "' is not a vertex reference";
+          // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string.
+          problem = "'";
+          problem += printable_token(t);
+          problem += "' is not a vertex reference";
           break;
         }
         if (index == 0) {
