@@ -2,7 +2,7 @@
 // `cadclash info` (and `info --json`) and must end with the listed exit code and message, without a
 // crash, a hang or a lost surface count.
 #include <gtest/gtest.h>
-#include "../test_temp.h"
+#include "cli_runner.h"
 #include <nlohmann/json.hpp>
 
 #include <cctype>
@@ -55,38 +55,9 @@ std::vector<Row> load_catalogue() {
   return rows;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-struct CliRun {
-  int code = -1;    // exit code, or -1 if ended by a signal
-  int signal = 0;   // the signal, if any
-  std::string out, err;
-};
-
-// `timeout 60 cadclash <args>`; timeout's own 124 (hang) and 128+n (signal) are reported as such.
-CliRun cadclash(const std::string& args) {
-  const std::string dir = cadclash::testing::scratch_dir();
-  const std::string out = dir + "/cli_out.txt", err = dir + "/cli_err.txt";
-  const std::string command = std::string("timeout 60 '") + CADCLASH_EXE + "' " + args + " >'" + out + "' 2>'" + err +
-                              "' </dev/null";
-  const int status = std::system(command.c_str());
-  CliRun r;
-  if (WIFEXITED(status)) {
-    r.code = WEXITSTATUS(status);
-    if (r.code > 128) {  // the shell's way of saying the child died of a signal
-      r.signal = r.code - 128;
-      r.code = -1;
-    }
-  } else if (WIFSIGNALED(status)) {
-    r.signal = WTERMSIG(status);
-  }
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using cadclash::testing::CliRun;
+using cadclash::testing::slurp;
+CliRun cadclash(const std::string& args) { return cadclash::testing::run_cadclash(args); }
 
 // The path a row names; '@' rows are made here. Empty if the row cannot run in this environment.
 std::string prepare(const Row& row, std::string& skip_reason) {

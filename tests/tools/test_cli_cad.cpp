@@ -1,7 +1,7 @@
 // The `cadclash` binary on a real STEP assembly: tessellate to .glb, and the .glb read back by
 // `info --json` keeps the instances and every surface's STEP id of the direct import.
 #include <gtest/gtest.h>
-#include "../test_temp.h"
+#include "cli_runner.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -14,28 +14,8 @@
 
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// Runs `cadclash <args>` with stdout and stderr sent to files in this process's scratch folder.
-CliRun cadclash(const std::string& args) {
-  const std::string dir = cadclash::testing::scratch_dir();
-  const std::string out = dir + "/cli_cad_out.txt", err = dir + "/cli_cad_err.txt";
-  const std::string command = std::string("'") + CADCLASH_EXE + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
-  const int status = std::system(command.c_str());
-  CliRun r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using cadclash::testing::CliRun;
+CliRun cadclash(const std::string& args) { return cadclash::testing::run_cadclash(args); }
 
 struct SurfaceView {
   std::int64_t step_id = -1;

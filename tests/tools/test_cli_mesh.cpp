@@ -1,6 +1,6 @@
 // The `cadclash` binary on mesh files: info, info --json, tessellate, exit codes and messages.
 #include <gtest/gtest.h>
-#include "../test_temp.h"
+#include "cli_runner.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -11,28 +11,9 @@
 
 namespace {
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// Runs `cadclash <args>` with stdout and stderr sent to files (so never a terminal).
-CliRun cadclash(const std::string& args) {
-  const std::string dir = cadclash::testing::scratch_dir();
-  const std::string out = dir + "/cli_out.txt", err = dir + "/cli_err.txt";
-  const std::string command = std::string("'") + CADCLASH_EXE + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
-  const int status = std::system(command.c_str());
-  CliRun r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using cadclash::testing::CliRun;
+using cadclash::testing::slurp;
+CliRun cadclash(const std::string& args) { return cadclash::testing::run_cadclash(args); }
 
 std::string mesh(const std::string& name) { return std::string("'") + CADCLASH_DATA_DIR + "/mesh/" + name + "'"; }
 std::string bad(const std::string& name) { return std::string("'") + CADCLASH_DATA_DIR + "/bad/" + name + "'"; }
