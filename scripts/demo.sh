@@ -3,5 +3,5 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/setup.sh"
-"$root/scripts/build.sh" "$root/build" -DCADCLASH_BUILD_TESTS=OFF -DCADCLASH_BUILD_BENCH=OFF >/dev/null
+"$root/scripts/build.sh" "$root/build" -DCADCLASH_BUILD_TESTS=OFF -DCADCLASH_BUILD_BENCH=OFF -DCADCLASH_BUILD_EXAMPLES=OFF >/dev/null
 exec "$root/build/tools/cadclash" check "$root/data/external/as1-tu-203.stp" "$@"
