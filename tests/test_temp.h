@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <unistd.h>
 
@@ -18,6 +19,13 @@ inline std::string scratch_dir() {
     return p.string();
   }();
   return dir;
+}
+
+// Writes `text` to `name` in the scratch folder and returns the file's path.
+inline std::string write_scratch_file(const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::path(scratch_dir()) / name).string();
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
 }
 
 }  // namespace cadclash::testing

@@ -98,9 +98,7 @@ TEST(MeshOff, NanVertexDropsTheFacesUsingIt) {
 class MeshOffTemp : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const std::string path = (std::filesystem::path(cadclash::testing::scratch_dir()) / name).string();
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
+    return cadclash::testing::write_scratch_file(name, text);
   }
 };
 
