@@ -1,5 +1,6 @@
 // cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
 #include "cli_common.h"
+#include "html_report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +20,8 @@ namespace {
 constexpr int kReportVersion = 1;
 // Exit code of --fail-on-collision when a penetrating or touching pair (or containment) was found.
 constexpr int kExitCollision = 3;
+// Exit code when --time-budget or --memory-budget ran out: the report was written, marked partial.
+constexpr int kExitBudget = 4;
 
 struct CheckOptions {
   InputOptions in;
@@ -26,9 +29,12 @@ struct CheckOptions {
   double clearance = 0.0;
   int threads = 0;
   int repeat = 1;
+  double time_budget = 0.0;       // seconds; 0 = none
+  double memory_budget_mb = 0.0;  // MiB; 0 = none
   std::string path_csv;
   bool all_triangles = false;
   std::string json;
+  std::string html;
   bool no_timings = false;
   bool fail_on_collision = false;
   bool brute_force = false;
@@ -70,6 +76,9 @@ CollideOptions collide_options(const CheckOptions& o) {
   c.use_oaabb = !o.brute_force;
   c.detect_containment = !o.no_containment;
   c.exact_verification = o.exact;
+  c.time_budget_seconds = o.time_budget;
+  c.memory_budget_bytes = static_cast<std::size_t>(o.memory_budget_mb * 1024.0 * 1024.0);
+  if (o.memory_budget_mb > 0.0 && c.memory_budget_bytes == 0) c.memory_budget_bytes = 1;  // a budget, however small
   if (!o.in.relative) {
     c.deflection_hint = o.in.deflection;
     c.tessellation_deflection = o.in.deflection;
@@ -199,7 +208,32 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
        << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
 }
 
+// The budget marker of one query: stopped_by (null when complete) and the instance pairs not examined.
+void add_budget_json(const Model& m, const Report& r, nlohmann::json& j) {
+  j["stopped_by"] = r.complete ? nlohmann::json(nullptr) : nlohmann::json(r.stopped_by);
+  nlohmann::json u = nlohmann::json::array();
+  for (const auto& p : r.unexamined_pairs) u.push_back({{"a", m.instances[p[0]].path}, {"b", m.instances[p[1]].path}});
+  j["unexamined_pairs"] = std::move(u);
+  j["memory_charged_bytes"] = r.memory_charged;
+}
+
+// A loud line (and the first few pairs not examined) when a budget ran out.
+void print_partial(const Model& m, const Report& r, std::ostream& os) {
+  if (r.complete) return;
+  os << "\nPARTIAL REPORT: stopped by the " << r.stopped_by << ": " << r.unexamined_pairs.size() << " of "
+     << r.counters.instance_pairs << " instance pairs not examined (or not finished)\n";
+  constexpr std::size_t kShown = 10;
+  for (std::size_t k = 0; k < r.unexamined_pairs.size() && k < kShown; ++k)
+    os << "  not examined: " << m.instances[r.unexamined_pairs[k][0]].path << "  x  "
+       << m.instances[r.unexamined_pairs[k][1]].path << '\n';
+  if (r.unexamined_pairs.size() > kShown) os << "  ... and " << r.unexamined_pairs.size() - kShown << " more\n";
+}
+
 int run_check(const CheckOptions& o) {
+  if (!o.html.empty() && !html_report_available()) {
+    std::cerr << "cadclash check: --html needs a build with the viewer (CMake option CADCLASH_HTML_VIEWER=ON)\n";
+    return kExitUsage;
+  }
   ImportResult imported = import_inputs(o.in);
   bool input_error = has_error(imported.diagnostics);
   Model& m = imported.model;
@@ -256,9 +290,13 @@ int run_check(const CheckOptions& o) {
                    {"exact_verification", o.exact},
                    {"exclude_under", o.exclude_under},
                    {"select_a", o.select_a},
-                   {"select_b", o.select_b}};
+                   {"select_b", o.select_b},
+                   {"time_budget", o.time_budget},
+                   {"memory_budget_mb", o.memory_budget_mb}};
   bool collision = false;
+  std::string stopped_by;  // first budget that ran out; empty when every query finished
   std::vector<Diagnostic> run_diags;
+  Report shown;  // what --html shows: the query, or a trajectory's last step
   if (rows.empty()) {
     Report r = scene.check(copt);
     for (int k = 1; k < o.repeat; ++k) r = scene.check(copt);  // a prepared scene: BVHs already built
@@ -266,13 +304,18 @@ int run_check(const CheckOptions& o) {
     ClassCounts n;
     n.add(r);
     collision = n.collision();
+    if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
     if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
     print_table(m, r, std::cout);
     print_summary(r, !o.no_timings, std::cout);
+    print_partial(m, r, std::cout);
+    if (!r.complete) stopped_by = r.stopped_by;
+    add_budget_json(m, r, j);
     j["pairs"] = pairs_json(m, r);
     j["summary"] = summary_json(r);
     j["counters"] = counters_json(r.counters);
     if (!o.no_timings) j["timings"] = timings_json(r.timings);
+    shown = std::move(r);
   } else {
     std::vector<Diagnostic> ds;
     std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
@@ -287,22 +330,41 @@ int run_check(const CheckOptions& o) {
       std::cout << "step " << s.step << ": " << n.c[0] << " penetrating, " << n.c[1] << " touching, " << n.c[2]
                 << " clearance, " << n.c[3] << " containment";
       if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
+      if (!s.report.complete) {
+        std::cout << "  PARTIAL: stopped by the " << s.report.stopped_by << ", " << s.report.unexamined_pairs.size()
+                  << " of " << s.report.counters.instance_pairs << " instance pairs not examined";
+        if (stopped_by.empty()) stopped_by = s.report.stopped_by;
+      }
       std::cout << '\n';
       nlohmann::json js{{"step", s.step},
                         {"pairs", pairs_json(m, s.report)},
                         {"summary", summary_json(s.report)},
                         {"counters", counters_json(s.report.counters)}};
       if (!o.no_timings) js["timings"] = timings_json(s.report.timings);
+      add_budget_json(m, s.report, js);
       j["steps"].push_back(std::move(js));
     }
+    std::size_t distinct_steps = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
+    const std::size_t not_checked = distinct_steps - steps.size();
+    j["steps_not_checked"] = not_checked;
+    if (not_checked > 0) {
+      std::cout << "\nPARTIAL REPORT: stopped by the time budget: " << not_checked << " of " << distinct_steps
+                << " steps not checked\n";
+      if (stopped_by.empty()) stopped_by = "time budget";
+    }
+    j["stopped_by"] = stopped_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(stopped_by);
     for (const Diagnostic& d : ds) j["diagnostics"].push_back(format_diagnostic(d));
+    if (!steps.empty()) shown = std::move(steps.back().report);
   }
   print_diagnostics(run_diags);
   input_error = input_error || has_error(run_diags);
   for (const Diagnostic& d : imported.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
   for (const Diagnostic& d : run_diags) j["diagnostics"].push_back(format_diagnostic(d));
   if (!j.contains("diagnostics")) j["diagnostics"] = nlohmann::json::array();
-  j["complete"] = imported.complete && !has_error(run_diags);
+  j["complete"] = imported.complete && !has_error(run_diags) && stopped_by.empty();
+  if (!stopped_by.empty())
+    std::cerr << "cadclash check: warning: partial report: the " << stopped_by << " ran out before every pair was examined\n";
 
   if (!o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);
@@ -312,8 +374,11 @@ int run_check(const CheckOptions& o) {
       return kExitInputError;
     }
   }
+  if (!o.html.empty() && !save_html_report(o.html, m, scene, shown, j, copt.tessellation_deflection))
+    return kExitInputError;
   if (input_error) return kExitInputError;
-  return (o.fail_on_collision && collision) ? kExitCollision : kExitOk;
+  if (o.fail_on_collision && collision) return kExitCollision;  // a definite finding, partial report or not
+  return stopped_by.empty() ? kExitOk : kExitBudget;
 }
 
 }  // namespace
@@ -321,16 +386,28 @@ int run_check(const CheckOptions& o) {
 void register_check(CLI::App& app) {
   auto o = std::make_shared<CheckOptions>();
   CLI::App* cmd = app.add_subcommand("check", "Report penetrating, touching, close and contained surface pairs");
+  cmd->footer(
+      "Exit codes: 0 the check ran; 1 input error; 2 usage error; 3 --fail-on-collision and a collision was found\n"
+      "(even in a partial report); 4 a --time-budget or --memory-budget ran out: the report (table, --json) was\n"
+      "written, marked PARTIAL, listing the instance pairs not examined.\n");
   add_input_options(*cmd, o->in);
   cmd->add_option("--tolerance", o->tolerance, "Contact tolerance t, mm (touching: distance <= t + both deflections)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", o->threads, "OpenMP threads (default: all)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz");
+  cmd->add_option("--time-budget", o->time_budget,
+                  "Stop after this many seconds (whole trajectory with --path) and report what was found, marked partial; exit 4")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--memory-budget", o->memory_budget_mb,
+                  "Stop before the query's own structures (triangles, BVHs, lists) pass this many MiB; the partial "
+                  "report is the same for any --threads; exit 4")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--repeat", o->repeat, "Run the query this many times on the prepared scene; report the last (benchmarking)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--all-triangles", o->all_triangles, "List every intersecting triangle pair (no early exit)");
   cmd->add_option("--json", o->json, "Write the JSON report (docs/report-schema.md) here");
+  cmd->add_option("--html", o->html, "Write a self-contained HTML report with a 3D view here (docs/viewer.md)");
   cmd->add_flag("--no-timings", o->no_timings, "Leave timings out (the report is then identical for any thread count)");
   cmd->add_flag("--fail-on-collision", o->fail_on_collision,
                 "Exit 3 when a penetrating, touching or containment pair is found");

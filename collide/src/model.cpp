@@ -1,6 +1,8 @@
 // The surface-tagged model: the small operations every module shares.
 #include "cadclash/collide.h"
 
+#include "budget.h"
+
 #include <cassert>
 #include <map>
 
@@ -71,6 +73,11 @@ Aabb mesh_aabb(const TriangleMesh& mesh) {
 
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
                                           double deflection) {
+  return detail::require_triangles(model, surfaces, deflection, detail::Deadline());
+}
+
+std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const SurfaceId> surfaces,
+                                                  double deflection, const Deadline& deadline) {
   // Group the missing surfaces by part: a source is thread-safe across parts, not within one.
   std::map<PartId, std::vector<SurfaceId>> by_part;
   for (SurfaceId s : surfaces) {
@@ -86,6 +93,7 @@ std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceI
     const auto& [part_id, ids] = work[static_cast<std::size_t>(w)];
     const Part& part = model.parts[part_id];
     for (SurfaceId s : ids) {
+      if (deadline.expired()) break;
       Surface& surf = model.surfaces[s];
       TriangleMesh mesh;
       double achieved = 0.0;

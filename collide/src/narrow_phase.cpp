@@ -133,13 +133,25 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
   out.margin = search + kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
 }
 
+std::size_t prepared_bytes(const PreparedPair& p) {
+  return (p.la.size() + p.lb.size()) * sizeof(std::uint32_t) + (p.box_a.size() + p.box_b.size()) * sizeof(Aabb) +
+         p.tri_b.size() * sizeof(p.tri_b[0]);
+}
+
 void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
-              const CollideOptions& options, PairOutcome& out, CollideCounters& counters) {
+              const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
+              const Deadline* deadline) {
   TrianglePredicateStats stats;
   const bool all = options.mode == CollideMode::AllTrianglePairs;
   const bool want_distance = p.margin > 0.0;
   bool done = false;
+  std::uint32_t polls = 0;
   auto test = [&](std::size_t i, std::size_t j) {
+    if (deadline != nullptr && (++polls & 255u) == 0 && deadline->expired()) {
+      out.cut = true;
+      done = true;
+      return;
+    }
     const auto& ta = sa.mesh.triangles[p.la[i]];
     const Vec3& a0 = sa.mesh.vertices[ta[0]];
     const Vec3& a1 = sa.mesh.vertices[ta[1]];
@@ -218,6 +230,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
 
 void merge_outcome(PairOutcome& into, PairOutcome&& later) {
   into.intersecting = into.intersecting || later.intersecting;
+  into.cut = into.cut || later.cut;
   into.penetration = std::max(into.penetration, later.penetration);
   into.distance = std::min(into.distance, later.distance);
   into.triangle_pairs.insert(into.triangle_pairs.end(), later.triangle_pairs.begin(), later.triangle_pairs.end());

@@ -3,6 +3,7 @@
 // parallel Version 2 can cut a pair into blocks. Internal to cadclash::collide.
 #pragma once
 
+#include "budget.h"
 #include "cadclash/collide.h"
 #include "surface_bvh.h"
 
@@ -26,7 +27,11 @@ struct PairOutcome {
   double penetration = 0.0;
   double distance = std::numeric_limits<double>::infinity();
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
+  bool cut = false;  // the deadline expired inside the run: the outcome covers only part of its range
 };
+
+// Bytes held by the survivor lists of a prepared pair (charged against the memory budget).
+std::size_t prepared_bytes(const PreparedPair& p);
 
 // Fills `out` for surfaces `sa` (of instance A, A's frame) and `sb` (of B, mapped by t_ab: B → A;
 // t_ba its inverse). With use_oaabb false every triangle of both surfaces survives (brute force).
@@ -35,8 +40,10 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
                   CollideCounters& counters);
 
 // Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
+// Polls `deadline` (when given) every 256 triangle tests and stops with out.cut set once it expired.
 void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
-              const CollideOptions& options, PairOutcome& out, CollideCounters& counters);
+              const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
+              const Deadline* deadline = nullptr);
 
 // Merges the outcome of a later block into an earlier one (blocks in ascending order of A's triangles).
 void merge_outcome(PairOutcome& into, PairOutcome&& later);

@@ -1,5 +1,6 @@
 // The prepared scene: broad phase, object and surface levels, and the parallel triangle level.
 #include "box_util.h"
+#include "budget.h"
 #include "narrow_phase.h"
 #include "surface_bvh.h"
 
@@ -25,6 +26,22 @@ constexpr std::size_t kV2Block = 64;
 constexpr std::ptrdiff_t kMinParallel = 4;
 // The object and surface levels of one instance pair take microseconds: only many pairs pay a team.
 constexpr std::ptrdiff_t kMinParallelPairs = 64;
+// Surfaces tessellated per round under a memory budget: a constant, so the rounds, and so what the
+// budget keeps, do not depend on the thread count.
+constexpr std::size_t kBudgetRound = 64;
+
+std::uint64_t mesh_bytes(const TriangleMesh& m) {
+  return m.vertices.size() * sizeof(Vec3) + m.triangles.size() * sizeof(m.triangles[0]);
+}
+
+std::uint64_t bvh_bytes(const detail::SurfaceBvh& b) {
+  return b.nodes.size() * sizeof(b.nodes[0]) + b.order.size() * sizeof(b.order[0]) +
+         b.triangle_boxes.size() * sizeof(Aabb);
+}
+
+std::uint64_t result_bytes(const SurfacePairResult& r) {
+  return sizeof(r) + r.triangle_pairs.size() * sizeof(r.triangle_pairs[0]);
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -66,6 +83,7 @@ struct InstancePair {
   std::vector<std::array<SurfaceId, 2>> candidates;
   int containment = 0;  // 1: B's box inside A's (test B inside A); 2: the reverse; 0: neither
   CollideCounters counters;
+  bool cut = false;  // the time budget ran out before its surface level
 };
 
 struct Task {
@@ -270,12 +288,14 @@ InstanceId Scene::find_instance(const std::string& path) const {
 }
 
 Report Scene::check(const CollideOptions& o) {
-  assert(o.tolerance >= 0.0 && o.clearance >= 0.0);
+  assert(o.tolerance >= 0.0 && o.clearance >= 0.0 && o.time_budget_seconds >= 0.0);
   Impl& s = *impl_;
   Model& model = s.model;
   Report report;
   CollideCounters& total = report.counters;
   const auto t0 = std::chrono::steady_clock::now();
+  const detail::Deadline deadline(t0, o.time_budget_seconds);
+  const std::uint64_t budget = o.memory_budget_bytes;
   const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   set_schedule(o.schedule);
 
@@ -313,53 +333,119 @@ Report Scene::check(const CollideOptions& o) {
   const auto t1 = std::chrono::steady_clock::now();
   const auto npairs = static_cast<std::ptrdiff_t>(pairs.size());
 #pragma omp parallel for num_threads(threads) schedule(runtime) if (npairs >= kMinParallelPairs)
-  for (std::ptrdiff_t k = 0; k < npairs; ++k) s.surface_level(pairs[static_cast<std::size_t>(k)], o);
+  for (std::ptrdiff_t k = 0; k < npairs; ++k) {
+    InstancePair& ip = pairs[static_cast<std::size_t>(k)];
+    if (deadline.expired()) ip.cut = true;
+    else s.surface_level(ip, o);
+  }
+  // The memory budget's ledger: per instance pair, the bytes it makes this query build. Each
+  // surface is charged to the first pair (in pair order) that needs it, so the prefix of pairs that
+  // fits the budget does not depend on how the work was spread over threads.
+  std::vector<std::uint64_t> charge(pairs.size(), 0);
   std::vector<Task> tasks;
-  std::vector<SurfaceId> needed;
+  std::vector<std::size_t> first_task(pairs.size() + 1, 0);  // tasks of pair k: [first_task[k], first_task[k+1])
+  std::vector<SurfaceId> needed;                              // in order of first need
+  std::vector<std::uint32_t> first_need(model.surfaces.size(), kInvalidId);
   for (std::uint32_t k = 0; k < pairs.size(); ++k) {
     const InstancePair& ip = pairs[k];
-    add(total, ip.counters);
+    first_task[k] = tasks.size();
+    charge[k] += ip.candidates.size() * sizeof(ip.candidates[0]);
+    auto need = [&](SurfaceId sid) {
+      if (first_need[sid] != kInvalidId) return;
+      first_need[sid] = k;
+      needed.push_back(sid);
+    };
     for (const auto& c : ip.candidates) {
       tasks.push_back({k, c[0], c[1]});
-      needed.push_back(c[0]);
-      needed.push_back(c[1]);
+      need(c[0]);
+      need(c[1]);
     }
     if (ip.containment) {
       for (InstanceId i : {ip.a, ip.b}) {
         const PartId p = model.instances[i].part;
-        for (SurfaceId sid = s.first(p); sid < s.end(p); ++sid) needed.push_back(sid);
+        for (SurfaceId sid = s.first(p); sid < s.end(p); ++sid) need(sid);
       }
     }
   }
-  std::sort(needed.begin(), needed.end());
-  needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
+  first_task[pairs.size()] = tasks.size();
   report.timings.surface_level = seconds_since(t1);
 
+  // Instance pairs from `cutoff` on do not fit the memory budget. Charges only grow, so the first
+  // pair whose running sum exceeds the budget can only move earlier as more is charged.
+  auto cutoff = static_cast<std::uint32_t>(pairs.size());
+  auto apply_memory_budget = [&] {
+    if (budget == 0) return;
+    std::uint64_t sum = 0;
+    for (std::uint32_t k = 0; k < cutoff; ++k) {
+      sum += charge[k];
+      if (sum > budget) {
+        cutoff = k;
+        return;
+      }
+    }
+  };
+  apply_memory_budget();
+
   // 3. Lazy tessellation of exactly the surviving surfaces, then their BVHs (built once per surface).
+  // Under a memory budget in rounds of a fixed number of surfaces in order of first need, checking
+  // the budget between rounds, so a small budget does not tessellate the whole scene first.
   const auto t2 = std::chrono::steady_clock::now();
-  std::vector<SurfaceId> missing;
-  for (SurfaceId sid : needed)
-    if (!model.surfaces[sid].has_triangles) missing.push_back(sid);
-  total.tessellated_surfaces = missing.size();
-  if (!missing.empty()) report.diagnostics = require_triangles(model, missing, o.tessellation_deflection);
-  std::vector<SurfaceId> to_build;
-  for (SurfaceId sid : needed)
-    if (!s.bvh_ready[sid] && model.surfaces[sid].has_triangles) to_build.push_back(sid);
-  const auto nbuild = static_cast<std::ptrdiff_t>(to_build.size());
+  std::vector<SurfaceId> asked, tessellated, built;
+  std::vector<double> old_deflection;  // parallel to `tessellated`: restored if released
+  const std::size_t round = budget > 0 ? kBudgetRound : std::max<std::size_t>(needed.size(), 1);
+  for (std::size_t r = 0; r < needed.size(); r += round) {
+    if (first_need[needed[r]] >= cutoff || deadline.expired()) break;
+    const std::span<const SurfaceId> wave(needed.data() + r, std::min(round, needed.size() - r));
+    std::vector<SurfaceId> missing;
+    std::vector<double> before;
+    for (SurfaceId sid : wave)
+      if (!model.surfaces[sid].has_triangles) {
+        missing.push_back(sid);
+        before.push_back(model.surfaces[sid].deflection);
+      }
+    if (!missing.empty()) {
+      std::vector<Diagnostic> ds = detail::require_triangles(model, missing, o.tessellation_deflection, deadline);
+      report.diagnostics.insert(report.diagnostics.end(), ds.begin(), ds.end());
+      asked.insert(asked.end(), missing.begin(), missing.end());
+    }
+    for (std::size_t i = 0; i < missing.size(); ++i) {
+      const Surface& surf = model.surfaces[missing[i]];
+      if (!surf.has_triangles) continue;
+      tessellated.push_back(missing[i]);
+      old_deflection.push_back(before[i]);
+      charge[first_need[missing[i]]] += mesh_bytes(surf.mesh);
+    }
+    std::vector<SurfaceId> to_build;
+    for (SurfaceId sid : wave)
+      if (!s.bvh_ready[sid] && model.surfaces[sid].has_triangles) to_build.push_back(sid);
+    std::vector<char> done(to_build.size(), 0);
+    const auto nbuild = static_cast<std::ptrdiff_t>(to_build.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nbuild >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < nbuild; ++k) {
-    const SurfaceId sid = to_build[static_cast<std::size_t>(k)];
-    s.bvh[sid] = detail::build_surface_bvh(model.surfaces[sid].mesh);
+    for (std::ptrdiff_t k = 0; k < nbuild; ++k) {
+      if (deadline.expired()) continue;
+      const SurfaceId sid = to_build[static_cast<std::size_t>(k)];
+      s.bvh[sid] = detail::build_surface_bvh(model.surfaces[sid].mesh);
+      done[static_cast<std::size_t>(k)] = 1;
+    }
+    for (std::size_t k = 0; k < to_build.size(); ++k) {
+      if (!done[k]) continue;
+      s.bvh_ready[to_build[k]] = 1;
+      built.push_back(to_build[k]);
+      charge[first_need[to_build[k]]] += bvh_bytes(s.bvh[to_build[k]]);
+    }
+    apply_memory_budget();
   }
-  for (SurfaceId sid : to_build) s.bvh_ready[sid] = 1;
   report.timings.tessellation = seconds_since(t2);
 
-  // 4. Triangle level: Version 1 (one item per surface pair) or 2 (surface pair × block of A's triangles).
+  // 4. Triangle level: Version 1 (one item per surface pair) or 2 (surface pair × block of A's
+  // triangles), over the tasks of the pairs within the memory budget. With the time budget out,
+  // remaining items are skipped and marked cut (an OpenMP loop cannot break).
   const auto t3 = std::chrono::steady_clock::now();
-  const auto ntasks = static_cast<std::ptrdiff_t>(tasks.size());
   std::vector<PreparedPair> prepared(tasks.size());
   std::vector<PairOutcome> outcomes(tasks.size());
   std::vector<CollideCounters> task_counters(tasks.size());
+  std::vector<char> task_cut(tasks.size(), 0);
+  std::vector<std::uint64_t> task_bytes(tasks.size(), 0);
   auto usable = [&](const Task& t) {
     return model.surfaces[t.sa].has_triangles && model.surfaces[t.sb].has_triangles;
   };
@@ -369,26 +455,43 @@ Report Scene::check(const CollideOptions& o) {
     const InstancePair& ip = pairs[t.pair];
     detail::prepare_pair(model.surfaces[t.sa], s.bvh[t.sa], model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, o,
                          prepared[k], task_counters[k]);
+    task_bytes[k] = detail::prepared_bytes(prepared[k]);
+  };
+  auto charge_prepared = [&](std::size_t end_task) {
+    for (std::size_t k = 0; k < end_task; ++k) charge[tasks[k].pair] += task_bytes[k];
+    apply_memory_budget();
   };
   if (o.version == ParallelVersion::V1) {
+    const auto ntasks = static_cast<std::ptrdiff_t>(first_task[cutoff]);
 #pragma omp parallel for num_threads(threads) schedule(runtime) if (ntasks >= kMinParallel)
     for (std::ptrdiff_t k = 0; k < ntasks; ++k) {
       const auto ku = static_cast<std::size_t>(k);
+      if (deadline.expired()) {
+        task_cut[ku] = 1;
+        continue;
+      }
       prepare(ku);
       detail::run_pair(model.surfaces[tasks[ku].sa], prepared[ku], 0, prepared[ku].la.size(), o, outcomes[ku],
-                       task_counters[ku]);
+                       task_counters[ku], &deadline);
       const double tau = prepared[ku].tau;  // keep tau only; free the survivors
       prepared[ku] = PreparedPair{};
       prepared[ku].tau = tau;
     }
+    charge_prepared(static_cast<std::size_t>(ntasks));
   } else {
+    const auto ntasks = static_cast<std::ptrdiff_t>(first_task[cutoff]);
 #pragma omp parallel for num_threads(threads) schedule(runtime) if (ntasks >= kMinParallel)
-    for (std::ptrdiff_t k = 0; k < ntasks; ++k) prepare(static_cast<std::size_t>(k));
+    for (std::ptrdiff_t k = 0; k < ntasks; ++k) {
+      if (deadline.expired()) task_cut[static_cast<std::size_t>(k)] = 1;
+      else prepare(static_cast<std::size_t>(k));
+    }
+    charge_prepared(static_cast<std::size_t>(ntasks));  // all survivor lists are held at once here
+    for (std::size_t k = first_task[cutoff]; k < static_cast<std::size_t>(ntasks); ++k) prepared[k] = PreparedPair{};
     struct Item {
       std::size_t task, begin, end;
     };
     std::vector<Item> items;
-    for (std::size_t k = 0; k < tasks.size(); ++k)
+    for (std::size_t k = 0; k < first_task[cutoff]; ++k)
       for (std::size_t b = 0; b < prepared[k].la.size(); b += kV2Block)
         items.push_back({k, b, std::min(prepared[k].la.size(), b + kV2Block)});
     std::vector<PairOutcome> item_out(items.size());
@@ -396,27 +499,34 @@ Report Scene::check(const CollideOptions& o) {
     const auto nitems = static_cast<std::ptrdiff_t>(items.size());
 #pragma omp parallel for num_threads(threads) schedule(runtime) if (nitems >= kMinParallel)
     for (std::ptrdiff_t i = 0; i < nitems; ++i) {
-      const Item& it = items[static_cast<std::size_t>(i)];
-      detail::run_pair(model.surfaces[tasks[it.task].sa], prepared[it.task], it.begin, it.end, o,
-                       item_out[static_cast<std::size_t>(i)], item_counters[static_cast<std::size_t>(i)]);
+      const auto iu = static_cast<std::size_t>(i);
+      const Item& it = items[iu];
+      if (deadline.expired()) item_out[iu].cut = true;
+      else detail::run_pair(model.surfaces[tasks[it.task].sa], prepared[it.task], it.begin, it.end, o, item_out[iu],
+                            item_counters[iu], &deadline);
     }
     for (std::size_t i = 0; i < items.size(); ++i) {  // fixed order: independent of the thread count
       detail::merge_outcome(outcomes[items[i].task], std::move(item_out[i]));
       add(task_counters[items[i].task], item_counters[i]);
     }
   }
+  for (std::size_t k = 0; k < first_task[cutoff]; ++k)
+    if (outcomes[k].cut) task_cut[k] = 1;
 
-  // 5. Classes, in task order.
+  // 5. Classes, in task order. A cut surface pair reports nothing: its class could be wrong.
+  std::vector<char> pair_cut(pairs.size(), 0);
+  for (std::size_t k = 0; k < pairs.size(); ++k) pair_cut[k] = pairs[k].cut;
   std::vector<char> pair_intersects(pairs.size(), 0);
   std::vector<double> pair_distance(pairs.size(), std::numeric_limits<double>::infinity());
-  for (std::size_t k = 0; k < tasks.size(); ++k) {
-    add(total, task_counters[k]);
+  std::vector<std::vector<SurfacePairResult>> pair_results(pairs.size());
+  for (std::size_t k = 0; k < first_task[cutoff]; ++k) {
     const Task& t = tasks[k];
-    const PairOutcome& out = outcomes[k];
-    if (out.intersecting) {
-      ++total.intersecting_pairs;
-      pair_intersects[t.pair] = 1;
+    if (task_cut[k]) {
+      pair_cut[t.pair] = 1;
+      continue;
     }
+    const PairOutcome& out = outcomes[k];
+    if (out.intersecting) pair_intersects[t.pair] = 1;
     const auto cls = detail::classify(out, prepared[k].tau, o.clearance);
     if (!cls) continue;
     SurfacePairResult r;
@@ -431,6 +541,11 @@ Report Scene::check(const CollideOptions& o) {
     r.triangle_pairs = out.triangle_pairs;
     pair_distance[t.pair] = std::min(pair_distance[t.pair], r.distance);
     if (o.exact_verification && !out.intersecting) {
+      if (deadline.expired()) {
+        task_cut[k] = 1;
+        pair_cut[t.pair] = 1;
+        continue;
+      }
       const Part& pa = model.parts[model.surfaces[t.sa].part];
       const Part& pb = model.parts[model.surfaces[t.sb].part];
       if (pa.source && pb.source)
@@ -438,28 +553,76 @@ Report Scene::check(const CollideOptions& o) {
                                                      t.sb - pb.first_surface, s.poses[r.instance_b],
                                                      std::max(prepared[k].tau, o.clearance));
     }
-    report.pairs.push_back(std::move(r));
+    charge[t.pair] += result_bytes(r);
+    pair_results[t.pair].push_back(std::move(r));
   }
 
-  // 6. Containment: instance pairs whose boxes nest and whose surfaces do not cross.
+  // 6. Containment: instance pairs whose boxes nest and whose surfaces do not cross (not decidable
+  // for a pair with a cut surface pair).
   std::vector<char> contained(pairs.size(), 0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (npairs >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < npairs; ++k) {
-    const InstancePair& ip = pairs[static_cast<std::size_t>(k)];
-    if (!ip.containment || pair_intersects[static_cast<std::size_t>(k)]) continue;
-    contained[static_cast<std::size_t>(k)] =
-        ip.containment == 1 ? s.inside(ip.b, ip.a, ip.t_ab) : s.inside(ip.a, ip.b, ip.t_ba);
+  const auto ncontain = static_cast<std::ptrdiff_t>(cutoff);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (ncontain >= kMinParallel)
+  for (std::ptrdiff_t k = 0; k < ncontain; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    const InstancePair& ip = pairs[ku];
+    if (!ip.containment || pair_intersects[ku] || pair_cut[ku]) continue;
+    if (deadline.expired()) {
+      pair_cut[ku] = 1;
+      continue;
+    }
+    contained[ku] = ip.containment == 1 ? s.inside(ip.b, ip.a, ip.t_ab) : s.inside(ip.a, ip.b, ip.t_ba);
   }
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
+  for (std::size_t k = 0; k < cutoff; ++k) {
     if (!contained[k]) continue;
     SurfacePairResult r;
     r.instance_a = pairs[k].a;
     r.instance_b = pairs[k].b;
     r.contact = ContactClass::Containment;
     r.distance = pair_distance[k];
-    report.pairs.push_back(std::move(r));
+    charge[k] += result_bytes(r);
+    pair_results[k].push_back(std::move(r));
   }
+  apply_memory_budget();
   report.timings.triangle_level = seconds_since(t3);
+
+  // 7. The kept prefix of instance pairs: its results, counters and charge; the rest is listed.
+  for (std::uint32_t k = 0; k < pairs.size(); ++k) {
+    if (k >= cutoff || pair_cut[k]) report.unexamined_pairs.push_back({pairs[k].a, pairs[k].b});
+    if (k >= cutoff) continue;
+    add(total, pairs[k].counters);
+    report.memory_charged += charge[k];
+    for (std::size_t t = first_task[k]; t < first_task[k + 1]; ++t) {
+      if (task_cut[t]) continue;
+      add(total, task_counters[t]);
+      if (outcomes[t].intersecting) ++total.intersecting_pairs;
+    }
+    for (SurfacePairResult& r : pair_results[k]) report.pairs.push_back(std::move(r));
+  }
+  for (SurfaceId sid : asked) total.tessellated_surfaces += first_need[sid] < cutoff;
+  const bool memory_cut = cutoff < pairs.size();
+  const bool time_cut = std::any_of(pair_cut.begin(), pair_cut.begin() + cutoff, [](char c) { return c != 0; });
+  report.complete = !memory_cut && !time_cut;
+  if (memory_cut && time_cut) report.stopped_by = "time and memory budget";
+  else if (memory_cut) report.stopped_by = "memory budget";
+  else if (time_cut) report.stopped_by = "time budget";
+  std::sort(report.unexamined_pairs.begin(), report.unexamined_pairs.end());
+
+  // Give back what was built only for pairs past the memory budget, leaving the model and the scene
+  // as if the query had stopped there.
+  if (memory_cut) {
+    for (std::size_t i = 0; i < tessellated.size(); ++i) {
+      if (first_need[tessellated[i]] < cutoff) continue;
+      Surface& surf = model.surfaces[tessellated[i]];
+      surf.mesh = TriangleMesh{};
+      surf.has_triangles = false;
+      surf.deflection = old_deflection[i];
+    }
+    for (SurfaceId sid : built) {
+      if (first_need[sid] < cutoff) continue;
+      s.bvh[sid] = detail::SurfaceBvh{};
+      s.bvh_ready[sid] = 0;
+    }
+  }
 
   std::sort(report.pairs.begin(), report.pairs.end(), [](const SurfacePairResult& x, const SurfacePairResult& y) {
     return std::tie(x.instance_a, x.instance_b, x.surface_a, x.surface_b) <

@@ -1,6 +1,7 @@
 // Trajectories: CSV of per-step instance poses, replayed on a Scene.
 #include "cadclash/collide.h"
 
+#include <chrono>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -89,9 +90,27 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
                                           const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                           const std::string& file) {
   std::vector<StepResult> results;
+  // The time budget covers the whole replay: each step gets what the earlier ones left.
+  const auto start = std::chrono::steady_clock::now();
   std::size_t k = 0;
   while (k < rows.size()) {
     const std::int64_t step = rows[k].step;
+    CollideOptions step_options = options;
+    if (options.time_budget_seconds > 0.0) {
+      const double left = options.time_budget_seconds -
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const bool out_of_time = left <= 0.0 || (!results.empty() && !results.back().report.complete &&
+                                               results.back().report.stopped_by.find("time") != std::string::npos);
+      if (out_of_time) {
+        std::size_t steps_left = 0;
+        for (std::size_t r = k; r < rows.size(); ++r) steps_left += (r == k || rows[r].step != rows[r - 1].step);
+        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
+                               "time budget ran out: " + std::to_string(steps_left) +
+                                   " steps from step " + std::to_string(step) + " on were not checked"});
+        break;
+      }
+      step_options.time_budget_seconds = left;
+    }
     for (; k < rows.size() && rows[k].step == step; ++k) {
       const InstanceId id = scene.find_instance(rows[k].path);
       if (id == kInvalidId) {
@@ -101,7 +120,7 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
       }
       scene.set_pose(id, rows[k].pose);
     }
-    results.push_back({step, scene.check(options)});
+    results.push_back({step, scene.check(step_options)});
   }
   return results;
 }

@@ -25,6 +25,12 @@ struct TrianglePredicateStats {
   std::uint64_t extended_signs = 0;   // orientation signs the double filter left to long double
 };
 
+// Benchmark-only switch for bench/bench_compare's "float only" rows: while on, triangles_intersect
+// answers a call its float filters cannot decide with "intersect" (a float test calls a sign within
+// rounding of zero touching) instead of asking CGAL; exact_fallbacks still counts those calls.
+// Process-wide, off by default; the library never turns it on. Not for concurrent toggling.
+void set_float_only_for_benchmark(bool on);
+
 // True iff the closed triangles (a0,a1,a2) and (b0,b1,b2) share at least one point, exactly as exact
 // arithmetic on the given double coordinates decides (coplanar overlap and touching count).
 // Degenerate triangles (collinear or repeated vertices) are handled as the point sets they are.

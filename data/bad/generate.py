@@ -36,6 +36,13 @@ def binary_stl():
     write("stl_binary_nan.stl", header + struct.pack("<I", 2) +
           tri((0, 0, 1), (nan, 0, 0), (1, 0, 0), (0, 1, 0)) +
           tri((0, 0, 1), (0, 0, 0), (1, 0, 0), (0, 1, 0)))
+    # A good facet, then a zero-area (collinear) one: kept, with a warning naming facet 1 at byte 134.
+    write("stl_binary_zero_area.stl", header + struct.pack("<I", 2) +
+          tri((0, 0, 1), (0, 0, 0), (1, 0, 0), (0, 1, 0)) +
+          tri((0, 0, 1), (0, 0, 0), (1, 0, 0), (2, 0, 0)))
+    # A header that begins with "solid" like an ASCII file, with the size of a binary one.
+    solid_header = b"solid binary STL whose header starts like ASCII".ljust(80, b" ")
+    write("stl_binary_solid_header.stl", solid_header + struct.pack("<I", 1) + one)
 
 
 def step_parts():
@@ -112,6 +119,13 @@ def step_no_units():
     write("step_no_units.step", text)
 
 
+def step_no_length_unit():
+    # The 3D context's unit list keeps the angle units but loses the length unit: OCCT says nothing.
+    text = open(BASE_STEP).read()
+    text = text.replace("GLOBAL_UNIT_ASSIGNED_CONTEXT\n((#346,#347,#348))", "GLOBAL_UNIT_ASSIGNED_CONTEXT\n((#347,#348))")
+    write("step_no_length_unit.step", text)
+
+
 def step_deep_entity_chain(length=5000):
     # The first part's shape reached through a chain of `length` MAPPED_ITEMs, each mapping a
     # representation that holds the next one; the last holds the solid #15.
@@ -153,5 +167,6 @@ if __name__ == "__main__":
     step_cycle()
     step_deep()
     step_no_units()
+    step_no_length_unit()
     step_deep_entity_chain()
     step_mapped_cycle()

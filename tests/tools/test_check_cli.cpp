@@ -185,3 +185,102 @@ TEST(CheckCliAs1, EqualsBruteForceAndFindsEveryFastenerContact) {
 }
 
 }  // namespace
+
+namespace {
+
+// Budgets: a partial report that says so (table, JSON, exit code 4); under a memory budget the same
+// for any thread count; a budget that is not exhausted changes nothing.
+TEST(CheckCliBudget, MemoryBudgetPartialReportIsMarkedAndThreadIndependent) {
+  const Proc full = run("check " + boxes() + " --clearance 0.4 --all-triangles --no-timings --json " + tmp("budget_full.json"));
+  ASSERT_EQ(full.code, 0) << full.out;
+  const nlohmann::json jf = nlohmann::json::parse(read(tmp("budget_full.json")));
+  EXPECT_TRUE(jf["stopped_by"].is_null());
+  EXPECT_TRUE(jf["unexamined_pairs"].empty());
+  EXPECT_EQ(jf["complete"], true);
+  const double charged = jf["memory_charged_bytes"].get<double>();
+  ASSERT_GT(charged, 0.0);
+
+  // A budget that keeps some instance pairs but not all: the first pair also pays for the BVHs.
+  std::string budget;
+  double budget_bytes = 0.0;
+  for (const double fraction : {0.5, 0.65, 0.8, 0.9}) {
+    std::ostringstream mb;
+    mb.precision(17);
+    mb << charged * fraction / (1024.0 * 1024.0);
+    const Proc probe = run("check " + boxes() + " --clearance 0.4 --all-triangles --no-timings --memory-budget " +
+                           mb.str() + " --json " + tmp("budget_probe.json"));
+    const nlohmann::json jp = nlohmann::json::parse(read(tmp("budget_probe.json")));
+    if (probe.code == 4 && !jp["pairs"].empty()) {
+      budget = mb.str();
+      budget_bytes = charged * fraction;
+      break;
+    }
+  }
+  ASSERT_FALSE(budget.empty()) << "no budget between half and 90% of the total keeps a non-empty prefix";
+  std::string first;
+  for (int threads : {1, 2, 4}) {
+    const std::string json = tmp("budget_mem" + std::to_string(threads) + ".json");
+    const Proc r = run("check " + boxes() + " --clearance 0.4 --all-triangles --no-timings --memory-budget " + budget +
+                      " --threads " + std::to_string(threads) + " --json " + json);
+    ASSERT_EQ(r.code, 4) << r.out;
+    EXPECT_NE(r.out.find("PARTIAL REPORT: stopped by the memory budget"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("not examined: /"), std::string::npos) << r.out;
+    const std::string text = read(json);
+    const nlohmann::json j = nlohmann::json::parse(text);
+    EXPECT_EQ(j["stopped_by"], "memory budget");
+    EXPECT_EQ(j["complete"], false);
+    EXPECT_FALSE(j["unexamined_pairs"].empty());
+    EXPECT_LT(j["unexamined_pairs"].size(), j["counters"]["instance_pairs"].get<std::size_t>());
+    EXPECT_FALSE(j["pairs"].empty());
+    EXPECT_LE(j["memory_charged_bytes"].get<double>(), budget_bytes);
+    for (const auto& p : j["pairs"]) {  // every reported pair is in the full report, unchanged
+      bool found = false;
+      for (const auto& q : jf["pairs"]) found = found || q == p;
+      EXPECT_TRUE(found) << p.dump();
+    }
+    if (threads == 1) first = text;
+    else EXPECT_EQ(text, first) << "threads " << threads;
+  }
+}
+
+TEST(CheckCliBudget, ExpiredTimeBudgetAndGenerousBudgets) {
+  const std::string json = tmp("budget_time.json");
+  const Proc r = run("check " + boxes() + " --time-budget 1e-9 --json " + json);
+  ASSERT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("PARTIAL REPORT: stopped by the time budget"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read(json));
+  EXPECT_EQ(j["stopped_by"], "time budget");
+  EXPECT_EQ(j["complete"], false);
+  EXPECT_FALSE(j["unexamined_pairs"].empty());
+
+  const Proc none = run("check " + boxes() + " --clearance 0.4 --no-timings --json " + tmp("budget_none.json"));
+  const Proc generous = run("check " + boxes() + " --clearance 0.4 --no-timings --time-budget 1000 --memory-budget 1000 --json " +
+                           tmp("budget_generous.json"));
+  ASSERT_EQ(none.code, 0) << none.out;
+  ASSERT_EQ(generous.code, 0) << generous.out;
+  EXPECT_EQ(generous.out.find("PARTIAL"), std::string::npos);
+  const nlohmann::json a = nlohmann::json::parse(read(tmp("budget_none.json")));
+  const nlohmann::json b = nlohmann::json::parse(read(tmp("budget_generous.json")));
+  for (const char* key : {"pairs", "summary", "counters", "stopped_by", "unexamined_pairs", "complete"})
+    EXPECT_EQ(a[key], b[key]) << key;
+
+  EXPECT_EQ(run("check " + boxes() + " --time-budget -1").code, 2);
+  EXPECT_EQ(run("check " + boxes() + " --memory-budget x").code, 2);
+  // --fail-on-collision wins when the partial report already holds a collision; else 4.
+  EXPECT_EQ(run("check " + boxes() + " --memory-budget 0.000001 --fail-on-collision").code, 4);
+}
+
+TEST(CheckCliBudget, TimeBudgetCoversTheWholeTrajectory) {
+  const std::string json = tmp("budget_path.json");
+  const Proc r = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_ok.csv") +
+                    " --time-budget 1e-9 --no-timings --json " + json);
+  ASSERT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("were not checked"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(read(json));
+  EXPECT_EQ(j["stopped_by"], "time budget");
+  EXPECT_EQ(j["complete"], false);
+  EXPECT_GE(j["steps_not_checked"].get<int>(), 2);
+  EXPECT_LE(j["steps"].size(), 1u);
+}
+
+}  // namespace

@@ -250,6 +250,20 @@ struct CollideOptions {
   bool detect_containment = true;
   bool exact_verification = false;  // ask SurfaceSource::exact_distance for touching/clearance pairs
   double tessellation_deflection = 0.0;  // passed to require_triangles (<= 0: each source's default)
+  // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
+  // results of the instance pairs it finished, with Report::complete false (see Report).
+  // - time_budget_seconds: wall clock from the start of check(). Checked cooperatively between work
+  //   items of every parallel loop (surface level, lazy tessellation, BVH builds, triangle level —
+  //   every 256 triangle tests inside a surface pair — and containment). Which pairs finish depends
+  //   on the machine and the thread count. A surface being tessellated is not interrupted.
+  // - memory_budget_bytes: bytes of what the query builds — candidate surface-pair lists, triangles
+  //   tessellated on demand, per-surface BVHs, the triangle level's survivor lists and the results —
+  //   summed per instance pair in instance-pair order (a sum of allocations, not a peak). The query
+  //   keeps the longest prefix of instance pairs whose sum fits, so the partial report is the same
+  //   for any thread count. Triangles and BVHs built for pairs past that prefix are released again.
+  //   Structures a previous check() of the same Scene built are not counted again.
+  double time_budget_seconds = 0.0;
+  std::size_t memory_budget_bytes = 0;
 };
 
 // Counters of one query, summed over instance pairs (the paper's Table 2). They depend on the options
@@ -296,6 +310,16 @@ struct Report {
   CollideCounters counters;
   CollideTimings timings;
   std::vector<Diagnostic> diagnostics;   // surfaces that could not be tessellated (skipped)
+  // False when a budget (CollideOptions) ran out before every instance pair was examined. `pairs`
+  // then holds what was found: every result of the examined instance pairs and, under a time budget,
+  // the surface pairs finished within the others. Counters count the work whose results are kept.
+  bool complete = true;
+  std::string stopped_by;  // "time budget" or "memory budget" when !complete; empty otherwise
+  // Broad-phase instance pairs (of counters.instance_pairs) not fully examined, sorted; (a < b).
+  std::vector<std::array<InstanceId, 2>> unexamined_pairs;
+  // Bytes charged against memory_budget_bytes (computed whether or not a budget is set); the same
+  // for any thread count.
+  std::uint64_t memory_charged = 0;
 };
 
 // One-off query of two instances. Tessellates (require_triangles) exactly the surfaces it needs.
@@ -355,6 +379,10 @@ struct StepResult {
 
 // Replays rows on `scene`: rows with equal consecutive step numbers are applied together, then the
 // scene is checked. Rows naming unknown instances become diagnostics (warning) and are skipped.
+// Budgets: options.time_budget_seconds covers the whole replay. When it runs out, the step being
+// checked returns a partial report (Report::complete false), the later steps are not checked (not
+// in the result) and a warning naming `file` and the first unchecked step's line says how many were
+// left. options.memory_budget_bytes applies to each step's check() on its own.
 std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const TrajectoryRow> rows,
                                           const CollideOptions& options,
                                           std::vector<Diagnostic>& diagnostics, const std::string& file = {});

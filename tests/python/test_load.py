@@ -1,0 +1,116 @@
+"""cadclash.load(): model inspection, diagnostics, and bad input."""
+import numpy as np
+import pytest
+
+import cadclash
+
+
+def test_mesh_files_form_one_scene(boxes):
+    model = cadclash.load(boxes)
+    assert model.complete and model.diagnostics == []
+    assert [i.path for i in model.instances] == ["/box_a.obj/box_a", "/box_near.obj/box_near"]
+    assert [p.name for p in model.parts] == ["box_a", "box_near"]
+    part = model.parts[0]
+    assert not part.has_exact_geometry
+    assert len(part.surfaces) == 6  # one OBJ group per cube face
+    s = part.surfaces[0]
+    assert s.provenance.kind == "obj-group"
+    assert s.provenance.source_file.endswith("box_a.obj")
+    assert s.step_id is None and s.face_index == 0 and s.has_triangles and s.deflection == 0.0
+    assert model.instance("/box_near.obj/box_near").part is model.parts[1]
+    np.testing.assert_array_equal(model.instances[0].pose, np.eye(4))
+    assert model.triangle_count == sum(len(s.triangles) for s in model.surfaces)
+
+
+def test_step_provenance(as1):
+    assert as1.complete, [str(d) for d in as1.diagnostics]
+    assert len(as1.instances) == 18
+    paths = {i.path for i in as1.instances}
+    assert "/as1/L-BRACKET-ASSEMBLY::2/NUT-BOLT-ASSEMBLY::1/BOLT" in paths
+    for part in as1.parts:
+        assert part.has_exact_geometry
+        for k, s in enumerate(part.surfaces):
+            assert s.provenance.kind == "step-face"
+            assert s.step_id is not None and s.step_id > 0
+            assert s.face_index == k  # faces in TopExp::MapShapes order
+            assert s.part is part
+            assert s.deflection >= 0.0  # 0 (or rounding) for planar faces
+            lo, hi = s.aabb
+            assert all(a <= b for a, b in zip(lo, hi))
+    assert max(s.deflection for s in as1.surfaces) > 0.0  # the curved ones
+    step_ids = [s.step_id for s in as1.surfaces]
+    assert len(set(step_ids)) == len(step_ids)  # one ADVANCED_FACE per surface
+    assert all(s.colour is None or len(s.colour) == 3 for s in as1.surfaces)
+
+
+def test_instance_lookup_errors(boxes):
+    model = cadclash.load(boxes)
+    with pytest.raises(KeyError, match="/nope"):
+        model.instance("/nope")
+    with pytest.raises(IndexError):
+        model.instance(7)
+    with pytest.raises(TypeError):
+        model.instance(1.5)
+
+
+def test_unreadable_file_raises_naming_file_and_line(data_dir):
+    path = data_dir / "bad" / "garbage.obj"
+    with pytest.raises(cadclash.InputError) as e:
+        cadclash.load(path)
+    assert "garbage.obj:1: error: binary data" in str(e.value)
+    assert e.value.diagnostics[0].file == str(path) and e.value.diagnostics[0].line == 1
+
+
+def test_missing_file_raises_naming_it(tmp_path):
+    missing = tmp_path / "no_such.stp"
+    with pytest.raises(cadclash.InputError, match="no_such.stp"):
+        cadclash.load(missing)
+
+
+def test_bad_step_names_entity(data_dir):
+    with pytest.raises(cadclash.InputError) as e:
+        cadclash.load(data_dir / "bad" / "step_garbage.step")
+    assert "step_garbage.step: error: cannot read STEP file" in str(e.value)
+
+
+def test_partly_bad_file_keeps_good_parts(data_dir):
+    path = data_dir / "bad" / "truncated.obj"
+    model = cadclash.load(path)
+    assert not model.complete
+    assert len(model.surfaces) == 2
+    errors = [d for d in model.diagnostics if d.is_error]
+    assert errors and errors[0].line == 9 and "truncated.obj:9: error: face dropped" in str(errors[0])
+    with pytest.raises(cadclash.InputError, match="truncated.obj:9"):
+        cadclash.load(path, strict=True)
+
+
+def test_step_diagnostic_carries_step_id(data_dir):
+    try:
+        model = cadclash.load(data_dir / "cad" / "dangling_ref.step")
+        diagnostics = model.diagnostics
+    except cadclash.InputError as e:
+        diagnostics = e.diagnostics
+    assert any(d.step_id == 449 and "dangling_ref.step: #449: error" in str(d) for d in diagnostics)
+
+
+def test_bad_arguments(boxes):
+    with pytest.raises(ValueError, match="preset"):
+        cadclash.load(boxes, preset="ultra")
+    with pytest.raises(ValueError, match="deflection"):
+        cadclash.load(boxes, deflection=0.0)
+
+
+def test_mesh_post_processing_switches(data_dir):
+    flipped = data_dir / "repair" / "flipped_box.obj"
+    assert not any(s.provenance.repaired for s in cadclash.load(flipped).surfaces)
+    assert any(s.provenance.repaired for s in cadclash.load(flipped, repair=True).surfaces)
+
+    cube = cadclash.load(data_dir / "mesh" / "cube_binary.stl", segment=True)
+    assert [s.name for s in cube.surfaces] == [f"mesh-0/patch-{k}" for k in range(6)]
+    assert all(s.provenance.kind == "segment" and s.provenance.parent == 0 for s in cube.surfaces)
+
+
+def test_off_colours(data_dir):
+    model = cadclash.load(data_dir / "mesh" / "colours.off")
+    assert [(s.name, s.colour) for s in model.surfaces] == [("colour-FF0000", (1.0, 0.0, 0.0)),
+                                                            ("colour-0000FF", (0.0, 0.0, 1.0))]
