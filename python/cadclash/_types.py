@@ -98,7 +98,7 @@ class PairResult:
     intersecting: bool
     distance: float
     penetration: float
-    exact_distance: Optional[float]   # only with exact=True, for non-intersecting B-rep pairs
+    exact_distance: Optional[float]   # only with exact=True, for B-rep pairs that are not penetrating
     instance_id_a: int
     instance_id_b: int
     surface_id_a: Optional[int]

@@ -1,6 +1,8 @@
 #include "test_triangle_cases.h"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/exceptions.h>
 #include <CGAL/intersections.h>
 
 #include <Eigen/Geometry>
@@ -39,7 +41,7 @@ Vec3 lattice_normal_pair(Rng& rng, Vec3& u, Vec3& v) {
   }
 }
 
-TriPair coplanar_grid(Rng& rng) {
+TriPair coplanar_grid_local(Rng& rng) {
   Vec3 u, v;
   lattice_normal_pair(rng, u, v);
   // A third in a coordinate plane, the common CAD contact (faces on z = c).
@@ -53,8 +55,10 @@ TriPair coplanar_grid(Rng& rng) {
   }
   const Vec3 o = rng.ivec(-100, 100);
   auto pt = [&] { return Vec3(o + rng.integer(-6, 6) * u + rng.integer(-6, 6) * v); };
-  return exact_scale_shift({{pt(), pt(), pt()}, {pt(), pt(), pt()}}, rng);
+  return {{pt(), pt(), pt()}, {pt(), pt(), pt()}};
 }
+
+TriPair coplanar_grid(Rng& rng) { return exact_scale_shift(coplanar_grid_local(rng), rng); }
 
 TriPair shared_feature(Rng& rng) {
   TriPair p;
@@ -80,7 +84,7 @@ TriPair shared_feature(Rng& rng) {
   return p;
 }
 
-TriPair touching_grid(Rng& rng) {
+TriPair touching_grid_local(Rng& rng) {
   TriPair p;
   Vec3 n;
   do {
@@ -108,8 +112,10 @@ TriPair touching_grid(Rng& rng) {
       p.b = {t, off(side), off(-side)};
       break;
   }
-  return exact_scale_shift(p, rng);
+  return p;
 }
+
+TriPair touching_grid(Rng& rng) { return exact_scale_shift(touching_grid_local(rng), rng); }
 
 TriPair far_offset(Rng& rng) {
   const Vec3 o(1e8 + rng.uniform(0, 1e3), -1e8 - rng.uniform(0, 1e3), 1e8 + rng.uniform(0, 1e3));
@@ -182,6 +188,157 @@ TriPair degenerate_case(Rng& rng) {
   return exact_scale_shift(p, rng);
 }
 
+
+// --- numerical extremes ---
+
+// Offsets of 1e3..1e12 (each axis signed independently) with features of 1e-3..1e-9 of the offset.
+TriPair offset_feature(Rng& rng) {
+  const double offset = std::pow(10.0, rng.integer(3, 12)) * rng.uniform(1, 9.99);
+  const double feature = offset * std::pow(10.0, -rng.integer(3, 9));
+  Vec3 o;
+  for (int k = 0; k < 3; ++k) {
+    const double sign = rng.integer(0, 1) ? 1 : -1;
+    o[k] = sign * offset * (k == 0 ? 1.0 : rng.uniform(0.1, 1));
+  }
+  TriPair p;
+  switch (rng.integer(0, 3)) {
+    case 0:  // two small triangles near each other
+      for (Vec3& x : p.a) x = o + feature * rng.vec(-1, 1);
+      for (Vec3& x : p.b) x = o + feature * (rng.vec(-1, 1) + 0.5 * rng.unit());
+      break;
+    case 1:  // B from affine combinations of A's vertices: coplanar up to the rounding at the offset
+      for (Vec3& x : p.a) x = o + feature * rng.vec(-1, 1);
+      for (Vec3& x : p.b) {
+        const double s = rng.uniform(-1, 2), t = rng.uniform(-1, 2);
+        x = p.a[0] + s * (p.a[1] - p.a[0]) + t * (p.a[2] - p.a[0]);
+      }
+      break;
+    case 2: {  // a vertex of B on a point of A's edge or face (rounded), B crossing or on one side
+      for (Vec3& x : p.a) x = o + feature * rng.vec(-1, 1);
+      const Vec3 n = (p.a[1] - p.a[0]).cross(p.a[2] - p.a[0]).normalized();
+      const double s = rng.uniform(0, 1), t = rng.integer(0, 1) ? 0.0 : rng.uniform(0, 1 - s);
+      const Vec3 q = p.a[0] + s * (p.a[1] - p.a[0]) + t * (p.a[2] - p.a[0]);
+      const double side = rng.integer(0, 1) ? 1 : -1;
+      p.b = {q, Vec3(q + feature * (side * n + rng.vec(-1, 1))),
+             Vec3(q + feature * ((rng.integer(0, 2) ? side : -side) * n + rng.vec(-1, 1)))};
+      break;
+    }
+    default: {  // exact lattice contact at the offset: coordinates k * 2^e + offset, all representable
+      // Lattice steps of 2^e <= feature / 256: offset / 2^e < 2^39 and lattice coordinates < 2^14,
+      // so every coordinate is an exact double.
+      const int e = static_cast<int>(std::floor(std::log2(feature))) - 8;
+      const double unit = std::ldexp(1.0, e);
+      const Vec3 base(std::round(o.x() / unit) * unit, std::round(o.y() / unit) * unit, std::round(o.z() / unit) * unit);
+      p = rng.integer(0, 1) ? coplanar_grid_local(rng) : touching_grid_local(rng);
+      for (Tri* tri : {&p.a, &p.b})
+        for (Vec3& v : *tri) v = base + unit * v;
+      break;
+    }
+  }
+  return p;
+}
+
+// A triangle in A's plane (overlapping A or beside it), rotated by 1e-15..1e-6 rad about an axis
+// in A's plane; the rotated vertices are rounded, as a CAD kernel's output would be.
+TriPair nearly_coplanar(Rng& rng) {
+  const double scale = std::pow(10.0, rng.integer(-2, 3));
+  const Vec3 o = rng.integer(0, 1) ? Vec3::Zero() : Vec3(std::pow(10.0, rng.integer(1, 4)) * rng.vec(-1, 1));
+  TriPair p;
+  for (Vec3& x : p.a) x = o + scale * rng.vec(-1, 1);
+  const Vec3 e1 = p.a[1] - p.a[0], e2 = p.a[2] - p.a[0];
+  const Vec3 n = e1.cross(e2).normalized();
+  auto in_plane = [&](double lo, double hi) {
+    const double s = rng.uniform(lo, hi), t = rng.uniform(lo, hi);
+    return Vec3(p.a[0] + s * e1 + t * e2);
+  };
+  Tri b{in_plane(-0.5, 1.5), in_plane(-0.5, 1.5), in_plane(-0.5, 1.5)};
+  const Vec3 pivot = in_plane(-0.2, 1.2);
+  const Vec3 axis_dir = (rng.unit().cross(n)).normalized();
+  const double angle = (rng.integer(0, 1) ? 1 : -1) * std::pow(10.0, rng.uniform(-15, -6));
+  const Eigen::AngleAxisd rot(angle, axis_dir);
+  for (Vec3& x : b) x = pivot + rot * (x - pivot);
+  p.b = b;
+  return p;
+}
+
+// A T-junction: B's vertex on the inside of an edge of A. Lattice cases are exact (the vertex is
+// exactly on the edge); the rest round it onto the edge. B then lies in A's plane on the far side of
+// the edge (the mesh T-junction), overlaps A, runs along the edge, or leaves the plane.
+TriPair t_junction(Rng& rng) {
+  TriPair p;
+  Vec3 n;
+  const bool lattice = rng.integer(0, 2) != 0;
+  do {
+    for (Vec3& x : p.a) x = lattice ? rng.ivec(-20, 20) : rng.vec(-1, 1);
+    n = (p.a[1] - p.a[0]).cross(p.a[2] - p.a[0]);
+  } while (n.squaredNorm() == 0);
+  const int k = rng.integer(0, 2);
+  const Vec3 a = p.a[k], b = p.a[(k + 1) % 3], c = p.a[(k + 2) % 3];
+  // Lattice: scale A by 8 so that the points at i/8 of the edge are lattice points.
+  const double s8 = lattice ? 8 : 1;
+  for (Vec3& x : p.a) x *= s8;
+  const int i = rng.integer(1, 7);
+  const Vec3 t = lattice ? Vec3(8 * a + i * (b - a)) : Vec3(a + rng.uniform(0.05, 0.95) * (b - a));
+  const Vec3 away = lattice ? Vec3(8 * (a + b) / 2 - 8 * c) : Vec3((a + b) / 2 - c);  // in-plane, across the edge
+  const Vec3 along = lattice ? Vec3(b - a) : Vec3(b - a);
+  const Vec3 up = lattice ? n : n.normalized();
+  switch (rng.integer(0, 3)) {
+    case 0:  // mesh T-junction: B across the edge, in A's plane, meeting it at t and along the edge
+      p.b = {t, Vec3(t + rng.integer(1, 3) * along), Vec3(t + away)};
+      break;
+    case 1:  // B in A's plane, reaching back over A
+      p.b = {t, Vec3(t - away), Vec3(t + away + along)};
+      break;
+    case 2:  // B touches the edge at t only, from above or crossing below
+      p.b = {t, Vec3(t + up + away), Vec3(t + (rng.integer(0, 1) ? 1 : -1) * up - along)};
+      break;
+    default:  // B stands on the edge with an edge along it
+      p.b = {t, Vec3(t + along), Vec3(t + up)};
+      break;
+  }
+  if (lattice) {
+    p = exact_scale_shift(p, rng);
+  }
+  // A third of the cases: the junction vertex moved off the edge by 1-4 ulps (rounding in a mesher).
+  if (rng.integer(0, 2) == 0) {
+    double& x = p.b[0][rng.integer(0, 2)];
+    const double dir = rng.integer(0, 1) ? HUGE_VAL : -HUGE_VAL;
+    for (int m = rng.integer(1, 4); m > 0; --m) x = std::nextafter(x, dir);
+  }
+  return p;
+}
+
+// A huge triangle (1e2..1e6) and a tiny one (1e-9..1e-3) at a point of it: crossing, touching with a
+// vertex, or just above or below by a fraction of its size.
+TriPair tiny_huge(Rng& rng) {
+  const double big = std::pow(10.0, rng.uniform(2, 6));
+  const double small = std::pow(10.0, rng.uniform(-9, -3));
+  TriPair p;
+  const Vec3 o = rng.integer(0, 1) ? Vec3::Zero() : Vec3(big * rng.vec(-1, 1));
+  for (Vec3& x : p.a) x = o + big * rng.vec(-1, 1);
+  const Vec3 n = (p.a[1] - p.a[0]).cross(p.a[2] - p.a[0]).normalized();
+  // A point on the huge triangle: inside, or on an edge (barycentric 0 on one side).
+  double s = rng.uniform(0, 1), t = rng.uniform(0, 1 - s);
+  if (rng.integer(0, 2) == 0) t = 0;
+  const Vec3 q = p.a[0] + s * (p.a[1] - p.a[0]) + t * (p.a[2] - p.a[0]);
+  switch (rng.integer(0, 2)) {
+    case 0:  // crossing the plane
+      p.b = {Vec3(q + small * (n + 0.3 * rng.vec(-1, 1))), Vec3(q + small * (-n + 0.3 * rng.vec(-1, 1))),
+             Vec3(q + small * rng.vec(-1, 1))};
+      break;
+    case 1:  // touching with a vertex, the rest on one side
+      p.b = {q, Vec3(q + small * (n + 0.5 * rng.vec(-1, 1))), Vec3(q + small * (n + 0.5 * rng.vec(-1, 1)))};
+      break;
+    default: {  // just off the plane, on either side, by 1e-6..1 of its size
+      const Vec3 lift = (rng.integer(0, 1) ? 1 : -1) * small * std::pow(10.0, rng.uniform(-6, 0)) * n;
+      p.b = {Vec3(q + lift), Vec3(q + lift + small * rng.unit().cross(n)), Vec3(q + lift + small * rng.unit().cross(n))};
+      break;
+    }
+  }
+  if (rng.integer(0, 1)) std::swap(p.a, p.b);
+  return p;
+}
+
 }  // namespace
 
 std::string_view family_name(Family f) {
@@ -196,6 +353,10 @@ std::string_view family_name(Family f) {
     case Family::UlpPerturbed: return "ulp_perturbed";
     case Family::Degenerate: return "degenerate";
     case Family::RigidMotion: return "rigid_motion";
+    case Family::OffsetFeature: return "offset_feature";
+    case Family::NearlyCoplanar: return "nearly_coplanar";
+    case Family::TJunction: return "t_junction";
+    case Family::TinyHuge: return "tiny_huge";
     case Family::kCount: break;
   }
   return "?";
@@ -241,6 +402,10 @@ TriPair make_case(Family f, Rng& rng) {
       p = rigid_motion(make_case(inner, rng), rng, shift);
       break;
     }
+    case Family::OffsetFeature: p = offset_feature(rng); break;
+    case Family::NearlyCoplanar: p = nearly_coplanar(rng); break;
+    case Family::TJunction: p = t_junction(rng); break;
+    case Family::TinyHuge: p = tiny_huge(rng); break;
     case Family::kCount: break;
   }
   return shuffle(p, rng);
@@ -252,44 +417,60 @@ TriPair make_case(Family f, Rng& rng) {
 
 namespace {
 using EK = CGAL::Exact_predicates_exact_constructions_kernel;
-using EPoint = EK::Point_3;
+using FK = CGAL::Simple_cartesian<double>;
 
-struct EShape {
+// The closed point set of a triangle as kernel K sees it: a triangle, or (collinear) the segment
+// between the two vertices farthest apart, or a point.
+template <class K>
+struct Shape {
   int dim = 2;  // 0 point, 1 segment, 2 triangle
-  EPoint p[3];
+  typename K::Point_3 p[3];
 };
 
-EShape exact_shape(const Tri& t) {
-  EShape s;
-  for (int i = 0; i < 3; ++i) s.p[i] = EPoint(t[i].x(), t[i].y(), t[i].z());
+template <class K>
+Shape<K> shape_of(const Tri& t) {
+  Shape<K> s;
+  for (int i = 0; i < 3; ++i) s.p[i] = typename K::Point_3(t[i].x(), t[i].y(), t[i].z());
   if (!CGAL::collinear(s.p[0], s.p[1], s.p[2])) return s;
-  // Collinear: the segment between the two vertices farthest apart.
   int bi = 0, bj = 1;
-  EK::FT best = CGAL::squared_distance(s.p[0], s.p[1]);
+  typename K::FT best = CGAL::squared_distance(s.p[0], s.p[1]);
   for (auto [i, j] : {std::pair{0, 2}, std::pair{1, 2}}) {
-    const EK::FT d = CGAL::squared_distance(s.p[i], s.p[j]);
+    const typename K::FT d = CGAL::squared_distance(s.p[i], s.p[j]);
     if (d > best) best = d, bi = i, bj = j;
   }
-  const EPoint a = s.p[bi], b = s.p[bj];
+  const typename K::Point_3 a = s.p[bi], b = s.p[bj];
   s.p[0] = a;
   s.p[1] = b;
   s.dim = (best == 0) ? 0 : 1;
   return s;
 }
-}  // namespace
 
-bool oracle_intersect(const Tri& ta, const Tri& tb) {
-  EShape a = exact_shape(ta), b = exact_shape(tb);
+template <class K>
+bool intersect_with(const Tri& ta, const Tri& tb) {
+  Shape<K> a = shape_of<K>(ta), b = shape_of<K>(tb);
   if (a.dim < b.dim) std::swap(a, b);
-  const EK::Triangle_3 at(a.p[0], a.p[1], a.p[2]);
-  const EK::Segment_3 as(a.p[0], a.p[1]);
+  const typename K::Triangle_3 at(a.p[0], a.p[1], a.p[2]);
+  const typename K::Segment_3 as(a.p[0], a.p[1]);
   switch (a.dim * 3 + b.dim) {
-    case 8: return CGAL::do_intersect(at, EK::Triangle_3(b.p[0], b.p[1], b.p[2]));
-    case 7: return CGAL::do_intersect(at, EK::Segment_3(b.p[0], b.p[1]));
+    case 8: return CGAL::do_intersect(at, typename K::Triangle_3(b.p[0], b.p[1], b.p[2]));
+    case 7: return CGAL::do_intersect(at, typename K::Segment_3(b.p[0], b.p[1]));
     case 6: return CGAL::do_intersect(at, b.p[0]);
-    case 4: return CGAL::do_intersect(as, EK::Segment_3(b.p[0], b.p[1]));
+    case 4: return CGAL::do_intersect(as, typename K::Segment_3(b.p[0], b.p[1]));
     case 3: return CGAL::do_intersect(as, b.p[0]);
     default: return a.p[0] == b.p[0];
+  }
+}
+}  // namespace
+
+bool oracle_intersect(const Tri& ta, const Tri& tb) { return intersect_with<EK>(ta, tb); }
+
+bool float_only_intersect(const Tri& ta, const Tri& tb, bool* failed) {
+  if (failed) *failed = false;
+  try {
+    return intersect_with<FK>(ta, tb);
+  } catch (const CGAL::Failure_exception&) {  // a precondition the rounded arithmetic broke
+    if (failed) *failed = true;
+    return false;
   }
 }
 

@@ -1,6 +1,8 @@
 // Generators of triangle pairs for the predicate tests and benchmarks: random, coplanar, touching,
-// shared features, far offsets, slivers, 1-ulp perturbations, degenerate, under rigid motions; and the
-// brute-force exact oracle (CGAL Epeck, exact constructions) they are checked against.
+// shared features, far offsets, slivers, 1-ulp perturbations, degenerate, under rigid motions, and the
+// numerical extremes (offsets 1e3..1e12 with features down to 1e-9 of the offset, nearly coplanar at
+// 1e-15..1e-6 rad, T-junctions, tiny against huge); the brute-force exact oracle (CGAL Epeck, exact
+// constructions) they are checked against; and the float-only answer the filters exist to avoid.
 #pragma once
 
 #include "cadclash/collide.h"
@@ -60,6 +62,11 @@ enum class Family {
   UlpPerturbed,    // a coplanar or touching pair with one coordinate moved by 1-4 ulps
   Degenerate,      // collinear and repeated vertices, points, segments
   RigidMotion,     // any of the above under a large rotation and translation (rounded)
+  // Numerical extremes (not mixed into RigidMotion, whose inner families stay the ones above).
+  OffsetFeature,   // offsets 1e3..1e12, features 1e-3..1e-9 of the offset: near, coplanar-ish, touching, lattice
+  NearlyCoplanar,  // B = a triangle in A's plane rotated by 1e-15..1e-6 rad about an in-plane axis
+  TJunction,       // a vertex of B on the inside of an edge of A (exact, or rounded onto it), B coplanar or not
+  TinyHuge,        // a triangle of 1e-9..1e-3 crossing, touching or just off a triangle of 1e2..1e6
   kCount
 };
 
@@ -74,5 +81,12 @@ TriPair rigid_motion(const TriPair& p, Rng& rng, double max_shift);
 
 // The oracle: exact intersection of the closed point sets with CGAL's Epeck (exact constructions).
 bool oracle_intersect(const Tri& a, const Tri& b);
+
+// The float-only answer: the same closed-set decision (CGAL's Guigue–Devillers triangle test, the
+// algorithm triangles_intersect filters) evaluated in plain double (Simple_cartesian<double>), with
+// no error bound and no exact fallback. What a naive implementation answers; often wrong on the
+// adversarial families. A CGAL precondition the rounded arithmetic breaks (only in builds with CGAL
+// assertions) returns false and sets *failed; callers count it as a wrong answer.
+bool float_only_intersect(const Tri& a, const Tri& b, bool* failed = nullptr);
 
 }  // namespace cadclash::test

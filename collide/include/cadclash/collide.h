@@ -298,8 +298,9 @@ struct SurfacePairResult {
   double distance = 0.0;      // min triangle distance; 0 when intersecting; for Containment, the min
                               // distance when within the search margin, else +infinity
   double penetration = 0.0;   // crossing-depth estimate (see above); in EarlyExit mode a lower bound
-  // exact_verification only: SurfaceSource::exact_distance for non-intersecting pairs, when both
-  // parts have exact geometry (a value > the search margin means "farther than the margin").
+  // exact_verification only: SurfaceSource::exact_distance for every pair that is not penetrating
+  // (touching pairs with crossing triangles included: faceted coaxial cylinders with a small gap
+  // cross), when both parts have exact geometry (a value > the search margin means "farther").
   std::optional<double> exact_distance;
   // AllTrianglePairs only: intersecting (triangle index in Sk, triangle index in Sl), sorted.
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;

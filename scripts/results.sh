@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Regenerates docs/results.md: builds with the benchmarks, runs the accuracy benchmark
+# (bench_accuracy), the side-by-side comparison (bench_compare, when built) and the numerical-extremes
+# oracle test, then fills docs/results/template.md. Plots go to docs/results/.
+#   bash scripts/results.sh [BUILD_DIR]        (default: build; ~5-10 min on 2 cores after the build)
+# Raw outputs stay in out/results/ (ground-truth cache in out/results/cache/, reused by later runs).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+out=$root/out/results
+docs=$root/docs/results
+cd "$root"
+
+# Configured as scripts/build.sh does, but only the programs this page runs are built: a whole tree
+# takes longer than the benchmarks.
+echo "results: building $build (bench_accuracy, bench_compare, test_triangle_predicates)"
+generator=()
+if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+    -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_TESTS=ON >/dev/null
+else
+  cmake -S "$root" -B "$build" -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_TESTS=ON >/dev/null
+fi
+cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates
+compare_built=no
+if cmake --build "$build" --target help | grep -q '^bench_compare:'; then
+  if cmake --build "$build" -j "$(nproc)" --target bench_compare; then compare_built=yes
+  else echo "results: bench_compare does not build; its section is left out" >&2; fi
+fi
+mkdir -p "$out" "$docs"
+start=$(date +%s)
+
+echo "results: accuracy against the exact geometry"
+"$build/bench/bench_accuracy" --out "$out" | tee "$out/accuracy.log"
+
+if [ "$compare_built" = yes ] && [ -x "$build/bench/bench_compare" ]; then
+  echo "results: side-by-side comparison"
+  "$build/bench/bench_compare" --data data/external --out "$out" | tee "$out/compare.log"
+  compare_status="ran"
+else
+  echo "results: bench_compare is not built; its section is left out"
+  rm -f "$out/compare.md"
+  compare_status="skipped"
+fi
+
+echo "results: numerical extremes (triangle test against the exact oracle)"
+"$build/tests/collide/test_triangle_predicates" --gtest_filter='Families/OracleAgreement.*' >"$out/extremes.log" 2>&1 || {
+  tail -30 "$out/extremes.log"
+  echo "results: the oracle test failed" >&2
+  exit 1
+}
+{
+  echo "| family | pairs | intersecting | plain double wrong | filters only wrong | filtered wrong | exact fallbacks |"
+  echo "|---|---|---|---|---|---|---|"
+  grep '^\[ family   \] |' "$out/extremes.log" | sed 's/^\[ family   \] //'
+} >"$out/extremes.md"
+elapsed=$(( $(date +%s) - start ))
+
+# Plots next to the page; links in the embedded tables point there.
+rm -f "$docs"/*.svg "$docs"/*.png
+for f in "$out"/*.svg "$out"/*.png; do [ -e "$f" ] && cp "$f" "$docs/"; done
+relink() { sed -E 's#\]\(([^/():]+\.(svg|png))\)#](results/\1)#g' "$1"; }
+# compare.md starts at level 1; under this page's "## Side by side" its headings go two levels down.
+demote() { awk '/^```/ { code = !code } !code && /^#/ { $0 = "##" $0 } { print }'; }
+
+cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git status --porcelain 2>/dev/null)" ]; then commit="$commit (with uncommitted changes)"; fi
+
+page=$root/docs/results.md
+while IFS= read -r line || [ -n "$line" ]; do
+  case "$line" in
+    @MACHINE@)
+      echo "- date: $(date -u '+%Y-%m-%d %H:%M UTC')"
+      echo "- commit: $commit"
+      echo "- CPU: $cpu; nproc: $(nproc)"
+      echo "- OS: $(. /etc/os-release && echo "$PRETTY_NAME"); compiler: $(c++ --version | head -1)"
+      echo "- benchmarks and oracle run: ${elapsed} s (build excluded)"
+      ;;
+    @COMPARE@)
+      if [ "$compare_status" = ran ] && [ -f "$out/compare.md" ]; then relink "$out/compare.md" | demote
+      else echo "_bench_compare was not built in this tree, so this run has no side-by-side section._"; fi
+      ;;
+    @ACCURACY@) relink "$out/accuracy.md" ;;
+    @EXTREMES@) cat "$out/extremes.md" ;;
+    *) printf '%s\n' "$line" ;;
+  esac
+done <"$docs/template.md" >"$page"
+echo "results: wrote $page (raw outputs in $out)"
