@@ -55,3 +55,17 @@ if [ ! -f "$stamp" ]; then
     done
   touch "$stamp"
 fi
+
+# The HTML clash viewer (viewer/): three.js, esbuild and playwright-core from npm, pinned by
+# viewer/package-lock.json; `npm ci` again whenever the lock file is newer than node_modules.
+if ! command -v npm >/dev/null; then
+  echo "setup: installing nodejs npm" >&2
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+fi
+viewer="$root/viewer"
+if [ ! -f "$viewer/node_modules/.package-lock.json" ] ||
+   [ "$viewer/package-lock.json" -nt "$viewer/node_modules/.package-lock.json" ]; then
+  echo "setup: npm ci in viewer/" >&2
+  (cd "$viewer" && npm ci --no-audit --no-fund --loglevel=error)
+fi

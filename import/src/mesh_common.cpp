@@ -86,10 +86,12 @@ bool parse_int(std::string_view token, std::int64_t& value) {
   return ec == std::errc{} && ptr == token.data() + token.size() && !token.empty();
 }
 
-std::string printable_token(std::string_view token) {
+std::string printable_token(std::string_view token) { return printable_text(token.substr(0, 32)); }
+
+std::string printable_text(std::string_view text) {
   static const char* const hex = "0123456789ABCDEF";
   std::string out;
-  for (const char c : token.substr(0, 32)) {
+  for (const char c : text) {
     const auto byte = static_cast<unsigned char>(c);
     if (byte >= 0x20 && byte < 0x7F) {
       out += c;
@@ -181,6 +183,18 @@ void finish_single_part_model(Model& model, const std::string& path) {
   instance.path = "/" + model.parts.back().name;
   instance.part = 0;
   model.instances.push_back(std::move(instance));
+}
+
+std::string degenerate_face(std::span<const Vec3> c) {
+  const std::size_t n = c.size();
+  for (std::size_t k = 0; k < n; ++k)
+    if (c[k] == c[(k + 1) % n])
+      return "has a zero-length edge (corners " + std::to_string(k + 1) + " and " + std::to_string((k + 1) % n + 1) +
+             " are the same point)";
+  Vec3 normal = Vec3::Zero();
+  for (std::size_t k = 1; k + 1 < n; ++k) normal += (c[k] - c[0]).cross(c[k + 1] - c[0]);
+  if (n >= 3 && normal == Vec3::Zero()) return "has zero area (its corners are collinear)";
+  return {};
 }
 
 }  // namespace cadclash::detail

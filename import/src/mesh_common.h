@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -48,6 +49,9 @@ bool find_binary_byte(std::string_view text, std::int64_t& line);
 // A token from the file as it may be quoted in a message: at most its first 32 bytes, with every byte
 // outside printable ASCII written as \xNN, so messages stay valid UTF-8 (the JSON report needs it).
 std::string printable_token(std::string_view token);
+// The same escaping for a whole text, without the length limit: for names from the file and for
+// library messages (assimp's) that quote the file's bytes.
+std::string printable_text(std::string_view text);
 
 // Collects diagnostics, listing at most `cap` per category and summarising the rest, so a file
 // with a million bad faces gives a readable report that still counts everything dropped.
@@ -72,6 +76,13 @@ class DiagnosticCollector {
   std::vector<Diagnostic> listed_;
   std::map<std::string, Category> categories_;
 };
+
+// Why a face with these corner positions (in order) is degenerate, as a phrase: "has a zero-length
+// edge (corners 1 and 2 are the same point)" or "has zero area (its corners are collinear)"; empty
+// when it is neither. Exact on the stored doubles for repeated points; zero area means the summed
+// fan cross product is exactly zero. Readers keep such faces and warn: a degenerate triangle is a
+// segment or point that can still touch another surface, and dropping it would renumber triangles.
+std::string degenerate_face(std::span<const Vec3> corners);
 
 // Renumbers a surface's vertices in the order of their numbers in the source file, given the
 // source number of each vertex (source_of_local[i] for mesh.vertices[i]), so a mesh read back keeps

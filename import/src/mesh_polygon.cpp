@@ -68,7 +68,6 @@ bool triangulate_polygon(std::span<const Vec3> points, std::span<const std::uint
   // Ear clipping, O(n^2): good for the polygons of mesh files, which are small.
   std::vector<std::size_t> ring(n);
   for (std::size_t i = 0; i < n; ++i) ring[i] = i;
-  bool simple = true;
   std::size_t guard = 0;
   std::size_t i = 0;
   while (ring.size() > 3) {
@@ -82,9 +81,10 @@ bool triangulate_polygon(std::span<const Vec3> points, std::span<const std::uint
       if (in_triangle(p[q], p[ia], p[ib], p[ic])) ear = false;
     }
     if (!ear && guard >= m) {
-      // A full turn without an ear: the polygon is not simple. Clip the corner anyway.
-      simple = false;
-      ear = true;
+      // A full turn without an ear: the polygon is not simple. Fan the rest: clipping one corner
+      // per full turn costs O(n^3): a random self-intersecting 3000-gon took 13 s under ASan.
+      for (std::size_t k = 1; k + 1 < m; ++k) out.push_back({corners[ring[0]], corners[ring[k]], corners[ring[k + 1]]});
+      return false;
     }
     if (ear) {
       out.push_back({corners[ia], corners[ib], corners[ic]});
@@ -97,7 +97,7 @@ bool triangulate_polygon(std::span<const Vec3> points, std::span<const std::uint
     }
   }
   out.push_back({corners[ring[0]], corners[ring[1]], corners[ring[2]]});
-  return simple;
+  return true;
 }
 
 }  // namespace cadclash::detail

@@ -14,7 +14,8 @@
 // Polygons are triangulated by triangulate_polygon (fan when convex, ear clipping otherwise) on the
 // double coordinates: aiProcess_Triangulate handles concave polygons too, but it only sees the vertex
 // numbers here.
-// Nothing is filtered by area: a degenerate triangle stays, as no tolerance here would fit all units.
+// Nothing is filtered by area: a degenerate triangle stays, as no tolerance here would fit all units;
+// an exactly degenerate face (repeated point, collinear corners) gets a warning naming its line.
 #include "mesh_common.h"
 #include "mesh_polygon.h"
 #include "readers.h"
@@ -22,7 +23,9 @@
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <string_view>
+#include <tuple>
 #include <unordered_map>
 
 namespace cadclash::detail {
@@ -194,6 +197,48 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
   }
 }
 
+// Faces that repeat an earlier face of the same surface (the same corners, in any order), as
+// (line, message) in line order: a group that recurs with the same faces doubles them. They are kept
+// (as degenerate faces are) and named with both lines. Sorting (surface, hash) keys keeps this cheap.
+std::vector<std::pair<std::int64_t, std::string>> repeated_faces(const ObjScan& scan,
+                                                                 const std::vector<std::uint32_t>& kept_face,
+                                                                 const std::vector<std::uint32_t>& kept_surface,
+                                                                 const std::vector<std::string>& surface_names) {
+  auto sorted_corners = [&](std::uint32_t f) {
+    const ObjFace& face = scan.faces[f];
+    std::vector<std::int64_t> c(scan.corners.begin() + face.first, scan.corners.begin() + face.first + face.count);
+    std::sort(c.begin(), c.end());
+    return c;
+  };
+  struct Key {
+    std::uint32_t surface;
+    std::uint64_t hash;
+    std::uint32_t face;
+  };
+  std::vector<Key> keys(kept_face.size());
+  for (std::size_t k = 0; k < kept_face.size(); ++k) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const std::int64_t v : sorted_corners(kept_face[k])) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
+    keys[k] = {kept_surface[k], h, kept_face[k]};
+  }
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+    return std::tie(a.surface, a.hash, a.face) < std::tie(b.surface, b.hash, b.face);
+  });
+  std::vector<std::pair<std::int64_t, std::string>> out;
+  for (std::size_t i = 1; i < keys.size(); ++i) {
+    for (std::size_t j = i; j-- > 0 && keys[j].surface == keys[i].surface && keys[j].hash == keys[i].hash;) {
+      if (sorted_corners(keys[j].face) != sorted_corners(keys[i].face)) continue;
+      out.emplace_back(scan.faces[keys[i].face].line,
+                       "face repeats the face at line " + std::to_string(scan.faces[keys[j].face].line) +
+                           " of surface '" + printable_token(surface_names[keys[i].surface]) +
+                           "' (a group that appears twice?); kept");
+      break;
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 ImportResult read_obj(const std::string& path, const ImportOptions&) {
@@ -225,6 +270,8 @@ ImportResult read_obj(const std::string& path, const ImportOptions&) {
   }
   std::size_t kept_faces = 0;
   std::uint32_t last_surface = kNoGroup;
+  std::vector<Vec3> face_points;
+  std::vector<std::uint32_t> kept_face, kept_surface;  // scan.faces index and surface of each kept face
   for (const ObjFace& f : scan.faces) {
     std::string problem;
     for (std::uint32_t c = f.first; c < f.first + f.count && problem.empty(); ++c) {
@@ -241,11 +288,18 @@ ImportResult read_obj(const std::string& path, const ImportOptions&) {
       dropped = true;
       continue;
     }
+    face_points.clear();
+    for (std::uint32_t c = f.first; c < f.first + f.count; ++c)
+      face_points.push_back(scan.vertices[static_cast<std::size_t>(scan.corners[c])]);
+    if (const std::string why = degenerate_face(face_points); !why.empty())
+      diags.add(Severity::Warning, f.line, "degenerate faces kept", "face " + why + "; kept");
     std::uint32_t& s = surface_of_group[f.group];
     if (s == kNoGroup) {
       s = static_cast<std::uint32_t>(surface_names.size());
       surface_names.push_back(scan.group_names[f.group]);
     }
+    kept_face.push_back(static_cast<std::uint32_t>(&f - scan.faces.data()));
+    kept_surface.push_back(s);
     if (s != last_surface) {
       normalised += "g s" + std::to_string(s) + '\n';
       last_surface = s;
@@ -255,6 +309,8 @@ ImportResult read_obj(const std::string& path, const ImportOptions&) {
     normalised += '\n';
     ++kept_faces;
   }
+  for (auto& [line, message] : repeated_faces(scan, kept_face, kept_surface, surface_names))
+    diags.add(Severity::Warning, line, "repeated faces kept", std::move(message));
   if (scan.ignored_lines_points > 0)
     diags.add(Severity::Warning, 0, "line and point elements ignored",
               std::to_string(scan.ignored_lines_points) + " line/point elements (l, p) ignored: they bound no surface");

@@ -193,7 +193,7 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
           diags.add(Severity::Error, line_no, "bad vertices",
                     "vertex " + std::to_string(i) +
                         (st == NumberStatus::NotFinite ? " has a coordinate that is not finite ('" : ": '") +
-                        std::string(tokens[c]) + (st == NumberStatus::NotFinite ? "')" : "' is not a number"));
+                        printable_token(tokens[c]) + (st == NumberStatus::NotFinite ? "')" : "' is not a number"));
           bad = line_no;
         } else if (c < 3) {
           p[static_cast<int>(c)] = v;
@@ -260,6 +260,10 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
     auto [it, inserted] = group_of_key.try_emplace(colour.key, static_cast<std::uint32_t>(groups.size()));
     if (inserted) groups.push_back(colour);
     face.group = it->second;
+    std::vector<Vec3> points;
+    for (std::uint32_t v : face.corners) points.push_back(vertices[v]);
+    if (const std::string why = degenerate_face(points); !why.empty())
+      diags.add(Severity::Warning, line_no, "degenerate faces kept", "face " + std::to_string(faces_read) + " " + why + "; kept");
     faces.push_back(std::move(face));
   }
   if (faces_read < nf) {

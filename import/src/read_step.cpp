@@ -1,5 +1,6 @@
 // STEP (AP203/AP214/AP242) through STEPCAFControl_Reader into an XCAF document.
 #include "cad_xcaf.h"
+#include "mesh_common.h"
 #include "readers.h"
 
 #include <IFSelect_ReturnStatus.hxx>
@@ -31,6 +32,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -100,6 +102,72 @@ std::optional<std::pair<std::string, std::int64_t>> close_truncated(const std::s
   const auto line = 1 + std::count(text.begin(), text.end(), '\n');
   text += "\nENDSEC;\nEND-ISO-10303-21;\n";
   return std::make_pair(std::move(text), static_cast<std::int64_t>(line));
+}
+
+// Representation contexts without a usable length unit, as diagnostics naming the context's #id.
+// OCCT knows the complex context entity only with its GLOBAL_UNIT_ASSIGNED_CONTEXT, so without one it
+// drops the entity and reports only that the representations using it have an "illegal type"
+// parameter (an error); with a unit list that holds no LENGTH_UNIT it says nothing and reads the
+// lengths as millimetres (a warning). Read from the text (entity id → instance text).
+std::vector<Diagnostic> unit_context_problems(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  std::unordered_map<std::int64_t, std::string_view> entities;
+  std::vector<std::int64_t> contexts;
+  std::size_t i = text.find("DATA;");
+  while (i != std::string::npos && i < text.size()) {
+    i = text.find('#', i);
+    if (i == std::string::npos) break;
+    std::size_t j = i + 1;
+    std::int64_t id = 0;
+    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50))
+      id = id * 10 + (text[j++] - '0');
+    std::size_t k = j;
+    while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+    if (j == i + 1 || k >= text.size() || text[k] != '=') {
+      i = j;
+      continue;
+    }
+    bool quoted = false;  // ';' inside a string does not end the entity ('' is an escaped quote)
+    std::size_t end = k;
+    for (; end < text.size() && (quoted || text[end] != ';'); ++end)
+      if (text[end] == '\'') quoted = !quoted;
+    const std::string_view body(text.data() + k + 1, end - k - 1);
+    entities[id] = body;
+    if (body.find("GEOMETRIC_REPRESENTATION_CONTEXT") != std::string_view::npos &&
+        body.find("REPRESENTATION_CONTEXT(2)") == std::string_view::npos)  // 2D parameter spaces need no unit
+      contexts.push_back(id);
+    i = end;
+  }
+  std::vector<Diagnostic> out;
+  for (const std::int64_t id : contexts) {
+    const std::string_view body = entities[id];
+    const std::size_t at = body.find("GLOBAL_UNIT_ASSIGNED_CONTEXT");
+    if (at == std::string_view::npos) {
+      out.push_back({Severity::Error, path, 0, id,
+                     "representation context without GLOBAL_UNIT_ASSIGNED_CONTEXT: its lengths have no unit, so "
+                     "OCCT rejects it and every shape representation placed in it"});
+      continue;
+    }
+    // The unit list: the #ids in the parentheses after the keyword.
+    const std::size_t open = body.find('(', at), close = body.find(')', at);
+    bool length = false;
+    for (std::size_t h = body.find('#', open); h != std::string_view::npos && h < close; h = body.find('#', h + 1)) {
+      std::int64_t ref = 0;
+      for (std::size_t d = h + 1; d < body.size() && std::isdigit(static_cast<unsigned char>(body[d])) &&
+                                  ref < (std::int64_t{1} << 50); ++d)  // the bound of the ids above: no overflow
+        ref = ref * 10 + (body[d] - '0');
+      const auto unit = entities.find(ref);
+      length = length || (unit != entities.end() && unit->second.find("LENGTH_UNIT") != std::string_view::npos);
+    }
+    if (!length)
+      out.push_back({Severity::Warning, path, 0, id,
+                     "representation context whose GLOBAL_UNIT_ASSIGNED_CONTEXT names no LENGTH_UNIT: its lengths "
+                     "have no stated unit; read as millimetres"});
+  }
+  return out;
 }
 
 // When no product can be transferred (a cut-off file loses its product structure, which OCCT
@@ -323,7 +391,8 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     for (const std::string& schema : schemas) {
       if (!known_schema(schema)) {
         result.diagnostics.push_back({Severity::Error, path, schema_line, -1,
-                                      "FILE_SCHEMA '" + schema + "' is not a STEP AP203/AP214/AP242 schema; read as AP214 anyway"});
+                                      "FILE_SCHEMA '" + printable_token(schema) +
+                                          "' is not a STEP AP203/AP214/AP242 schema; read as AP214 anyway"});
         result.complete = false;
       }
     }
@@ -356,6 +425,10 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       return result;
     }
     if (load_fails > 0) result.complete = false;
+    for (Diagnostic& d : unit_context_problems(path)) {
+      if (d.severity == Severity::Error) result.complete = false;
+      result.diagnostics.push_back(std::move(d));
+    }
     if (model.IsNull() || model->NbEntities() == 0) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP file has an empty DATA section"});
       result.complete = false;

@@ -101,9 +101,9 @@ MeshStageResult repair_soup_cgal(const TaggedSoup& soup, std::uint32_t tag_count
   Mesh mesh;
   if (!soup_to_mesh(soup.points, soup.triangles, mesh, r.error)) return r;
   const std::size_t n_in = soup.triangles.size();
-  auto [ftag, tag_created] = mesh.add_property_map<FI, std::uint32_t>("f:cadclash_tag", 0u);
-  auto [forigin, origin_created] = mesh.add_property_map<FI, std::int64_t>("f:cadclash_origin", -1);
-  (void)tag_created, (void)origin_created;
+  // Not structured bindings: clang 14 cannot capture them in the lambdas below.
+  auto ftag = mesh.add_property_map<FI, std::uint32_t>("f:cadclash_tag", 0u).first;
+  auto forigin = mesh.add_property_map<FI, std::int64_t>("f:cadclash_origin", -1).first;
   for (std::size_t i = 0; i < n_in; ++i) {
     FI f(static_cast<Mesh::size_type>(i));
     ftag[f] = soup.tags[i];
