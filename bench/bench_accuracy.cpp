@@ -183,7 +183,7 @@ int run(const Args& args) {
      << "import and tessellation excluded. Angular deflection 0.5 rad (the CLI default).\n\n";
   md << "Modes: **mesh-only** τ = tolerance; **error-aware** τ = tolerance + both faces' achieved deflections "
         "(cadclash's default); **exact-verified** error-aware, then `CollideOptions::exact_verification` and a "
-        "non-intersecting pair is kept only if its exact B-rep distance is ≤ tolerance (+" << fmt(kContactSlack)
+        "pair that is not penetrating is kept only if its exact B-rep distance is ≤ tolerance (+" << fmt(kContactSlack)
      << " mm); **occt-proximity** `BRepExtrema_ShapeProximity(tolerance)` on the same face triangulations, given the "
         "instance pairs whose boxes are within tolerance + 2 × deflection.\n\n";
   md << "Truth: `BRepExtrema_DistShapeShape` on the placed B-rep faces ≤ tolerance + " << fmt(kContactSlack)
