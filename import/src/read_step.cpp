@@ -4,6 +4,8 @@
 #include "readers.h"
 
 #include <IFSelect_ReturnStatus.hxx>
+#include <Interface_EntityIterator.hxx>
+#include <Interface_Graph.hxx>
 #include <Interface_Static.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPControl_Reader.hxx>
@@ -172,16 +174,45 @@ std::vector<Diagnostic> unit_context_problems(const std::string& path) {
 
 // When no product can be transferred (a cut-off file loses its product structure, which OCCT
 // writes last), every face entity is transferred on its own into one part named after the file.
+// The first entity `entity` refers to, directly or not, that the file reader could not read
+// whole (an error entity: missing or malformed parameters), or 0. OCCT's geometry translators
+// dereference such entities' missing fields without checking (AXIS2_PLACEMENT_3D without a
+// location crashed StepToGeom::MakeAxis2Placement), so a face reaching one is not transferred.
+Standard_Integer first_broken_reference(const Interface_Graph& graph, const Handle(StepData_StepModel)& model,
+                                        const Handle(Standard_Transient)& entity) {
+  std::vector<Handle(Standard_Transient)> stack{entity};
+  std::unordered_set<Standard_Integer> seen;
+  while (!stack.empty()) {
+    const Handle(Standard_Transient) e = stack.back();
+    stack.pop_back();
+    const Standard_Integer n = model->Number(e);
+    if (n <= 0 || !seen.insert(n).second) continue;
+    if (model->IsErrorEntity(n)) return n;
+    for (Interface_EntityIterator it = graph.Shareds(e); it.More(); it.Next()) stack.push_back(it.Value());
+  }
+  return 0;
+}
+
 void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepModel)& model, const std::string& path,
                          const ImportOptions& options, const EntityLabelFn& label, ImportResult& result) {
   TopoDS_Compound faces;
   BRep_Builder builder;
   builder.MakeCompound(faces);
   std::size_t tried = 0, made = 0;
+  const Interface_Graph graph(model);
   for (Standard_Integer i = 1; i <= model->NbEntities(); ++i) {
     const Handle(Standard_Transient) entity = model->Value(i);
     if (entity.IsNull() || !entity->IsKind(STANDARD_TYPE(StepShape_Face))) continue;
     ++tried;
+    if (const Standard_Integer broken = first_broken_reference(graph, model, entity); broken > 0) {
+      const bool itself = model->Value(broken) == entity;
+      result.diagnostics.push_back(
+          {Severity::Error, path, 0, label(entity),
+           itself ? std::string("face entity could not be read whole; dropped")
+                  : "face entity refers to #" + std::to_string(label(model->Value(broken))) +
+                        ", which could not be read whole; dropped"});
+      continue;
+    }
     try {
       step.ClearShapes();
       if (!step.TransferEntity(entity) || step.NbShapes() == 0) {

@@ -33,6 +33,11 @@ const Regression kRegressions[] = {
      "fuzz_stl: assimp's error message quoted the solid's name from the file raw, not UTF-8"},
     {"obj_self_intersecting_2000_corners.obj", "self-intersecting",
      "hand-made, fuzz_obj timeout: ear clipping a self-intersecting polygon was O(n^3)"},
+    {"step_axis_without_location.step", "face entity could not be read whole; dropped",
+     "fuzz_step: loose-face recovery transferred a face whose AXIS2_PLACEMENT_3D has no location; "
+     "OCCT dereferenced the missing point (SEGV in StepToGeom::MakeAxis2Placement)"},
+    {"step_face_on_broken_placement.step", "face entity refers to #376, which could not be read whole; dropped",
+     "variant of the above with a well-formed face: the broken placement is two references away"},
 };
 
 // Names the case by its file in test listings (instead of a byte dump).
