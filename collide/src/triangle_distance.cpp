@@ -149,6 +149,11 @@ bool plane_separates(const P3& p0, const P3& p1, const P3& p2, const P3& q0, con
   const P3 n = cross(a, b);
   const P3 pn{std::abs(a.y * b.z) + std::abs(a.z * b.y), std::abs(a.z * b.x) + std::abs(a.x * b.z),
               std::abs(a.x * b.y) + std::abs(a.y * b.x)};
+  // The error bound assumes no underflow: products of a sliver's subnormal edge with a long one,
+  // and the squares in the norms, lose their relative precision (fuzz_triangles found a segment
+  // against such a sliver at 2^37 judged 2.4e11 apart by this test with d above the distance). Such
+  // a plane cannot separate anything reliably; leave the pair to the distance computation.
+  if (std::max({pn.x, pn.y, pn.z}) < 0x1p-400) return false;
   const double n_up = (std::sqrt(norm2(n)) + 4 * u * std::sqrt(norm2(pn))) * (1 + 8 * u);
   const double limit = d * n_up;
   int sign = 0;

@@ -227,5 +227,20 @@ TEST(TrianglesWithin, AgreesWithDistance) {
   EXPECT_FALSE(triangles_within(unit[0], unit[1], unit[2], unit[0], unit[1], unit[2], -1.0, stats));
 }
 
+// fuzz_triangles: a segment (a0 == a1) against a sliver whose edge b0-b2 is a subnormal, at 2^37.
+// The plane early out of triangles_within judged them apart for d above their distance: the sliver's
+// normal underflows, and its error bound assumed it would not.
+TEST(TrianglesWithin, SubnormalSliverIsNotSeparatedByItsPlane) {
+  const Vec3 a0(-0x1p+37, -0x1p+36, -0x1p+36), a2(-0x1p+37, -0x1.8p+37, -0x1.8p+37);
+  const Vec3 b0(0.0, 0x1.2p+39, 0x1.4p+38), b1(0x1p+37, -0x1.4p+38, -0x1.8p+37),
+      b2(-0x0.0000000000003p-1022, 0x1.2p+39, 0x1.4p+38);
+  TrianglePredicateStats stats;
+  const double d = detail::triangle_distance(a0, a0, a2, b0, b1, b2, stats);
+  ASSERT_TRUE(std::isfinite(d));
+  EXPECT_TRUE(triangles_within(a0, a0, a2, b0, b1, b2, d * (1 + 0x1p-40), stats)) << d;
+  EXPECT_TRUE(triangles_within(b0, b1, b2, a0, a0, a2, d * (1 + 0x1p-40), stats)) << d;
+  EXPECT_FALSE(triangles_within(a0, a0, a2, b0, b1, b2, d * (1 - 0x1p-40), stats)) << d;
+}
+
 }  // namespace
 }  // namespace cadclash
