@@ -22,3 +22,15 @@ function(cadclash_target_warnings target)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
 endfunction()
+
+# Declares module `name`: library cadclash_<name>, alias cadclash::<name> (the export name too), its
+# public headers in <module>/include, the warning set. Sources and links stay in the module's file.
+function(cadclash_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
+  add_library(cadclash_${name} ${ARG_SOURCES})
+  add_library(cadclash::${name} ALIAS cadclash_${name})
+  set_target_properties(cadclash_${name} PROPERTIES EXPORT_NAME ${name} OUTPUT_NAME cadclash_${name})
+  target_include_directories(cadclash_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
+  cadclash_target_warnings(cadclash_${name})
+endfunction()
