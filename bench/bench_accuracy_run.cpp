@@ -21,15 +21,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-gp_Trsf to_trsf(const Pose& pose) {
-  const Eigen::Matrix3d& r = pose.linear();
-  const Vec3& t = pose.translation();
-  gp_Trsf trsf;
-  trsf.SetValues(r(0, 0), r(0, 1), r(0, 2), t.x(), r(1, 0), r(1, 1), r(1, 2), t.y(), r(2, 0), r(2, 1), r(2, 2),
-                 t.z());
-  return trsf;
-}
-
 Aabb world_box(const Model& m, InstanceId i) {
   const Instance& inst = m.instances[i];
   const Part& p = m.parts[inst.part];

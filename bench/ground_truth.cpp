@@ -25,10 +25,6 @@
 #include <utility>
 
 namespace cadclash::bench {
-namespace {
-
-// Bump when the meaning of a cached file changes.
-constexpr int kCacheVersion = 1;
 
 gp_Trsf to_trsf(const Pose& pose) {
   const Eigen::Matrix3d& r = pose.linear();
@@ -38,6 +34,11 @@ gp_Trsf to_trsf(const Pose& pose) {
                  t.z());
   return trsf;
 }
+
+namespace {
+
+// Bump when the meaning of a cached file changes.
+constexpr int kCacheVersion = 1;
 
 Aabb world_box(const Aabb& local, const Pose& pose) {
   Aabb world;

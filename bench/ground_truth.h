@@ -17,7 +17,12 @@
 #include <string>
 #include <vector>
 
+class gp_Trsf;
+
 namespace cadclash::bench {
+
+// The OCCT transformation of a pose (part-local -> world), to place B-rep shapes like instances.
+gp_Trsf to_trsf(const Pose& pose);
 
 // Exact contact is "distance <= tolerance + kContactSlack": touching faces do not measure exactly 0
 // (on as1-tu-203.stp they measure 0 or 1e-15..1e-11 mm; the next face pair is 1 mm away), and
