@@ -106,6 +106,100 @@ std::optional<std::pair<std::string, std::int64_t>> close_truncated(const std::s
   return std::make_pair(std::move(text), static_cast<std::int64_t>(line));
 }
 
+// References to entities the file does not define, replaced by '$' (unset) in a copy of the text.
+// OCCT may bind such a reference to an unrelated entity instead of leaving it null: a cut-up file
+// whose ORIENTED_EDGE named a vanished edge got itself as its edge and OCCT's own load check
+// (RWStepShape_RWEdgeLoop::Check) recursed until the stack overflowed (fuzz_step). Unset, the
+// parameter is reported by OCCT as missing and the entity is left out as for any bad parameter.
+// Returns nullopt when every reference resolves.
+struct UnsetReferences {
+  std::string text;
+  std::vector<Diagnostic> diagnostics;
+};
+std::optional<UnsetReferences> unset_undefined_references(const std::string& text, const std::string& path) {
+  const std::size_t data = text.find("DATA;");
+  if (data == std::string::npos) return std::nullopt;
+  // Pass 1: defined ids ("#N =" at the start of a statement, outside strings).
+  std::unordered_set<std::int64_t> defined;
+  auto read_id = [&](std::size_t& i) -> std::int64_t {  // text[i] == '#'; advances past the digits
+    std::int64_t id = 0;
+    std::size_t j = i + 1;
+    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50))
+      id = id * 10 + (text[j++] - '0');
+    const bool any = j > i + 1;
+    i = j;
+    return any ? id : -1;
+  };
+  bool in_string = false, statement_start = true;
+  for (std::size_t i = data + 5; i < text.size();) {
+    const char c = text[i];
+    if (in_string) {
+      in_string = c != '\'';  // '' inside a string closes and reopens it: same result
+      ++i;
+    } else if (c == '\'') {
+      in_string = true;
+      statement_start = false;
+      ++i;
+    } else if (c == '#' && statement_start) {
+      std::size_t j = i;
+      const std::int64_t id = read_id(j);
+      while (j < text.size() && std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      if (id >= 0 && j < text.size() && text[j] == '=') defined.insert(id);
+      statement_start = false;
+      i = j;
+    } else {
+      if (c == ';') statement_start = true;
+      else if (!std::isspace(static_cast<unsigned char>(c))) statement_start = false;
+      ++i;
+    }
+  }
+  // Pass 2: copy the text, unsetting references to ids not defined.
+  UnsetReferences out;
+  out.text.reserve(text.size());
+  out.text.append(text, 0, data + 5);
+  std::int64_t line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(data + 5), '\n');
+  std::int64_t current = -1;  // the entity being read
+  std::size_t unset = 0;
+  in_string = false;
+  statement_start = true;
+  for (std::size_t i = data + 5; i < text.size();) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (in_string || c == '\'') {
+      in_string = in_string ? c != '\'' : true;
+      statement_start = false;
+      out.text += c;
+      ++i;
+      continue;
+    }
+    if (c != '#') {
+      if (c == ';') statement_start = true;
+      else if (!std::isspace(static_cast<unsigned char>(c))) statement_start = false;
+      out.text += c;
+      ++i;
+      continue;
+    }
+    const std::size_t begin = i;
+    const std::int64_t id = read_id(i);
+    if (statement_start || id < 0 || defined.count(id) > 0) {
+      if (statement_start) current = id;
+      out.text.append(text, begin, i - begin);
+    } else {
+      out.text += '$';
+      if (++unset <= 20)
+        out.diagnostics.push_back({Severity::Error, path, line, current,
+                                   "reference to #" + std::to_string(id) +
+                                       " is unresolved: the file defines no such entity; read as unset"});
+    }
+    statement_start = false;
+  }
+  if (unset == 0) return std::nullopt;
+  if (unset > 20)
+    out.diagnostics.push_back({Severity::Error, path, 0, -1,
+                               std::to_string(unset - 20) + " more unresolved references, read as unset"});
+  return out;
+}
+
 // Representation contexts without a usable length unit, as diagnostics naming the context's #id.
 // OCCT knows the complex context entity only with its GLOBAL_UNIT_ASSIGNED_CONTEXT, so without one it
 // drops the entity and reports only that the representations using it have an "illegal type"
@@ -427,17 +521,38 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
         result.complete = false;
       }
     }
-    IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
     STEPControl_Reader& step = reader.ChangeReader();
-    if (status != IFSelect_RetDone) {
-      if (auto closed = close_truncated(path)) {
-        result.diagnostics.push_back({Severity::Error, path, closed->second, -1,
-                                      "STEP file is truncated (no END-ISO-10303-21); read up to its last complete entity, "
-                                      "which ends on this line"});
+    // OCCT reads a copy when references must be unset first (see unset_undefined_references).
+    auto read_text = [&](const std::string& text, bool whole_file) {
+      if (auto unset = unset_undefined_references(text, path)) {
+        result.diagnostics.insert(result.diagnostics.end(), unset->diagnostics.begin(), unset->diagnostics.end());
         result.complete = false;
-        std::istringstream stream(closed->first);
-        status = step.ReadStream(path.c_str(), stream);
+        std::istringstream stream(unset->text);
+        return step.ReadStream(path.c_str(), stream);
       }
+      if (whole_file) return reader.ReadFile(path.c_str());
+      std::istringstream stream(text);
+      return step.ReadStream(path.c_str(), stream);
+    };
+    std::string text;
+    {
+      std::ifstream in(path, std::ios::binary);
+      std::stringstream buffer;
+      buffer << in.rdbuf();
+      text = buffer.str();
+    }
+    const auto truncated = close_truncated(path);
+    IFSelect_ReturnStatus status = IFSelect_RetVoid;
+    if (!std::ifstream(path)) {
+      status = reader.ReadFile(path.c_str());  // OCCT's own message for a file it cannot open
+    } else if (truncated) {
+      result.diagnostics.push_back({Severity::Error, path, truncated->second, -1,
+                                    "STEP file is truncated (no END-ISO-10303-21); read up to its last complete entity, "
+                                    "which ends on this line"});
+      result.complete = false;
+      status = read_text(truncated->first, false);
+    } else {
+      status = read_text(text, true);
     }
     const Handle(StepData_StepModel) model = step.StepModel();
     const EntityLabelFn label = [&model](const Handle(Standard_Transient)& entity) -> std::int64_t {

@@ -38,6 +38,9 @@ const Regression kRegressions[] = {
      "OCCT dereferenced the missing point (SEGV in StepToGeom::MakeAxis2Placement)"},
     {"step_face_on_broken_placement.step", "face entity refers to #376, which could not be read whole; dropped",
      "variant of the above with a well-formed face: the broken placement is two references away"},
+    {"step_cut_oriented_edge_recursion.step", "reference to #21 is unresolved: the file defines no such entity",
+     "fuzz_step: a cut-up file whose ORIENTED_EDGE #330 names the vanished #194; OCCT bound it to an oriented "
+     "edge and its load check recursed through EdgeStart/EdgeEnd until the stack overflowed"},
 };
 
 // Names the case by its file in test listings (instead of a byte dump).
