@@ -54,11 +54,8 @@ const char* status_text(IFSelect_ReturnStatus status) {
 }
 
 // The FILE_SCHEMA names of the header and the line they are on; empty when there is none.
-std::pair<std::vector<std::string>, std::int64_t> header_schemas(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string header(64 * 1024, '\0');
-  in.read(header.data(), static_cast<std::streamsize>(header.size()));
-  header.resize(static_cast<std::size_t>(in.gcount()));
+std::pair<std::vector<std::string>, std::int64_t> header_schemas(const std::string& text) {
+  const std::string header = text.substr(0, 64 * 1024);
   const std::size_t at = header.find("FILE_SCHEMA");
   if (at == std::string::npos) return {{}, 0};
   const auto line = 1 + std::count(header.begin(), header.begin() + static_cast<std::ptrdiff_t>(at), '\n');
@@ -85,14 +82,11 @@ bool known_schema(std::string name) {
 
 // A truncated file cut back to its last complete entity and closed properly, with the line of the
 // cut; nullopt when the file is not truncated (it ends with END-ISO-10303-21).
-std::optional<std::pair<std::string, std::int64_t>> close_truncated(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
-  if (text.find("END-ISO-10303-21") != std::string::npos) return std::nullopt;
-  const std::size_t data = text.find("DATA;");
+std::optional<std::pair<std::string, std::int64_t>> close_truncated(const std::string& source) {
+  if (source.find("END-ISO-10303-21") != std::string::npos) return std::nullopt;
+  const std::size_t data = source.find("DATA;");
   if (data == std::string::npos) return std::nullopt;
+  std::string text = source;
   std::size_t cut = text.rfind(");", std::string::npos);
   while (cut != std::string::npos && cut > data) {
     const std::size_t after = cut + 2;
@@ -205,11 +199,7 @@ std::optional<UnsetReferences> unset_undefined_references(const std::string& tex
 // drops the entity and reports only that the representations using it have an "illegal type"
 // parameter (an error); with a unit list that holds no LENGTH_UNIT it says nothing and reads the
 // lengths as millimetres (a warning). Read from the text (entity id → instance text).
-std::vector<Diagnostic> unit_context_problems(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+std::vector<Diagnostic> unit_context_problems(const std::string& text, const std::string& path) {
   std::unordered_map<std::int64_t, std::string_view> entities;
   std::vector<std::int64_t> contexts;
   std::size_t i = text.find("DATA;");
@@ -512,7 +502,16 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     reader.SetMatMode(Standard_False);
     reader.SetViewMode(Standard_False);
 
-    const auto [schemas, schema_line] = header_schemas(path);
+    // One read of the text for every scan below; OCCT reads the file (or a corrected copy) itself.
+    std::string text;
+    const bool readable = static_cast<bool>(std::ifstream(path));
+    {
+      std::ifstream in(path, std::ios::binary);
+      std::stringstream buffer;
+      buffer << in.rdbuf();
+      text = buffer.str();
+    }
+    const auto [schemas, schema_line] = header_schemas(text);
     for (const std::string& schema : schemas) {
       if (!known_schema(schema)) {
         result.diagnostics.push_back({Severity::Error, path, schema_line, -1,
@@ -523,27 +522,20 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     }
     STEPControl_Reader& step = reader.ChangeReader();
     // OCCT reads a copy when references must be unset first (see unset_undefined_references).
-    auto read_text = [&](const std::string& text, bool whole_file) {
-      if (auto unset = unset_undefined_references(text, path)) {
+    auto read_text = [&](const std::string& source, bool whole_file) {
+      if (auto unset = unset_undefined_references(source, path)) {
         result.diagnostics.insert(result.diagnostics.end(), unset->diagnostics.begin(), unset->diagnostics.end());
         result.complete = false;
         std::istringstream stream(unset->text);
         return step.ReadStream(path.c_str(), stream);
       }
       if (whole_file) return reader.ReadFile(path.c_str());
-      std::istringstream stream(text);
+      std::istringstream stream(source);
       return step.ReadStream(path.c_str(), stream);
     };
-    std::string text;
-    {
-      std::ifstream in(path, std::ios::binary);
-      std::stringstream buffer;
-      buffer << in.rdbuf();
-      text = buffer.str();
-    }
-    const auto truncated = close_truncated(path);
+    const auto truncated = close_truncated(text);
     IFSelect_ReturnStatus status = IFSelect_RetVoid;
-    if (!std::ifstream(path)) {
+    if (!readable) {
       status = reader.ReadFile(path.c_str());  // OCCT's own message for a file it cannot open
     } else if (truncated) {
       result.diagnostics.push_back({Severity::Error, path, truncated->second, -1,
@@ -571,7 +563,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       return result;
     }
     if (load_fails > 0) result.complete = false;
-    for (Diagnostic& d : unit_context_problems(path)) {
+    for (Diagnostic& d : unit_context_problems(text, path)) {
       if (d.severity == Severity::Error) result.complete = false;
       result.diagnostics.push_back(std::move(d));
     }
