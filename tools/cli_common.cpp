@@ -16,6 +16,8 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_option("--preset", in.preset, "Tessellation preset (overrides --deflection/--angular)")
       ->check(CLI::IsMember({"coarse", "normal", "fine", "very-fine"}));
   cmd.add_flag("--lazy", in.lazy, "Tessellate B-rep faces only when a query needs them");
+  cmd.add_flag("--no-isolation", in.no_isolation,
+               "Read STEP/IGES/BREP in this process only (faster; a file that crashes OCCT then ends the program)");
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
   cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
@@ -39,6 +41,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
     }
   }
   options.lazy = in.lazy;
+  options.isolate_cad_readers = !in.no_isolation;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
   if (in.repair) {

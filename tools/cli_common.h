@@ -23,6 +23,7 @@ struct InputOptions {
   double angular = 0.5;
   std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
   bool lazy = false;
+  bool no_isolation = false;
   // Mesh post-processing (mesh parts only; see tessellate.h).
   bool repair = false;
   bool fill_holes = false;  // with --repair

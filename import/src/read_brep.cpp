@@ -1,5 +1,6 @@
 // OCCT's native .brep through BRepTools::Read: one part named after the file, one instance.
 #include "cad_xcaf.h"
+#include "isolated_run.h"
 #include "readers.h"
 
 #include <BRepTools.hxx>
@@ -23,10 +24,8 @@ bool has_topology_header(const std::string& path) {
   return head.find("CASCADE Topology V") != std::string::npos;
 }
 
-}  // namespace
-
-ImportResult read_brep(const std::string& path, const ImportOptions& options) {
-  prepare_occt_exchange();
+// `probe`: stop after reading the shape (see read_isolated).
+ImportResult read_brep_once(const std::string& path, const ImportOptions& options, bool probe) {
   ImportResult result;
   try {
     if (!has_topology_header(path))
@@ -37,6 +36,7 @@ ImportResult read_brep(const std::string& path, const ImportOptions& options) {
       return failed_import(path, "cannot read BREP file (not an OCCT .brep, or damaged)");
     // Triangulations stored in the file were made with unknown settings; ours follow the options.
     BRepTools::Clean(shape, Standard_True);
+    if (probe) return result;
     BrepPartInput in;
     in.shape = &shape;
     in.name = cad_file_stem(path);
@@ -54,6 +54,13 @@ ImportResult read_brep(const std::string& path, const ImportOptions& options) {
     return failed_import(path, std::string("OCCT failed while reading BREP: ") + e.GetMessageString());
   }
   return result;
+}
+
+}  // namespace
+
+ImportResult read_brep(const std::string& path, const ImportOptions& options) {
+  prepare_occt_exchange();
+  return read_isolated(path, "BREP", options, [&](bool probe) { return read_brep_once(path, options, probe); });
 }
 
 }  // namespace cadclash::detail

@@ -1,5 +1,6 @@
 // IGES through IGESCAFControl_Reader into an XCAF document.
 #include "cad_xcaf.h"
+#include "isolated_run.h"
 #include "readers.h"
 
 #include <IFSelect_ReturnStatus.hxx>
@@ -16,8 +17,10 @@
 
 namespace cadclash::detail {
 
-ImportResult read_iges(const std::string& path, const ImportOptions& options) {
-  prepare_occt_exchange();
+namespace {
+
+// `probe`: stop after the transfer (see read_isolated).
+ImportResult read_iges_once(const std::string& path, const ImportOptions& options, bool probe) {
   ImportResult result;
   Handle(TDocStd_Document) doc;
   try {
@@ -54,7 +57,7 @@ ImportResult read_iges(const std::string& path, const ImportOptions& options) {
     if (!transferred) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "IGES transfer failed; no shape could be made"});
       result.complete = false;
-    } else {
+    } else if (!probe) {
       const FaceEntityMap faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
         const Handle(IGESData_IGESEntity) iges = Handle(IGESData_IGESEntity)::DownCast(entity);
         if (iges.IsNull()) return false;
@@ -77,6 +80,13 @@ ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   } catch (const Standard_Failure&) {
   }
   return result;
+}
+
+}  // namespace
+
+ImportResult read_iges(const std::string& path, const ImportOptions& options) {
+  prepare_occt_exchange();
+  return read_isolated(path, "IGES", options, [&](bool probe) { return read_iges_once(path, options, probe); });
 }
 
 }  // namespace cadclash::detail

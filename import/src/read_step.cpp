@@ -1,5 +1,6 @@
 // STEP (AP203/AP214/AP242) through STEPCAFControl_Reader into an XCAF document.
 #include "cad_xcaf.h"
+#include "isolated_run.h"
 #include "mesh_common.h"
 #include "readers.h"
 
@@ -8,6 +9,12 @@
 #include <Interface_Graph.hxx>
 #include <Interface_Static.hxx>
 #include <STEPCAFControl_Reader.hxx>
+#include <StepShape_ConnectedFaceSet.hxx>
+#include <StepShape_HArray1OfFace.hxx>
+#include <StepShape_ShapeRepresentation.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <StepData_StepModel.hxx>
@@ -26,10 +33,12 @@
 #include <XSControl_WorkSession.hxx>
 #include <BRep_Builder.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS_Compound.hxx>
 
 #include <algorithm>
+#include <functional>
 #include <cctype>
 #include <fstream>
 #include <optional>
@@ -256,6 +265,17 @@ std::vector<Diagnostic> unit_context_problems(const std::string& text, const std
   return out;
 }
 
+using StepItems = Handle(StepRepr_HArray1OfRepresentationItem);
+
+// Whether the document holds at least one face: products without any mean the attempt gave nothing.
+bool has_faces(const Handle(TDocStd_Document)& doc) {
+  TDF_LabelSequence free;
+  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetFreeShapes(free);
+  for (Standard_Integer i = 1; i <= free.Length(); ++i)
+    if (TopExp_Explorer(XCAFDoc_ShapeTool::GetShape(free(i)), TopAbs_FACE).More()) return true;
+  return false;
+}
+
 // When no product can be transferred (a cut-off file loses its product structure, which OCCT
 // writes last), every face entity is transferred on its own into one part named after the file.
 // The first entity `entity` refers to, directly or not, that the file reader could not read
@@ -277,8 +297,27 @@ Standard_Integer first_broken_reference(const Interface_Graph& graph, const Hand
   return 0;
 }
 
+// One way through the file. The plain transfer comes first; the others exist because OCCT's
+// translators crash on some malformed entities (see read_step).
+enum class Attempt {
+  Whole,               // every product, as the file says
+  WithoutBrokenFaces,  // the same, after taking out the faces and shape items that reach broken entities
+  LooseFaces,          // no products: each face entity on its own (recover_loose_faces)
+};
+
+// Marks a child reports (isolated_run.h): the file was parsed, shapes were transferred, and the
+// transfer made at least one shape.
+constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S';
+
+struct AttemptRun {
+  Attempt attempt = Attempt::Whole;
+  bool probe = false;                          // stop after the transfer: nothing tessellated, nothing kept
+  std::function<void(char)> mark = [](char) {};
+};
+
 void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepModel)& model, const std::string& path,
-                         const ImportOptions& options, const EntityLabelFn& label, ImportResult& result) {
+                         const ImportOptions& options, const EntityLabelFn& label, const AttemptRun& run,
+                         const std::string& why, ImportResult& result) {
   TopoDS_Compound faces;
   BRep_Builder builder;
   builder.MakeCompound(faces);
@@ -311,7 +350,10 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
       result.diagnostics.push_back({Severity::Error, path, 0, label(entity), "face entity could not be made; dropped"});
     }
   }
+  run.mark(kTransferred);
   if (made == 0) return;
+  run.mark(kShapes);
+  if (run.probe) return;
   const Handle(XSControl_WorkSession) ws = step.WS();
   const FaceEntityMap tags = map_face_entities(ws->TransferReader()->TransientProcess(),
                                                [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
@@ -333,8 +375,68 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
                                   result.diagnostics, result.complete);
   result.model.instances.push_back(Instance{"/" + in.name, ids[0], Pose::Identity()});
   result.diagnostics.push_back({Severity::Error, path, 0, -1,
-                                "no product structure could be read; " + std::to_string(made) + " of " +
-                                    std::to_string(tried) + " face entities recovered as loose faces of one part"});
+                                why + "; " + std::to_string(made) + " of " + std::to_string(tried) +
+                                    " face entities recovered as loose faces of one part"});
+}
+
+// Takes out of the model, before the transfer, every face of a shell and then every item of a shape
+// representation that reaches an entity the reader could not read whole, with one error per
+// dropped entity. Used only after OCCT crashed on the file: OCCT reads many such entities well.
+// Faces first, so a solid loses only its bad faces; an item is dropped only if it still reaches one.
+void drop_broken_shapes(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
+                        ImportResult& result) {
+  std::size_t dropped = 0;
+  auto report = [&](const Handle(Standard_Transient)& entity, Standard_Integer broken, const std::string& from) {
+    if (++dropped > 40) return;
+    const bool itself = model->Value(broken) == entity;
+    result.diagnostics.push_back(
+        {Severity::Error, path, 0, label(entity),
+         (itself ? std::string("entity could not be read whole")
+                 : "entity refers to #" + std::to_string(label(model->Value(broken))) + ", which could not be read whole") +
+             "; dropped from " + from + " after OCCT crashed on the file"});
+  };
+  {
+    const Interface_Graph graph(model);
+    for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+      const Handle(StepShape_ConnectedFaceSet) shell = Handle(StepShape_ConnectedFaceSet)::DownCast(model->Value(e));
+      if (shell.IsNull() || shell->CfsFaces().IsNull()) continue;
+      const Handle(StepShape_HArray1OfFace) faces = shell->CfsFaces();
+      std::vector<Handle(StepShape_Face)> kept;
+      std::vector<std::pair<Standard_Integer, Standard_Integer>> bad;  // face index, broken entity
+      for (Standard_Integer i = faces->Lower(); i <= faces->Upper(); ++i) {
+        const Standard_Integer broken = first_broken_reference(graph, model, faces->Value(i));
+        if (broken == 0) kept.push_back(faces->Value(i));
+        else bad.emplace_back(i, broken);
+      }
+      if (bad.empty() || kept.empty()) continue;  // a shell with no good face goes with its item below
+      for (const auto& [i, broken] : bad) report(faces->Value(i), broken, "shell #" + std::to_string(label(shell)));
+      const Handle(StepShape_HArray1OfFace) shorter = new StepShape_HArray1OfFace(1, static_cast<Standard_Integer>(kept.size()));
+      for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
+      shell->SetCfsFaces(shorter);
+    }
+  }
+  const Interface_Graph graph(model);  // anew: the shells changed
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+    const Handle(StepShape_ShapeRepresentation) rep = Handle(StepShape_ShapeRepresentation)::DownCast(model->Value(e));
+    if (rep.IsNull() || rep->Items().IsNull()) continue;
+    const StepItems items = rep->Items();
+    std::vector<Handle(StepRepr_RepresentationItem)> kept;
+    for (Standard_Integer i = items->Lower(); i <= items->Upper(); ++i) {
+      const Standard_Integer broken = first_broken_reference(graph, model, items->Value(i));
+      if (broken == 0) kept.push_back(items->Value(i));
+      else report(items->Value(i), broken, "shape representation #" + std::to_string(label(rep)));
+    }
+    if (kept.size() == static_cast<std::size_t>(items->Length())) continue;
+    StepItems shorter;
+    if (!kept.empty()) {
+      shorter = new StepRepr_HArray1OfRepresentationItem(1, static_cast<Standard_Integer>(kept.size()));
+      for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
+    }
+    rep->SetItems(shorter);
+  }
+  if (dropped > 40)
+    result.diagnostics.push_back({Severity::Error, path, 0, -1, std::to_string(dropped - 40) + " more entities dropped"});
+  if (dropped > 0) result.complete = false;
 }
 
 // Closes the XCAF document on every path out (the shapes we keep hold their own handles).
@@ -352,8 +454,6 @@ struct DocumentGuard {
 // level, so a long (or cyclic) chain of MAPPED_ITEMs overflows the stack. Before the transfer, every
 // MAPPED_ITEM that heads a chain deeper than this is taken out of the representations that hold it.
 constexpr int kMaxMappedItemNesting = 64;
-
-using StepItems = Handle(StepRepr_HArray1OfRepresentationItem);
 
 // Mapped items held directly by the representation that `item` maps.
 std::vector<const StepRepr_MappedItem*> mapped_children(const StepRepr_MappedItem* item) {
@@ -486,9 +586,7 @@ void report_assembly_cycles(const Handle(StepData_StepModel)& model, const Entit
   }
 }
 
-}  // namespace
-
-ImportResult read_step(const std::string& path, const ImportOptions& options) {
+ImportResult read_step_attempt(const std::string& path, const ImportOptions& options, const AttemptRun& run) {
   prepare_occt_exchange();
   ImportResult result;
   try {
@@ -562,6 +660,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       result.complete = false;
       return result;
     }
+    run.mark(kParsed);
     if (load_fails > 0) result.complete = false;
     for (Diagnostic& d : unit_context_problems(text, path)) {
       if (d.severity == Severity::Error) result.complete = false;
@@ -572,9 +671,13 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       result.complete = false;
       return result;
     }
+    if (run.attempt == Attempt::LooseFaces) {
+      recover_loose_faces(step, model, path, options, label, run, "the products could not be transferred", result);
+      return result;
+    }
     if (reader.NbRootsForTransfer() == 0) {
-      recover_loose_faces(step, model, path, options, label, result);
-      if (!result.model.instances.empty()) return result;
+      recover_loose_faces(step, model, path, options, label, run, "no product structure could be read", result);
+      if (!result.model.instances.empty() || run.probe) return result;
       result.diagnostics.push_back({Severity::Error, path, 0, -1,
                                     "STEP file holds no shape to transfer (no product with a shape representation "
                                     "that this reader's schema knows)"});
@@ -582,6 +685,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       return result;
     }
 
+    if (run.attempt == Attempt::WithoutBrokenFaces) drop_broken_shapes(model, label, path, result);
     cut_deep_mapped_items(model, label, path, result);
     report_assembly_cycles(model, label, path, result);
 
@@ -593,11 +697,14 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     if (!process.IsNull() &&
         append_checks(process->CheckList(Standard_True), model, label, path, "STEP transfer", false, result.diagnostics) > 0)
       result.complete = false;
+    run.mark(kTransferred);
     if (!transferred) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP transfer failed; no shape could be made"});
       result.complete = false;
       return result;
     }
+    if (has_faces(guard.doc)) run.mark(kShapes);
+    if (run.probe) return result;
 
     const FaceEntityMap faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
       if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
@@ -616,6 +723,54 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     result.complete = false;
   }
   return result;
+}
+
+}  // namespace
+
+// OCCT's translators dereference the missing parameters of malformed entities (StepToGeom::MakeLine
+// on a LINE whose point was cut off), so each attempt first runs in a child process; a crash there
+// costs the attempt, not the caller's process. An attempt the child finished is run here again,
+// which reads and transfers the file twice: the price of never crashing on a bad file.
+ImportResult read_step(const std::string& path, const ImportOptions& options) {
+  prepare_occt_exchange();
+  if (!options.isolate_cad_readers) return read_step_attempt(path, options, {});
+  std::vector<Diagnostic> crashes;
+  auto finish = [&](ImportResult result) {
+    if (!crashes.empty()) result.complete = false;
+    result.diagnostics.insert(result.diagnostics.begin(), crashes.begin(), crashes.end());
+    return result;
+  };
+  for (const Attempt attempt : {Attempt::Whole, Attempt::WithoutBrokenFaces, Attempt::LooseFaces}) {
+    const ChildRun child = run_in_child([&](const std::function<void(char)>& mark) {
+      read_step_attempt(path, options, {attempt, true, mark});
+    });
+    if (!child.isolated) {
+      crashes.push_back({Severity::Warning, path, 0, -1, "could not start an isolated reader (" + child.how +
+                                                             "); read in this process, unprotected from OCCT crashes"});
+      return finish(read_step_attempt(path, options, {attempt, false}));
+    }
+    const bool shapes = child.marks.find(kShapes) != std::string::npos;
+    if (!child.crashed && (shapes || attempt != Attempt::WithoutBrokenFaces))
+      return finish(read_step_attempt(path, options, {attempt, false}));
+    if (!child.crashed) {  // nothing left after the drops: the loose faces may still give some
+      crashes.push_back({Severity::Error, path, 0, -1,
+                         "without the faces that reach entities OCCT could not read whole, no face was left; read again as loose faces"});
+      continue;
+    }
+    const bool parsed = child.marks.find(kParsed) != std::string::npos;
+    const char* stage = !parsed ? "parsing the file"
+                        : attempt == Attempt::LooseFaces ? "transferring its faces one by one"
+                        : attempt == Attempt::Whole ? "transferring its shapes"
+                                                    : "transferring its shapes without the broken faces";
+    const char* next = !parsed ? "nothing could be read"
+                       : attempt == Attempt::Whole ? "read again without the faces that reach entities it could not read whole"
+                       : attempt == Attempt::WithoutBrokenFaces ? "read again as loose faces"
+                                                                : "nothing could be read";
+    crashes.push_back({Severity::Error, path, 0, -1,
+                       std::string("OCCT crashed with ") + child.how + " while " + stage + " (in an isolated reader); " + next});
+    if (!parsed) break;
+  }
+  return finish(failed_import(path, "no shape could be read from the STEP file"));
 }
 
 }  // namespace cadclash::detail

@@ -32,6 +32,7 @@ struct LoadArgs {
   bool segment = false;
   double sharp_angle = 60.0;
   bool planar = false;
+  bool isolate = true;
 };
 
 // Same steps and defaults as the CLI's import_inputs(), without printing: (diagnostics, complete).
@@ -53,6 +54,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
     options.tessellation.relative = false;
   }
   options.lazy = a.lazy;
+  options.isolate_cad_readers = a.isolate;
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;
@@ -137,13 +139,13 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar) {
+             bool planar, bool isolate) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
-                               fill_holes, segment, sharp_angle, planar});
+                               fill_holes, segment, sharp_angle, planar, isolate});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
-          pyb::arg("planar"))
+          pyb::arg("planar"), pyb::arg("isolate"))
       .def_property_readonly("_query_deflection", [](const ModelCore& c) { return c.state->query_deflection; })
       .def("_counts",
            [](const ModelCore& c) {

@@ -41,6 +41,9 @@ const Regression kRegressions[] = {
     {"step_cut_oriented_edge_recursion.step", "reference to #21 is unresolved: the file defines no such entity",
      "fuzz_step: a cut-up file whose ORIENTED_EDGE #330 names the vanished #194; OCCT bound it to an oriented "
      "edge and its load check recursed through EdgeStart/EdgeEnd until the stack overflowed"},
+    {"step_truncated_line_without_point.step", "OCCT crashed with SIGSEGV",
+     "fuzz_step: a cut-off file whose LINE #198 lost its point; the product transfer reached it and "
+     "StepToGeom::MakeLine dereferenced the missing point (SEGV). Now contained by the isolated reader"},
 };
 
 // Names the case by its file in test listings (instead of a byte dump).
@@ -76,6 +79,22 @@ std::string case_name(const ::testing::TestParamInfo<Regression>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, FuzzRegression, ::testing::ValuesIn(kRegressions), case_name);
+
+// The crash is contained and the file is then read as far as it can be: of its box's six faces, two
+// were cut off, three reach the broken entities, and the remaining one (#17) is kept with its #id.
+TEST(FuzzRegressionStepCrash, GoodFaceIsKeptAfterTheContainedCrash) {
+  const std::string path = std::string(CADCLASH_DATA_DIR) + "/fuzz-regressions/step_truncated_line_without_point.step";
+  const ImportResult r = import_file(path);
+  EXPECT_FALSE(r.complete);
+  ASSERT_EQ(r.model.surfaces.size(), 1u);
+  EXPECT_EQ(r.model.surfaces[0].provenance.step_id, 17);
+  EXPECT_FALSE(r.model.surfaces[0].mesh.triangles.empty());
+  std::string all;
+  for (const Diagnostic& d : r.diagnostics) all += format_diagnostic(d) + "\n";
+  for (const char* dropped : {"#137: error: face entity refers to #198", "#237: error: face entity refers to #242",
+                              "#284: error: face entity refers to #286", "1 of 4 face entities recovered"})
+    EXPECT_NE(all.find(dropped), std::string::npos) << dropped << " not in:\n" << all;
+}
 
 // The polygon case at a size where the old O(n^3) clipping would run for hours, so a regression
 // hits CTest's timeout instead of passing slowly: 20000 corners in random order in z = 0 (a fixed

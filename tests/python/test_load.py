@@ -93,6 +93,15 @@ def test_step_diagnostic_carries_step_id(data_dir):
     assert any(d.step_id == 449 and "dangling_ref.step: #449: error" in str(d) for d in diagnostics)
 
 
+def test_step_that_crashes_occt_is_contained(data_dir):
+    # OCCT's transfer dereferences the LINE whose point was cut off (SIGSEGV): read in a child, the
+    # crash is an error and the one good face is kept. Without isolation this test would kill Python.
+    model = cadclash.load(data_dir / "fuzz-regressions" / "step_truncated_line_without_point.step")
+    assert not model.complete
+    assert any("OCCT crashed with SIGSEGV" in d.message for d in model.diagnostics)
+    assert [s.step_id for s in model.surfaces] == [17]
+
+
 def test_bad_arguments(boxes):
     with pytest.raises(ValueError, match="preset"):
         cadclash.load(boxes, preset="ultra")

@@ -1,0 +1,116 @@
+// fork + pipe + waitpid: a child that dies leaves this process untouched.
+#include "isolated_run.h"
+#include "readers.h"
+
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace cadclash::detail {
+namespace {
+
+// Written last by a child whose work returned. Without it the child did not finish, whatever
+// waitpid says (a host that ignores SIGCHLD has its children reaped before we can ask).
+constexpr char kFinished = '\0';
+
+std::string signal_text(int sig) {
+  const char* name = sig == SIGSEGV ? "SIGSEGV" : sig == SIGBUS ? "SIGBUS" : sig == SIGFPE ? "SIGFPE"
+                   : sig == SIGILL ? "SIGILL" : sig == SIGABRT ? "SIGABRT" : sig == SIGKILL ? "SIGKILL" : nullptr;
+  const char* what = strsignal(sig);
+  std::string out = name ? name : "signal " + std::to_string(sig);
+  if (what != nullptr) out += std::string(" (") + what + ")";
+  return out;
+}
+
+// The child dies of its signal without the handlers the parent installed (a sanitizer's or a
+// fuzzer's would report the crash as the whole program's and write artifacts for it).
+void default_crash_handlers() {
+  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+}
+
+}  // namespace
+
+ChildRun run_in_child(const std::function<void(const std::function<void(char)>& mark)>& work) {
+  static std::mutex one_at_a_time;
+  const std::lock_guard<std::mutex> lock(one_at_a_time);
+  ChildRun run;
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) {
+    run.isolated = false;
+    run.how = std::string("pipe: ") + std::strerror(errno);
+    return run;
+  }
+  const pid_t pid = fork();
+  if (pid < 0) {
+    run.isolated = false;
+    run.how = std::string("fork: ") + std::strerror(errno);
+    close(fds[0]);
+    close(fds[1]);
+    return run;
+  }
+  if (pid == 0) {
+    close(fds[0]);
+    default_crash_handlers();
+    if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
+    const int out = fds[1];
+    try {
+      work([out](char c) { (void)!write(out, &c, 1); });
+    } catch (...) {
+      // An exception (bad_alloc, ...) is the parent's to meet again; it is not a crash.
+    }
+    (void)!write(out, &kFinished, 1);
+    _exit(0);  // no atexit handlers or static destructors: they belong to the parent
+  }
+  close(fds[1]);
+  char buffer[64];
+  for (;;) {
+    const ssize_t n = read(fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      run.marks.append(buffer, static_cast<std::size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  close(fds[0]);
+  const bool finished = !run.marks.empty() && run.marks.back() == kFinished;
+  if (finished) run.marks.pop_back();
+  int status = 0;
+  pid_t waited = -1;
+  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  }
+  if (waited == pid && WIFSIGNALED(status)) {
+    run.crashed = true;
+    run.how = signal_text(WTERMSIG(status));
+  } else if (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0) {
+    run.crashed = true;  // a sanitizer's report ends the child with exit status 1
+    run.how = "exit status " + std::to_string(WEXITSTATUS(status));
+  } else if (!finished) {
+    run.crashed = true;
+    run.how = "it ended before finishing";
+  }
+  return run;
+}
+
+ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
+                           const std::function<ImportResult(bool probe)>& read) {
+  if (!options.isolate_cad_readers) return read(false);
+  const ChildRun child = run_in_child([&](const std::function<void(char)>&) { read(true); });
+  if (!child.isolated) {
+    ImportResult result = read(false);
+    result.diagnostics.insert(result.diagnostics.begin(),
+                              {Severity::Warning, path, 0, -1, "could not start an isolated reader (" + child.how +
+                                                                   "); read in this process, unprotected from OCCT crashes"});
+    return result;
+  }
+  if (!child.crashed) return read(false);
+  return failed_import(path, std::string("OCCT crashed with ") + child.how + " while reading the " + format +
+                                 " file (in an isolated reader); nothing could be read");
+}
+
+}  // namespace cadclash::detail
