@@ -36,7 +36,7 @@ void default_crash_handlers() {
 
 }  // namespace
 
-ChildRun run_in_child(const std::function<void(const std::function<void(char)>& mark)>& work) {
+ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) {
   static std::mutex one_at_a_time;
   const std::lock_guard<std::mutex> lock(one_at_a_time);
   ChildRun run;
@@ -59,12 +59,18 @@ ChildRun run_in_child(const std::function<void(const std::function<void(char)>& 
     default_crash_handlers();
     if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
     const int out = fds[1];
+    std::string payload;
     try {
-      work([out](char c) { (void)!write(out, &c, 1); });
+      payload = work([out](char c) { (void)!write(out, &c, 1); });
     } catch (...) {
       // An exception (bad_alloc, ...) is the parent's to meet again; it is not a crash.
     }
     (void)!write(out, &kFinished, 1);
+    for (std::size_t at = 0; at < payload.size();) {
+      const ssize_t n = write(out, payload.data() + at, payload.size() - at);
+      if (n > 0) at += static_cast<std::size_t>(n);
+      else if (errno != EINTR) break;
+    }
     _exit(0);  // no atexit handlers or static destructors: they belong to the parent
   }
   close(fds[1]);
@@ -78,8 +84,12 @@ ChildRun run_in_child(const std::function<void(const std::function<void(char)>& 
     }
   }
   close(fds[0]);
-  const bool finished = !run.marks.empty() && run.marks.back() == kFinished;
-  if (finished) run.marks.pop_back();
+  const std::size_t end = run.marks.find(kFinished);
+  const bool finished = end != std::string::npos;
+  if (finished) {
+    run.payload = run.marks.substr(end + 1);
+    run.marks.resize(end);
+  }
   int status = 0;
   pid_t waited = -1;
   while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
@@ -100,7 +110,10 @@ ChildRun run_in_child(const std::function<void(const std::function<void(char)>& 
 ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
                            const std::function<ImportResult(bool probe)>& read) {
   if (!options.isolate_cad_readers) return read(false);
-  const ChildRun child = run_in_child([&](const std::function<void(char)>&) { read(true); });
+  const ChildRun child = run_in_child([&](const Mark&) {
+    read(true);
+    return std::string();
+  });
   if (!child.isolated) {
     ImportResult result = read(false);
     result.diagnostics.insert(result.diagnostics.begin(),

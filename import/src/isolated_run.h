@@ -1,8 +1,8 @@
 // Runs OCCT's file translators in a forked child before trusting them in this process.
 // OCCT's STEP/IGES translators dereference parameters of malformed entities without checking
 // (StepToGeom::MakeLine on a LINE whose point was cut off), so a bad file can end the process with
-// SIGSEGV instead of a check-list message. A crash in a child becomes an error naming the file;
-// only a run that the child finished is repeated here. Internal to cadclash::import.
+// SIGSEGV instead of a check-list message. A crash in a child becomes an error naming the file; a
+// child that finished sends back what it made (cad_transfer.h). Internal to cadclash::import.
 #pragma once
 
 #include "cadclash/import.h"
@@ -18,15 +18,19 @@ struct ChildRun {
   bool crashed = false;   // the child ended by a signal or a non-zero exit
   std::string how;        // "SIGSEGV (segmentation fault)", "exit status 1", or why no child started
   std::string marks;      // the progress marks the child reported, in order (see `work` below)
+  std::string payload;    // what `work` returned, when the child finished
 };
 
+using Mark = std::function<void(char)>;
+
 // Calls `work(mark)` in a forked child and waits for it. `work` calls `mark(c)` as it passes each
-// stage, so a crash can be placed (marks are any char but '\0'); only that `work` returned matters.
+// stage, so a crash can be placed (marks are any char but '\0'); what it returns comes back as
+// `payload`.
 // Preconditions:
 // - `work` uses no OpenMP and starts no threads (a forked child has only the calling thread);
 // - `work` writes nothing to stdout (the child's stdout is /dev/null).
 // Process-wide, one child runs at a time.
-ChildRun run_in_child(const std::function<void(const std::function<void(char)>& mark)>& work);
+ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work);
 
 // For readers with a single way through the file: runs `read(true)` (a probe: stop before
 // tessellating) in a child, then `read(false)` here if the child finished, else returns an error

@@ -1,6 +1,6 @@
 // IGES through IGESCAFControl_Reader into an XCAF document.
 #include "cad_xcaf.h"
-#include "isolated_run.h"
+#include "cad_transfer.h"
 #include "readers.h"
 
 #include <IFSelect_ReturnStatus.hxx>
@@ -19,10 +19,10 @@ namespace cadclash::detail {
 
 namespace {
 
-// `probe`: stop after the transfer (see read_isolated).
-ImportResult read_iges_once(const std::string& path, const ImportOptions& options, bool probe) {
-  ImportResult result;
-  Handle(TDocStd_Document) doc;
+// Reads and transfers the file, tessellating nothing.
+Transfer read_iges_transfer(const std::string& path) {
+  Transfer result;
+  result.kind = SourceKind::IgesFace;
   try {
     IGESCAFControl_Reader reader;  // registers the IGES controller and its parameters
     Interface_Static::SetCVal("xstep.cascade.unit", "MM");
@@ -47,8 +47,8 @@ ImportResult read_iges_once(const std::string& path, const ImportOptions& option
       result.complete = false;
       return result;
     }
-    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-    const bool transferred = reader.Transfer(doc) == Standard_True;
+    result.doc = new_xcaf_document();
+    const bool transferred = reader.Transfer(result.doc) == Standard_True;
     const Handle(Transfer_TransientProcess) process =
         ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
     if (!process.IsNull() &&
@@ -57,36 +57,37 @@ ImportResult read_iges_once(const std::string& path, const ImportOptions& option
     if (!transferred) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "IGES transfer failed; no shape could be made"});
       result.complete = false;
-    } else if (!probe) {
-      const FaceEntityMap faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
+      result.discard_shapes();
+    } else {
+      result.faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
         const Handle(IGESData_IGESEntity) iges = Handle(IGESData_IGESEntity)::DownCast(entity);
         if (iges.IsNull()) return false;
         out.id = label(entity);
         if (iges->HasName() && !iges->NameValue().IsNull()) out.name = iges->NameValue()->ToCString();
         return true;
       });
-      add_xcaf_document(doc, path, SourceKind::IgesFace, faces, options, result);
-      if (result.model.instances.empty()) {
-        result.diagnostics.push_back({Severity::Error, path, 0, -1, "IGES file produced no shape"});
-        result.complete = false;
-      }
     }
   } catch (const Standard_Failure& e) {
     result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string("OCCT failed while reading IGES: ") + e.GetMessageString()});
     result.complete = false;
-  }
-  try {
-    if (!doc.IsNull() && doc->IsOpened()) XCAFApp_Application::GetApplication()->Close(doc);
-  } catch (const Standard_Failure&) {
+    result.discard_shapes();  // a transfer cut short keeps nothing
   }
   return result;
 }
 
 }  // namespace
 
+// OCCT's translators may crash on a malformed file (read_step says more): the transfer runs in a
+// child process, which sends the document back.
 ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  return read_isolated(path, "IGES", options, [&](bool probe) { return read_iges_once(path, options, probe); });
+  if (!options.isolate_cad_readers) return finish_transfer(read_iges_transfer(path), path, options);
+  IsolatedTransfer run = transfer_in_child(path, [&](const Mark&) { return read_iges_transfer(path); });
+  if (run.child.crashed)
+    return failed_import(path, "OCCT crashed with " + run.child.how + " while reading the IGES file (in an isolated reader); nothing could be read");
+  ImportResult result = finish_transfer(std::move(run.transfer), path, options);
+  if (run.warning) result.diagnostics.insert(result.diagnostics.begin(), *run.warning);
+  return result;
 }
 
 }  // namespace cadclash::detail

@@ -1,4 +1,5 @@
 // STEP (AP203/AP214/AP242) through STEPCAFControl_Reader into an XCAF document.
+#include "cad_transfer.h"
 #include "cad_xcaf.h"
 #include "isolated_run.h"
 #include "mesh_common.h"
@@ -311,13 +312,11 @@ constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S';
 
 struct AttemptRun {
   Attempt attempt = Attempt::Whole;
-  bool probe = false;                          // stop after the transfer: nothing tessellated, nothing kept
-  std::function<void(char)> mark = [](char) {};
+  Mark mark = [](char) {};
 };
 
 void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepModel)& model, const std::string& path,
-                         const ImportOptions& options, const EntityLabelFn& label, const AttemptRun& run,
-                         const std::string& why, ImportResult& result) {
+                         const EntityLabelFn& label, const AttemptRun& run, const std::string& why, Transfer& result) {
   TopoDS_Compound faces;
   BRep_Builder builder;
   builder.MakeCompound(faces);
@@ -353,7 +352,6 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
   run.mark(kTransferred);
   if (made == 0) return;
   run.mark(kShapes);
-  if (run.probe) return;
   const Handle(XSControl_WorkSession) ws = step.WS();
   const FaceEntityMap tags = map_face_entities(ws->TransferReader()->TransientProcess(),
                                                [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
@@ -361,22 +359,15 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
                                                  out.id = label(entity);
                                                  return true;
                                                });
-  BrepPartInput in;
-  in.shape = &faces;
-  in.name = cad_file_stem(path);
-  in.source_file = path;
-  in.kind = SourceKind::StepFace;
   TopTools_IndexedMapOfShape map;
   TopExp::MapShapes(faces, TopAbs_FACE, map);
-  in.tags.resize(static_cast<std::size_t>(map.Extent()));
+  result.loose = faces;
+  result.loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
   for (Standard_Integer f = 1; f <= map.Extent(); ++f)
-    if (auto it = tags.find(map(f).TShape().get()); it != tags.end()) in.tags[static_cast<std::size_t>(f - 1)].entity_id = it->second.id;
-  const auto ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation, options.lazy,
-                                  result.diagnostics, result.complete);
-  result.model.instances.push_back(Instance{"/" + in.name, ids[0], Pose::Identity()});
-  result.diagnostics.push_back({Severity::Error, path, 0, -1,
-                                why + "; " + std::to_string(made) + " of " + std::to_string(tried) +
-                                    " face entities recovered as loose faces of one part"});
+    if (auto it = tags.find(map(f).TShape().get()); it != tags.end()) result.loose_ids[static_cast<std::size_t>(f - 1)] = it->second.id;
+  result.loose_note = why + "; " + std::to_string(made) + " of " + std::to_string(tried) +
+                      " face entities recovered as loose faces of one part";
+  result.complete = false;
 }
 
 // Takes out of the model, before the transfer, every face of a shell and then every item of a shape
@@ -384,7 +375,7 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
 // dropped entity. Used only after OCCT crashed on the file: OCCT reads many such entities well.
 // Faces first, so a solid loses only its bad faces; an item is dropped only if it still reaches one.
 void drop_broken_shapes(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
-                        ImportResult& result) {
+                        Transfer& result) {
   std::size_t dropped = 0;
   auto report = [&](const Handle(Standard_Transient)& entity, Standard_Integer broken, const std::string& from) {
     if (++dropped > 40) return;
@@ -439,17 +430,6 @@ void drop_broken_shapes(const Handle(StepData_StepModel)& model, const EntityLab
   if (dropped > 0) result.complete = false;
 }
 
-// Closes the XCAF document on every path out (the shapes we keep hold their own handles).
-struct DocumentGuard {
-  Handle(TDocStd_Document) doc;
-  ~DocumentGuard() {
-    try {
-      if (!doc.IsNull() && doc->IsOpened()) XCAFApp_Application::GetApplication()->Close(doc);
-    } catch (const Standard_Failure&) {
-    }
-  }
-};
-
 // OCCT transfers a MAPPED_ITEM by recursing into the representation it maps, three stack frames per
 // level, so a long (or cyclic) chain of MAPPED_ITEMs overflows the stack. Before the transfer, every
 // MAPPED_ITEM that heads a chain deeper than this is taken out of the representations that hold it.
@@ -468,7 +448,7 @@ std::vector<const StepRepr_MappedItem*> mapped_children(const StepRepr_MappedIte
 }
 
 void cut_deep_mapped_items(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
-                           ImportResult& result) {
+                           Transfer& result) {
   // Height of each mapped item (longest chain of mapped items below and including it), found without
   // recursion; an item met again while still open lies on a cycle and counts as infinitely deep.
   constexpr int kCycle = 1 << 30;
@@ -545,7 +525,7 @@ void cut_deep_mapped_items(const Handle(StepData_StepModel)& model, const Entity
 // the products on the cycle and every root that reaches it without a word, so name each usage that
 // closes a cycle (found by an iterative depth-first walk, in file order, so the report is stable).
 void report_assembly_cycles(const Handle(StepData_StepModel)& model, const EntityLabelFn& label, const std::string& path,
-                            ImportResult& result) {
+                            Transfer& result) {
   using Pd = const StepBasic_ProductDefinition*;
   std::unordered_map<Pd, std::vector<std::pair<Pd, Standard_Integer>>> children;  // child, usage entity
   std::vector<Pd> parents;
@@ -586,9 +566,10 @@ void report_assembly_cycles(const Handle(StepData_StepModel)& model, const Entit
   }
 }
 
-ImportResult read_step_attempt(const std::string& path, const ImportOptions& options, const AttemptRun& run) {
+// Reads and transfers the file one way (`run.attempt`), tessellating nothing.
+Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
   prepare_occt_exchange();
-  ImportResult result;
+  Transfer result;
   try {
     STEPCAFControl_Reader reader;  // its constructor registers the STEP controller and its parameters
     Interface_Static::SetCVal("xstep.cascade.unit", "MM");
@@ -672,12 +653,12 @@ ImportResult read_step_attempt(const std::string& path, const ImportOptions& opt
       return result;
     }
     if (run.attempt == Attempt::LooseFaces) {
-      recover_loose_faces(step, model, path, options, label, run, "the products could not be transferred", result);
+      recover_loose_faces(step, model, path, label, run, "the products could not be transferred", result);
       return result;
     }
     if (reader.NbRootsForTransfer() == 0) {
-      recover_loose_faces(step, model, path, options, label, run, "no product structure could be read", result);
-      if (!result.model.instances.empty() || run.probe) return result;
+      recover_loose_faces(step, model, path, label, run, "no product structure could be read", result);
+      if (!result.loose.IsNull()) return result;
       result.diagnostics.push_back({Severity::Error, path, 0, -1,
                                     "STEP file holds no shape to transfer (no product with a shape representation "
                                     "that this reader's schema knows)"});
@@ -689,9 +670,8 @@ ImportResult read_step_attempt(const std::string& path, const ImportOptions& opt
     cut_deep_mapped_items(model, label, path, result);
     report_assembly_cycles(model, label, path, result);
 
-    DocumentGuard guard;
-    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", guard.doc);
-    const bool transferred = reader.Transfer(guard.doc) == Standard_True;
+    result.doc = new_xcaf_document();
+    const bool transferred = reader.Transfer(result.doc) == Standard_True;
     const Handle(Transfer_TransientProcess) process =
         ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
     if (!process.IsNull() &&
@@ -701,26 +681,21 @@ ImportResult read_step_attempt(const std::string& path, const ImportOptions& opt
     if (!transferred) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP transfer failed; no shape could be made"});
       result.complete = false;
+      result.discard_shapes();
       return result;
     }
-    if (has_faces(guard.doc)) run.mark(kShapes);
-    if (run.probe) return result;
-
-    const FaceEntityMap faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
+    if (has_faces(result.doc)) run.mark(kShapes);
+    result.faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
       if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
       out.id = label(entity);
       const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
       if (!item.IsNull() && !item->Name().IsNull()) out.name = item->Name()->ToCString();
       return true;
     });
-    add_xcaf_document(guard.doc, path, SourceKind::StepFace, faces, options, result);
-    if (result.model.instances.empty()) {
-      result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP file produced no shape"});
-      result.complete = false;
-    }
   } catch (const Standard_Failure& e) {
     result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string("OCCT failed while reading STEP: ") + e.GetMessageString()});
     result.complete = false;
+    result.discard_shapes();  // a transfer cut short keeps nothing
   }
   return result;
 }
@@ -728,30 +703,28 @@ ImportResult read_step_attempt(const std::string& path, const ImportOptions& opt
 }  // namespace
 
 // OCCT's translators dereference the missing parameters of malformed entities (StepToGeom::MakeLine
-// on a LINE whose point was cut off), so each attempt first runs in a child process; a crash there
-// costs the attempt, not the caller's process. An attempt the child finished is run here again,
-// which reads and transfers the file twice: the price of never crashing on a bad file.
+// on a LINE whose point was cut off), so each attempt runs in a child process, which sends back the
+// transferred document (cad_transfer.h): a crash there costs the attempt, not the caller's process,
+// and this process never runs OCCT's STEP code on the file.
 ImportResult read_step(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  if (!options.isolate_cad_readers) return read_step_attempt(path, options, {});
+  if (!options.isolate_cad_readers) return finish_transfer(read_step_attempt(path, {}), path, options);
   std::vector<Diagnostic> crashes;
   auto finish = [&](ImportResult result) {
-    if (!crashes.empty()) result.complete = false;
+    for (const Diagnostic& d : crashes) result.complete = result.complete && d.severity != Severity::Error;
     result.diagnostics.insert(result.diagnostics.begin(), crashes.begin(), crashes.end());
     return result;
   };
   for (const Attempt attempt : {Attempt::Whole, Attempt::WithoutBrokenFaces, Attempt::LooseFaces}) {
-    const ChildRun child = run_in_child([&](const std::function<void(char)>& mark) {
-      read_step_attempt(path, options, {attempt, true, mark});
-    });
-    if (!child.isolated) {
-      crashes.push_back({Severity::Warning, path, 0, -1, "could not start an isolated reader (" + child.how +
-                                                             "); read in this process, unprotected from OCCT crashes"});
-      return finish(read_step_attempt(path, options, {attempt, false}));
+    IsolatedTransfer run = transfer_in_child(path, [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark}); });
+    const ChildRun& child = run.child;
+    if (run.warning) {
+      crashes.push_back(*run.warning);
+      return finish(finish_transfer(std::move(run.transfer), path, options));
     }
     const bool shapes = child.marks.find(kShapes) != std::string::npos;
     if (!child.crashed && (shapes || attempt != Attempt::WithoutBrokenFaces))
-      return finish(read_step_attempt(path, options, {attempt, false}));
+      return finish(finish_transfer(std::move(run.transfer), path, options));
     if (!child.crashed) {  // nothing left after the drops: the loose faces may still give some
       crashes.push_back({Severity::Error, path, 0, -1,
                          "without the faces that reach entities OCCT could not read whole, no face was left; read again as loose faces"});

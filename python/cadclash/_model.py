@@ -247,9 +247,9 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     each part's size with ``relative``), ``angular`` (radians), ``preset`` ("coarse", "normal",
     "fine", "very-fine"; overrides deflection and angular), ``lazy`` (B-rep faces get triangles only
     when a query or an array access needs them), ``repair`` / ``fill_holes`` and ``segment`` /
-    ``sharp_angle`` / ``planar`` for mesh parts. ``isolate`` reads STEP/IGES/BREP first in a forked
-    child, so a file that crashes OCCT gives an ``InputError`` instead of ending Python (about twice
-    the read time; ``--no-isolation`` of the CLI is ``isolate=False``). Several files form one scene;
+    ``sharp_angle`` / ``planar`` for mesh parts. ``isolate`` reads STEP/IGES/BREP in a forked child
+    process, so a file that crashes OCCT gives an error diagnostic (and the faces that could still be
+    read) instead of ending Python; ``isolate=False`` is the CLI's ``--no-isolation``. Several files form one scene;
     each file's instance paths are then prefixed with "/<file name>".
 
     Returns the model with ``diagnostics`` and ``complete`` set: a partly bad file keeps its good

@@ -12,32 +12,37 @@ namespace cadclash::detail {
 namespace {
 
 TEST(IsolatedRun, FinishedChildReportsItsMarks) {
-  const ChildRun run = run_in_child([](const std::function<void(char)>& mark) {
+  const std::string big(1 << 20, 'x');  // more than a pipe holds: the parent must read while the child writes
+  const ChildRun run = run_in_child([&](const Mark& mark) {
     mark('P');
     mark('T');
+    return big + '\0' + "end";
   });
   EXPECT_TRUE(run.isolated);
   EXPECT_FALSE(run.crashed) << run.how;
   EXPECT_EQ(run.marks, "PT");
+  EXPECT_EQ(run.payload, big + '\0' + "end");
 }
 
 TEST(IsolatedRun, SegfaultIsContainedAndNamed) {
-  const ChildRun run = run_in_child([](const std::function<void(char)>& mark) {
+  const ChildRun run = run_in_child([](const Mark& mark) {
     mark('P');
     volatile int* null = nullptr;
     *null = 1;  // what OCCT's translators do with a missing parameter
     mark('T');
+    return std::string("never");
   });
   EXPECT_TRUE(run.crashed);
   EXPECT_EQ(run.how.rfind("SIGSEGV", 0), 0u) << run.how;
   EXPECT_EQ(run.marks, "P");
+  EXPECT_EQ(run.payload, "");
 }
 
 TEST(IsolatedRun, AbortAndNonZeroExitAreCrashes) {
-  const ChildRun aborted = run_in_child([](const std::function<void(char)>&) { std::abort(); });
+  const ChildRun aborted = run_in_child([](const Mark&) -> std::string { std::abort(); });
   EXPECT_TRUE(aborted.crashed);
   EXPECT_EQ(aborted.how.rfind("SIGABRT", 0), 0u) << aborted.how;
-  const ChildRun exited = run_in_child([](const std::function<void(char)>&) { std::_Exit(3); });
+  const ChildRun exited = run_in_child([](const Mark&) -> std::string { std::_Exit(3); });
   EXPECT_TRUE(exited.crashed);
   EXPECT_EQ(exited.how, "exit status 3");
 }
@@ -49,16 +54,20 @@ TEST(IsolatedRun, UnreapableChildIsJudgedByItsLastMark) {
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigaction(SIGCHLD, &ignore, &old);
-  const ChildRun fine = run_in_child([](const std::function<void(char)>& mark) { mark('P'); });
-  const ChildRun dead = run_in_child([](const std::function<void(char)>&) { std::_Exit(0); });
+  const ChildRun fine = run_in_child([](const Mark& mark) {
+    mark('P');
+    return std::string("ok");
+  });
+  const ChildRun dead = run_in_child([](const Mark&) -> std::string { std::_Exit(0); });
   sigaction(SIGCHLD, &old, nullptr);
   EXPECT_FALSE(fine.crashed) << fine.how;
   EXPECT_EQ(fine.marks, "P");
+  EXPECT_EQ(fine.payload, "ok");
   EXPECT_TRUE(dead.crashed);
 }
 
 TEST(IsolatedRun, ExceptionInChildIsNotACrash) {
-  const ChildRun run = run_in_child([](const std::function<void(char)>&) { throw std::bad_alloc(); });
+  const ChildRun run = run_in_child([](const Mark&) -> std::string { throw std::bad_alloc(); });
   EXPECT_FALSE(run.crashed) << run.how;
 }
 

@@ -55,10 +55,10 @@ namespace cadclash {
 struct ImportOptions {
   TessellationOptions tessellation;  // for B-rep formats
   bool lazy = false;                 // B-rep: AABBs from the exact geometry now, triangles when first required
-  // STEP/IGES/BREP: run OCCT's reader and transfer in a forked child first, so that a file on which
+  // STEP/IGES/BREP: run OCCT's reader and transfer in a forked child process, so that a file on which
   // OCCT crashes gives an error naming it instead of ending this process (a STEP file is then read
-  // again without the faces that reach malformed entities, then as loose faces). A file the child
-  // read is read again here: reading and transfer cost about twice as much (docs/import.md).
+  // again without the faces that reach malformed entities, then as loose faces). STEP and IGES come
+  // back as a stored XCAF document (a few % slower); a .brep is read twice (docs/import.md).
   // Turn it off only for trusted files, or in a host that must not fork (fork copies only the
   // calling thread; a thread of the host holding a lock OCCT needs would hang the child).
   bool isolate_cad_readers = true;

@@ -1,0 +1,231 @@
+// Transfer ↔ bytes, and Transfer → model.
+#include "cad_transfer.h"
+
+#include <BinTools.hxx>
+#include <BinXCAFDrivers.hxx>
+#include <PCDM_ReaderStatus.hxx>
+#include <PCDM_StoreStatus.hxx>
+#include <Standard_Failure.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+
+#include <cstring>
+#include <mutex>
+#include <sstream>
+
+namespace cadclash::detail {
+namespace {
+
+Handle(XCAFApp_Application) application() {
+  static std::once_flag once;
+  std::call_once(once, [] { BinXCAFDrivers::DefineFormat(XCAFApp_Application::GetApplication()); });
+  return XCAFApp_Application::GetApplication();
+}
+
+// Every face of the document's shapes, in one order that a stored and reloaded document repeats:
+// shape labels in tag order, faces in TopExp::MapShapes order.
+TopTools_IndexedMapOfShape document_faces(const Handle(TDocStd_Document)& doc) {
+  TopTools_IndexedMapOfShape faces;
+  TDF_LabelSequence labels;
+  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetShapes(labels);
+  for (Standard_Integer i = 1; i <= labels.Length(); ++i)
+    TopExp::MapShapes(XCAFDoc_ShapeTool::GetShape(labels(i)), TopAbs_FACE, faces);
+  return faces;
+}
+
+struct Writer {
+  std::string out;
+  void u64(std::uint64_t v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void str(const std::string& s) {
+    u64(s.size());
+    out += s;
+  }
+};
+
+struct Reader {
+  const std::string& in;
+  std::size_t at = 0;
+  bool ok = true;
+  std::uint64_t u64() {
+    std::uint64_t v = 0;
+    if (in.size() - at < sizeof v) {
+      ok = false;
+      return 0;
+    }
+    std::memcpy(&v, in.data() + at, sizeof v);
+    at += sizeof v;
+    return v;
+  }
+  std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+  std::string str() {
+    const std::uint64_t n = u64();
+    if (!ok || in.size() - at < n) {
+      ok = false;
+      return {};
+    }
+    std::string s = in.substr(at, n);
+    at += n;
+    return s;
+  }
+};
+
+}  // namespace
+
+Transfer::~Transfer() { discard_shapes(); }
+
+void Transfer::discard_shapes() {
+  try {
+    if (!doc.IsNull() && doc->IsOpened()) XCAFApp_Application::GetApplication()->Close(doc);
+  } catch (const Standard_Failure&) {
+  }
+  doc.Nullify();
+  faces.clear();
+  loose.Nullify();
+  loose_ids.clear();
+}
+
+Handle(TDocStd_Document) new_xcaf_document() {
+  Handle(TDocStd_Document) doc;
+  application()->NewDocument("BinXCAF", doc);
+  return doc;
+}
+
+std::string pack_transfer(const Transfer& t) {
+  Writer w;
+  w.u64(t.diagnostics.size());
+  for (const Diagnostic& d : t.diagnostics) {
+    w.u64(static_cast<std::uint64_t>(d.severity));
+    w.str(d.file);
+    w.i64(d.line);
+    w.i64(d.step_id);
+    w.str(d.message);
+  }
+  w.u64(t.complete ? 1 : 0);
+  w.u64(static_cast<std::uint64_t>(t.kind));
+  if (!t.doc.IsNull()) {
+    w.u64(1);
+    const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
+    std::vector<std::pair<Standard_Integer, const FaceEntity*>> tagged;
+    for (Standard_Integer f = 1; f <= faces.Extent(); ++f)
+      if (const auto it = t.faces.find(faces(f).TShape().get()); it != t.faces.end()) tagged.emplace_back(f, &it->second);
+    w.u64(tagged.size());
+    for (const auto& [f, entity] : tagged) {
+      w.i64(f);
+      w.i64(entity->id);
+      w.str(entity->name);
+    }
+    std::ostringstream stored;
+    if (application()->SaveAs(t.doc, stored) != PCDM_SS_OK) return {};
+    w.str(stored.str());
+  } else if (!t.loose.IsNull()) {
+    w.u64(2);
+    w.u64(t.loose_ids.size());
+    for (const std::int64_t id : t.loose_ids) w.i64(id);
+    w.str(t.loose_note);
+    std::ostringstream stored;
+    BinTools::Write(t.loose, stored, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
+    w.str(stored.str());
+  } else {
+    w.u64(0);
+  }
+  return std::move(w.out);
+}
+
+bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
+  Reader r{bytes};
+  const std::uint64_t n = r.u64();
+  for (std::uint64_t i = 0; r.ok && i < n; ++i) {
+    Diagnostic d;
+    d.severity = r.u64() == 0 ? Severity::Warning : Severity::Error;
+    d.file = r.str();
+    d.line = r.i64();
+    d.step_id = r.i64();
+    d.message = r.str();
+    t.diagnostics.push_back(std::move(d));
+  }
+  t.complete = r.u64() == 1;
+  t.kind = static_cast<SourceKind>(r.u64());
+  const std::uint64_t what = r.u64();
+  try {
+    if (r.ok && what == 1) {
+      std::vector<std::pair<std::int64_t, FaceEntity>> tagged(r.u64());
+      for (auto& [f, entity] : tagged) {
+        f = r.i64();
+        entity.id = r.i64();
+        entity.name = r.str();
+      }
+      std::istringstream stored(r.str());
+      if (!r.ok) {
+        why = "the reader's output is cut short";
+        return false;
+      }
+      if (application()->Open(stored, t.doc) != PCDM_RS_OK || t.doc.IsNull()) {
+        why = "OCCT could not load the document the reader stored";
+        return false;
+      }
+      const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
+      for (const auto& [f, entity] : tagged)
+        if (f >= 1 && f <= faces.Extent()) t.faces.emplace(faces(static_cast<Standard_Integer>(f)).TShape().get(), entity);
+    } else if (r.ok && what == 2) {
+      t.loose_ids.resize(r.u64());
+      for (std::int64_t& id : t.loose_ids) id = r.i64();
+      t.loose_note = r.str();
+      std::istringstream stored(r.str());
+      if (r.ok) BinTools::Read(t.loose, stored);
+    }
+  } catch (const Standard_Failure& e) {
+    why = std::string("OCCT could not load what the reader stored: ") + e.GetMessageString();
+    return false;
+  }
+  if (!r.ok) why = "the reader's output is cut short";
+  return r.ok;
+}
+
+IsolatedTransfer transfer_in_child(const std::string& path, const std::function<Transfer(const Mark&)>& transfer) {
+  IsolatedTransfer out;
+  out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); });
+  std::string why;
+  if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
+  out.warning = Diagnostic{Severity::Warning, path, 0, -1,
+                           (out.child.isolated ? "the isolated reader's result could not be read back (" + why + ")"
+                                               : "could not start an isolated reader (" + out.child.how + ")") +
+                               "; read in this process, unprotected from OCCT crashes"};
+  out.child.crashed = false;
+  out.transfer = transfer([](char) {});
+  return out;
+}
+
+ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options) {
+  ImportResult result;
+  result.diagnostics = std::move(t.diagnostics);
+  result.complete = t.complete;
+  const char* format = t.kind == SourceKind::IgesFace ? "IGES" : "STEP";
+  if (!t.doc.IsNull()) {
+    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result);
+    if (result.model.instances.empty()) {
+      result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string(format) + " file produced no shape"});
+      result.complete = false;
+    }
+  } else if (!t.loose.IsNull()) {
+    BrepPartInput in;
+    in.shape = &t.loose;
+    in.name = cad_file_stem(path);
+    in.source_file = path;
+    in.kind = t.kind;
+    in.tags.resize(t.loose_ids.size());
+    for (std::size_t f = 0; f < t.loose_ids.size(); ++f) in.tags[f].entity_id = t.loose_ids[f];
+    const auto ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation,
+                                    options.lazy, result.diagnostics, result.complete);
+    result.model.instances.push_back(Instance{"/" + in.name, ids[0], Pose::Identity()});
+    result.diagnostics.push_back({Severity::Error, path, 0, -1, t.loose_note});
+    result.complete = false;
+  }
+  return result;
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,63 @@
+// A CAD file read and transferred, not yet tessellated: what the isolated reader's child process
+// hands back to the caller's process as bytes (isolated_run.h), so OCCT's file translators run only
+// in the child. Internal to cadclash::import.
+#pragma once
+
+#include "cad_xcaf.h"
+#include "isolated_run.h"
+
+#include <TopoDS_Shape.hxx>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cadclash::detail {
+
+struct Transfer {
+  std::vector<Diagnostic> diagnostics;  // everything said so far about the file
+  bool complete = true;
+  SourceKind kind = SourceKind::StepFace;
+  // Products: an XCAF document (closed by the destructor) and the entities of its faces.
+  Handle(TDocStd_Document) doc;
+  FaceEntityMap faces;
+  // Or loose faces of one part: a compound, the entity #id of each face in TopExp::MapShapes order,
+  // and the error that says how many were recovered.
+  TopoDS_Shape loose;
+  std::vector<std::int64_t> loose_ids;
+  std::string loose_note;
+
+  Transfer() = default;
+  Transfer(const Transfer&) = delete;
+  Transfer& operator=(const Transfer&) = delete;
+  Transfer(Transfer&&) = default;
+  Transfer& operator=(Transfer&&) = default;
+  ~Transfer();
+
+  // Closes the document and forgets the faces: for a transfer that failed or was cut short.
+  void discard_shapes();
+};
+
+// A new XCAF document that pack_transfer can store. Throws Standard_Failure if OCCT cannot make one.
+Handle(TDocStd_Document) new_xcaf_document();
+
+// The transfer as bytes (OCCT's binary XCAF document or shape format, plus our tags and diagnostics).
+std::string pack_transfer(const Transfer& t);
+
+// Back from pack_transfer's bytes; false (and `why`) if they are not whole.
+bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why);
+
+// A transfer made in a child process (run_in_child) and brought back. When no child could be started
+// or its bytes could not be read back, the transfer is made here instead and `warning` says so.
+struct IsolatedTransfer {
+  ChildRun child;       // child.crashed: `transfer` is empty
+  Transfer transfer;
+  std::optional<Diagnostic> warning;
+};
+IsolatedTransfer transfer_in_child(const std::string& path, const std::function<Transfer(const Mark&)>& transfer);
+
+// Tessellates and walks the transfer into parts and instances (add_xcaf_document / add_brep_parts).
+ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options);
+
+}  // namespace cadclash::detail
