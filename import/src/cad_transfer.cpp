@@ -186,8 +186,13 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   return r.ok;
 }
 
-IsolatedTransfer transfer_in_child(const std::string& path, const std::function<Transfer(const Mark&)>& transfer) {
+IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, const std::function<Transfer(const Mark&)>& transfer) {
   IsolatedTransfer out;
+  if (!isolate) {
+    out.transfer = transfer([&out](char c) { out.child.marks += c; });
+    out.child.isolated = false;
+    return out;
+  }
   out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); });
   std::string why;
   if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
@@ -195,8 +200,9 @@ IsolatedTransfer transfer_in_child(const std::string& path, const std::function<
                            (out.child.isolated ? "the isolated reader's result could not be read back (" + why + ")"
                                                : "could not start an isolated reader (" + out.child.how + ")") +
                                "; read in this process, unprotected from OCCT crashes"};
-  out.child.crashed = false;
-  out.transfer = transfer([](char) {});
+  out.child = ChildRun{};
+  out.child.isolated = false;
+  out.transfer = transfer([&out](char c) { out.child.marks += c; });
   return out;
 }
 

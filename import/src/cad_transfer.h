@@ -48,14 +48,15 @@ std::string pack_transfer(const Transfer& t);
 // Back from pack_transfer's bytes; false (and `why`) if they are not whole.
 bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why);
 
-// A transfer made in a child process (run_in_child) and brought back. When no child could be started
-// or its bytes could not be read back, the transfer is made here instead and `warning` says so.
+// A transfer made in a child process (run_in_child) and brought back; made here when `isolate` is
+// false. When no child could be started or its bytes could not be read back, the transfer is made
+// here instead and `warning` says so.
 struct IsolatedTransfer {
   ChildRun child;       // child.crashed: `transfer` is empty
   Transfer transfer;
   std::optional<Diagnostic> warning;
 };
-IsolatedTransfer transfer_in_child(const std::string& path, const std::function<Transfer(const Mark&)>& transfer);
+IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, const std::function<Transfer(const Mark&)>& transfer);
 
 // Tessellates and walks the transfer into parts and instances (add_xcaf_document / add_brep_parts).
 ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options);

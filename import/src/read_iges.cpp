@@ -81,8 +81,7 @@ Transfer read_iges_transfer(const std::string& path) {
 // child process, which sends the document back.
 ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  if (!options.isolate_cad_readers) return finish_transfer(read_iges_transfer(path), path, options);
-  IsolatedTransfer run = transfer_in_child(path, [&](const Mark&) { return read_iges_transfer(path); });
+  IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, [&](const Mark&) { return read_iges_transfer(path); });
   if (run.child.crashed)
     return failed_import(path, "OCCT crashed with " + run.child.how + " while reading the IGES file (in an isolated reader); nothing could be read");
   ImportResult result = finish_transfer(std::move(run.transfer), path, options);

@@ -306,9 +306,9 @@ enum class Attempt {
   LooseFaces,          // no products: each face entity on its own (recover_loose_faces)
 };
 
-// Marks a child reports (isolated_run.h): the file was parsed, shapes were transferred, and the
-// transfer made at least one shape.
-constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S';
+// Marks a child reports (isolated_run.h): the file was parsed, shapes were transferred, the
+// transfer made at least one face, and faces were transferred one by one (no products).
+constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S', kLoose = 'L';
 
 struct AttemptRun {
   Attempt attempt = Attempt::Whole;
@@ -321,6 +321,7 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
   BRep_Builder builder;
   builder.MakeCompound(faces);
   std::size_t tried = 0, made = 0;
+  run.mark(kLoose);
   const Interface_Graph graph(model);
   for (Standard_Integer i = 1; i <= model->NbEntities(); ++i) {
     const Handle(Standard_Transient) entity = model->Value(i);
@@ -708,42 +709,62 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
 // and this process never runs OCCT's STEP code on the file.
 ImportResult read_step(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  if (!options.isolate_cad_readers) return finish_transfer(read_step_attempt(path, {}), path, options);
-  std::vector<Diagnostic> crashes;
-  auto finish = [&](ImportResult result) {
-    for (const Diagnostic& d : crashes) result.complete = result.complete && d.severity != Severity::Error;
-    result.diagnostics.insert(result.diagnostics.begin(), crashes.begin(), crashes.end());
+  std::vector<Diagnostic> notes;  // how the attempts went, first in the result
+  std::optional<Transfer> faceless;  // the first attempt that finished without a face
+  auto finish = [&](Transfer transfer) {
+    // What the faceless attempt said (its transfer's checks) stays, without repeating what this one says.
+    if (faceless) {
+      std::unordered_set<std::string> said;
+      for (const Diagnostic& d : transfer.diagnostics) said.insert(format_diagnostic(d));
+      for (const Diagnostic& d : faceless->diagnostics)
+        if (!said.count(format_diagnostic(d))) notes.push_back(d);
+    }
+    ImportResult result = finish_transfer(std::move(transfer), path, options);
+    for (const Diagnostic& d : notes) result.complete = result.complete && d.severity != Severity::Error;
+    result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
     return result;
   };
-  for (const Attempt attempt : {Attempt::Whole, Attempt::WithoutBrokenFaces, Attempt::LooseFaces}) {
-    IsolatedTransfer run = transfer_in_child(path, [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark}); });
+  Attempt attempt = Attempt::Whole;
+  for (;;) {
+    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers,
+                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark}); });
+    if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
-    if (run.warning) {
-      crashes.push_back(*run.warning);
-      return finish(finish_transfer(std::move(run.transfer), path, options));
-    }
-    const bool shapes = child.marks.find(kShapes) != std::string::npos;
-    if (!child.crashed && (shapes || attempt != Attempt::WithoutBrokenFaces))
-      return finish(finish_transfer(std::move(run.transfer), path, options));
-    if (!child.crashed) {  // nothing left after the drops: the loose faces may still give some
-      crashes.push_back({Severity::Error, path, 0, -1,
-                         "without the faces that reach entities OCCT could not read whole, no face was left; read again as loose faces"});
+    const bool parsed = child.marks.find(kParsed) != std::string::npos;
+    if (!child.crashed) {
+      if (child.marks.find(kShapes) != std::string::npos) return finish(std::move(run.transfer));
+      const bool loose = attempt == Attempt::LooseFaces || child.marks.find(kLoose) != std::string::npos;
+      if (!faceless) faceless.emplace(std::move(run.transfer));
+      if (loose || !parsed) break;
+      // OCCT made nothing of the products: each face entity on its own may still give some.
+      notes.push_back({Severity::Error, path, 0, -1,
+                       attempt == Attempt::Whole
+                           ? "the file's products gave no face; read again as loose faces"
+                           : "without the faces that reach entities OCCT could not read whole, no face was left; read again as loose faces"});
+      attempt = Attempt::LooseFaces;
       continue;
     }
-    const bool parsed = child.marks.find(kParsed) != std::string::npos;
     const char* stage = !parsed ? "parsing the file"
                         : attempt == Attempt::LooseFaces ? "transferring its faces one by one"
                         : attempt == Attempt::Whole ? "transferring its shapes"
                                                     : "transferring its shapes without the broken faces";
-    const char* next = !parsed ? "nothing could be read"
+    const char* next = !parsed || attempt == Attempt::LooseFaces ? "nothing more could be read"
                        : attempt == Attempt::Whole ? "read again without the faces that reach entities it could not read whole"
-                       : attempt == Attempt::WithoutBrokenFaces ? "read again as loose faces"
-                                                                : "nothing could be read";
-    crashes.push_back({Severity::Error, path, 0, -1,
-                       std::string("OCCT crashed with ") + child.how + " while " + stage + " (in an isolated reader); " + next});
-    if (!parsed) break;
+                                                   : "read again as loose faces";
+    notes.push_back({Severity::Error, path, 0, -1,
+                     std::string("OCCT crashed with ") + child.how + " while " + stage + " (in an isolated reader); " + next});
+    if (!parsed || attempt == Attempt::LooseFaces) break;
+    attempt = attempt == Attempt::Whole ? Attempt::WithoutBrokenFaces : Attempt::LooseFaces;
   }
-  return finish(failed_import(path, "no shape could be read from the STEP file"));
+  if (faceless) {
+    Transfer best = std::move(*faceless);
+    faceless.reset();
+    return finish(std::move(best));
+  }
+  Transfer nothing;
+  nothing.complete = false;
+  nothing.diagnostics.push_back({Severity::Error, path, 0, -1, "no shape could be read from the STEP file"});
+  return finish(std::move(nothing));
 }
 
 }  // namespace cadclash::detail
