@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the libFuzzer targets of fuzz/: scripts/fuzz.sh [BUILD_DIR (default build-sanitize)] [TARGET...]
-# TARGET is obj, off, stl, step or triangles (default: all). docs/fuzzing.md has the details.
+# TARGET is obj, off, stl, step, iges or triangles (default: all). docs/fuzzing.md has the details.
 #
 # The build tree must be configured with clang and -DCADCLASH_BUILD_FUZZERS=ON (scripts/test.sh's
 # sanitizer tree is). Each target starts from its committed seeds (fuzz/corpus/<target>/) plus, at
@@ -17,7 +17,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 dir=${1:-$root/build-sanitize}
 if [ $# -gt 0 ]; then shift; fi
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(obj off stl step triangles); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(obj off stl step iges triangles); fi
 seconds=${CADCLASH_FUZZ_SECONDS:-25}
 parallel=${CADCLASH_FUZZ_PARALLEL:-2}
 timeout=${CADCLASH_FUZZ_TIMEOUT:-10}
@@ -26,7 +26,7 @@ rss_mb=${CADCLASH_FUZZ_RSS_MB:-2048}
 # Largest input libFuzzer makes per target, and the extensions of its data/external seeds. STEP
 # files are large by nature; the mesh readers' interesting structure fits in a few kilobytes.
 max_len() { case $1 in triangles) echo 512 ;; *) echo 65536 ;; esac; }
-extensions() { case $1 in obj) echo obj ;; off) echo off ;; stl) echo stl ;; step) echo "stp step" ;; *) ;; esac; }
+extensions() { case $1 in obj) echo obj ;; off) echo off ;; stl) echo stl ;; step) echo "stp step" ;; iges) echo "igs iges" ;; *) ;; esac; }
 
 for t in "${targets[@]}"; do
   if [ ! -x "$dir/fuzz/fuzz_$t" ]; then

@@ -107,6 +107,22 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) 
   return run;
 }
 
+void mark_entity_begin(const Mark& mark, std::int64_t id) {
+  mark('#');
+  for (const char c : std::to_string(id)) mark(c);
+}
+
+void mark_entity_end(const Mark& mark) { mark('.'); }
+
+std::int64_t entity_in_progress(const std::string& marks) {
+  const std::size_t hash = marks.rfind('#');
+  if (hash == std::string::npos || marks.find('.', hash) != std::string::npos) return -1;
+  std::int64_t id = 0;
+  std::size_t i = hash + 1;
+  for (; i < marks.size() && marks[i] >= '0' && marks[i] <= '9' && id < (std::int64_t{1} << 50); ++i) id = id * 10 + (marks[i] - '0');
+  return i > hash + 1 ? id : -1;
+}
+
 ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
                            const std::function<ImportResult(bool probe)>& read) {
   if (!options.isolate_cad_readers) return read(false);

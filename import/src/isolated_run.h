@@ -7,6 +7,7 @@
 
 #include "cadclash/import.h"
 
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -31,6 +32,14 @@ using Mark = std::function<void(char)>;
 // - `work` writes nothing to stdout (the child's stdout is /dev/null).
 // Process-wide, one child runs at a time.
 ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work);
+
+// Marks that name the entity a child is working on: "#<id>" before it, "." after it. A child that
+// crashes inside the entity leaves an unclosed "#<id>", so the next child can skip that entity.
+void mark_entity_begin(const Mark& mark, std::int64_t id);
+void mark_entity_end(const Mark& mark);
+
+// The entity whose "#<id>" mark is the last one and unclosed; -1 when there is none.
+std::int64_t entity_in_progress(const std::string& marks);
 
 // For readers with a single way through the file: runs `read(true)` (a probe: stop before
 // tessellating) in a child, then `read(false)` here if the child finished, else returns an error

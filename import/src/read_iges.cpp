@@ -1,8 +1,9 @@
-// IGES through IGESCAFControl_Reader into an XCAF document.
+// IGES through IGESCAFControl_Reader into an XCAF document (or root by root after a crash).
 #include "cad_xcaf.h"
 #include "cad_transfer.h"
 #include "readers.h"
 
+#include <BRep_Builder.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESData_IGESEntity.hxx>
@@ -13,14 +14,70 @@
 #include <TDocStd_Document.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XSControl_TransferReader.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS_Compound.hxx>
 #include <XSControl_WorkSession.hxx>
+
+#include <set>
 
 namespace cadclash::detail {
 
 namespace {
 
-// Reads and transfers the file, tessellating nothing.
-Transfer read_iges_transfer(const std::string& path) {
+FaceEntityFn describe_iges_face(const EntityLabelFn& label) {
+  return [label](const Handle(Standard_Transient)& entity, FaceEntity& out) {
+    const Handle(IGESData_IGESEntity) iges = Handle(IGESData_IGESEntity)::DownCast(entity);
+    if (iges.IsNull()) return false;
+    out.id = label(entity);
+    if (iges->HasName() && !iges->NameValue().IsNull()) out.name = iges->NameValue()->ToCString();
+    return true;
+  };
+}
+
+void transfer_roots_one_by_one(IGESCAFControl_Reader& reader, const EntityLabelFn& label, const std::string& path,
+                               const std::set<std::int64_t>& skip, const Mark& mark, Transfer& result) {
+  reader.ClearShapes();
+  const Standard_Integer roots = reader.NbRootsForTransfer();
+  std::size_t made = 0;
+  for (Standard_Integer i = 1; i <= roots; ++i) {
+    const std::int64_t id = label(reader.RootForTransfer(i));
+    if (skip.count(id)) continue;  // read_iges names it
+    mark_entity_begin(mark, id);
+    try {
+      const Standard_Integer before = reader.NbShapes();
+      if (reader.TransferOneRoot(i) && reader.NbShapes() > before) ++made;
+      else result.diagnostics.push_back({Severity::Error, path, 0, id, "root entity could not be transferred; dropped"});
+    } catch (const Standard_Failure&) {
+      result.diagnostics.push_back({Severity::Error, path, 0, id, "root entity could not be transferred; dropped"});
+    }
+    mark_entity_end(mark);
+  }
+  result.complete = false;
+  if (made == 0) return;
+  TopoDS_Compound faces;
+  BRep_Builder builder;
+  builder.MakeCompound(faces);
+  for (Standard_Integer k = 1; k <= reader.NbShapes(); ++k) builder.Add(faces, reader.Shape(k));
+  const Handle(XSControl_WorkSession) ws = reader.WS();
+  const FaceEntityMap tags = map_face_entities(ws->TransferReader()->TransientProcess(), describe_iges_face(label));
+  TopTools_IndexedMapOfShape map;
+  TopExp::MapShapes(faces, TopAbs_FACE, map);
+  result.loose = faces;
+  result.loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
+  for (Standard_Integer f = 1; f <= map.Extent(); ++f)
+    if (auto it = tags.find(map(f).TShape().get()); it != tags.end()) result.loose_ids[static_cast<std::size_t>(f - 1)] = it->second.id;
+  result.loose_note = "the file could not be transferred whole; " + std::to_string(made) + " of " + std::to_string(roots) +
+                      " root entities transferred on their own into loose faces of one part";
+}
+
+// Marks of the child (isolated_run.h): the file was parsed.
+constexpr char kParsed = 'P';
+
+// Reads and transfers the file, tessellating nothing: the whole document (colours, names, assembly
+// structure), or, after OCCT crashed on that, each root entity on its own into loose faces of one
+// part, without the roots in `skip` (directory entry numbers a child crashed on).
+Transfer read_iges_transfer(const std::string& path, bool one_by_one, const std::set<std::int64_t>& skip, const Mark& mark) {
   Transfer result;
   result.kind = SourceKind::IgesFace;
   try {
@@ -47,6 +104,11 @@ Transfer read_iges_transfer(const std::string& path) {
       result.complete = false;
       return result;
     }
+    mark(kParsed);
+    if (one_by_one) {
+      transfer_roots_one_by_one(reader, label, path, skip, mark, result);
+      return result;
+    }
     result.doc = new_xcaf_document();
     const bool transferred = reader.Transfer(result.doc) == Standard_True;
     const Handle(Transfer_TransientProcess) process =
@@ -59,13 +121,7 @@ Transfer read_iges_transfer(const std::string& path) {
       result.complete = false;
       result.discard_shapes();
     } else {
-      result.faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
-        const Handle(IGESData_IGESEntity) iges = Handle(IGESData_IGESEntity)::DownCast(entity);
-        if (iges.IsNull()) return false;
-        out.id = label(entity);
-        if (iges->HasName() && !iges->NameValue().IsNull()) out.name = iges->NameValue()->ToCString();
-        return true;
-      });
+      result.faces = map_face_entities(process, describe_iges_face(label));
     }
   } catch (const Standard_Failure& e) {
     result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string("OCCT failed while reading IGES: ") + e.GetMessageString()});
@@ -81,11 +137,37 @@ Transfer read_iges_transfer(const std::string& path) {
 // child process, which sends the document back.
 ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, [&](const Mark&) { return read_iges_transfer(path); });
-  if (run.child.crashed)
-    return failed_import(path, "OCCT crashed with " + run.child.how + " while reading the IGES file (in an isolated reader); nothing could be read");
-  ImportResult result = finish_transfer(std::move(run.transfer), path, options);
-  if (run.warning) result.diagnostics.insert(result.diagnostics.begin(), *run.warning);
+  std::vector<Diagnostic> notes;
+  std::set<std::int64_t> skip;  // root entities a child crashed on
+  constexpr std::size_t kMaxSkips = 20;
+  bool one_by_one = false;
+  for (;;) {
+    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, [&](const Mark& mark) {
+      return read_iges_transfer(path, one_by_one, skip, mark);
+    });
+    if (run.warning) notes.push_back(*run.warning);
+    if (!run.child.crashed) {
+      ImportResult result = finish_transfer(std::move(run.transfer), path, options);
+      for (const Diagnostic& d : notes) result.complete = result.complete && d.severity != Severity::Error;
+      result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
+      return result;
+    }
+    const bool parsed = run.child.marks.find(kParsed) != std::string::npos;
+    const std::int64_t root = entity_in_progress(run.child.marks);
+    if (one_by_one && root >= 0 && skip.size() < kMaxSkips && skip.insert(root).second) {
+      notes.push_back({Severity::Error, path, 0, root,
+                       "OCCT crashed with " + run.child.how + " while transferring this root entity on its own (in an isolated reader); dropped"});
+      continue;
+    }
+    const bool retry = parsed && !one_by_one;
+    notes.push_back({Severity::Error, path, 0, -1,
+                     "OCCT crashed with " + run.child.how + " while " + (!parsed ? "parsing the file" : "transferring its shapes") +
+                         " (in an isolated reader); " + (retry ? "read again root entity by root entity" : "nothing more could be read")});
+    if (!retry) break;
+    one_by_one = true;
+  }
+  ImportResult result = failed_import(path, "no shape could be read from the IGES file");
+  result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
   return result;
 }
 

@@ -39,10 +39,13 @@
 #include <TopoDS_Compound.hxx>
 
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <functional>
 #include <cctype>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -310,9 +313,12 @@ enum class Attempt {
 // transfer made at least one face, and faces were transferred one by one (no products).
 constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S', kLoose = 'L';
 
+std::atomic<std::int64_t> crash_injected_at{-1};  // see set_step_crash_injection_for_testing
+
 struct AttemptRun {
   Attempt attempt = Attempt::Whole;
   Mark mark = [](char) {};
+  const std::set<std::int64_t>* skip = nullptr;  // LooseFaces: face entities (#id) an earlier child crashed on
 };
 
 void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepModel)& model, const std::string& path,
@@ -336,19 +342,23 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
                         ", which could not be read whole; dropped"});
       continue;
     }
+    if (run.skip != nullptr && run.skip->count(label(entity))) continue;  // read_step names it
+    mark_entity_begin(run.mark, label(entity));
+    if (label(entity) == crash_injected_at.load(std::memory_order_relaxed)) std::raise(SIGSEGV);
     try {
       step.ClearShapes();
-      if (!step.TransferEntity(entity) || step.NbShapes() == 0) {
+      if (step.TransferEntity(entity) && step.NbShapes() > 0) {
+        TopTools_IndexedMapOfShape map;
+        TopExp::MapShapes(step.Shape(1), TopAbs_FACE, map);
+        for (Standard_Integer f = 1; f <= map.Extent(); ++f) builder.Add(faces, map(f));
+        ++made;
+      } else {
         result.diagnostics.push_back({Severity::Error, path, 0, label(entity), "face entity could not be made; dropped"});
-        continue;
       }
-      TopTools_IndexedMapOfShape map;
-      TopExp::MapShapes(step.Shape(1), TopAbs_FACE, map);
-      for (Standard_Integer f = 1; f <= map.Extent(); ++f) builder.Add(faces, map(f));
-      ++made;
     } catch (const Standard_Failure&) {
       result.diagnostics.push_back({Severity::Error, path, 0, label(entity), "face entity could not be made; dropped"});
     }
+    mark_entity_end(run.mark);
   }
   run.mark(kTransferred);
   if (made == 0) return;
@@ -703,6 +713,8 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
 
 }  // namespace
 
+void set_step_crash_injection_for_testing(std::int64_t face_id) { crash_injected_at.store(face_id, std::memory_order_relaxed); }
+
 // OCCT's translators dereference the missing parameters of malformed entities (StepToGeom::MakeLine
 // on a LINE whose point was cut off), so each attempt runs in a child process, which sends back the
 // transferred document (cad_transfer.h): a crash there costs the attempt, not the caller's process,
@@ -725,9 +737,11 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     return result;
   };
   Attempt attempt = Attempt::Whole;
+  std::set<std::int64_t> skip;  // face entities a child crashed on, each one
+  constexpr std::size_t kMaxSkips = 20;
   for (;;) {
     IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers,
-                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark}); });
+                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
     const bool parsed = child.marks.find(kParsed) != std::string::npos;
@@ -742,6 +756,12 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
                            ? "the file's products gave no face; read again as loose faces"
                            : "without the faces that reach entities OCCT could not read whole, no face was left; read again as loose faces"});
       attempt = Attempt::LooseFaces;
+      continue;
+    }
+    if (const std::int64_t face = entity_in_progress(child.marks);
+        attempt == Attempt::LooseFaces && face >= 0 && skip.size() < kMaxSkips && skip.insert(face).second) {
+      notes.push_back({Severity::Error, path, 0, face,
+                       "OCCT crashed with " + child.how + " while transferring this face entity on its own (in an isolated reader); dropped"});
       continue;
     }
     const char* stage = !parsed ? "parsing the file"

@@ -10,6 +10,9 @@ ImportResult read_off(const std::string& path, const ImportOptions& options);
 ImportResult read_assimp_mesh(const std::string& path, const ImportOptions& options);  // stl, ply, gltf, glb, ...
 ImportResult read_cadclash_glb(const std::string& path, const ImportOptions& options);  // our own .glb, exact round trip
 ImportResult read_step(const std::string& path, const ImportOptions& options);
+// Fault injection for the tests of the isolated reader: the STEP reader raises SIGSEGV when it
+// transfers face entity #face_id on its own (loose faces); -1 turns it off.
+void set_step_crash_injection_for_testing(std::int64_t face_id);
 ImportResult read_iges(const std::string& path, const ImportOptions& options);
 ImportResult read_brep(const std::string& path, const ImportOptions& options);
 

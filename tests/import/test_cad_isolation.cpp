@@ -3,6 +3,7 @@
 // surfaces, entity ids, names, colours, triangles and instance poses, bit for bit.
 #include "cadclash/import.h"
 #include "../test_temp.h"
+#include "readers.h"
 
 #include <gtest/gtest.h>
 
@@ -76,14 +77,18 @@ INSTANTIATE_TEST_SUITE_P(Files, CadIsolation,
 
 // Shells whose shape representations are gone: the products give no face, so each face entity is
 // transferred on its own; the same in both modes, and every face keeps its #id.
-TEST(CadIsolation, FacesOfProductsWithoutShapesAreReadAsLooseFaces) {
+std::string file_without_shape_representations() {
   std::ifstream in(std::string(CADCLASH_DATA_DIR) + "/cad/valid_two_solids.step");
   std::string text, line;
   while (std::getline(in, line))
     if (line.find("SHAPE_DEFINITION_REPRESENTATION") == std::string::npos &&
         line.find("SHAPE_REPRESENTATION") == std::string::npos && line.find("MANIFOLD_SOLID_BREP") == std::string::npos)
       text += line + "\n";
-  const std::string path = testing::write_scratch_file("no_shape_representations.step", text);
+  return testing::write_scratch_file("no_shape_representations.step", text);
+}
+
+TEST(CadIsolation, FacesOfProductsWithoutShapesAreReadAsLooseFaces) {
+  const std::string path = file_without_shape_representations();
   ImportOptions here;
   here.isolate_cad_readers = false;
   const ImportResult a = import_file(path);
@@ -96,6 +101,23 @@ TEST(CadIsolation, FacesOfProductsWithoutShapesAreReadAsLooseFaces) {
   for (const Diagnostic& d : a.diagnostics) all += format_diagnostic(d) + "\n";
   EXPECT_NE(all.find("the file's products gave no face; read again as loose faces"), std::string::npos) << all;
   EXPECT_NE(all.find("9 of 9 face entities recovered"), std::string::npos) << all;
+}
+
+// A face on which OCCT crashes when it is transferred on its own (injected: SIGSEGV in the child at
+// face #137) costs that face only: the next child skips it, and it is named with the signal.
+TEST(CadIsolation, FaceThatCrashesOnItsOwnIsSkippedAndNamed) {
+  const std::string path = file_without_shape_representations();
+  detail::set_step_crash_injection_for_testing(137);
+  const ImportResult r = import_file(path);
+  detail::set_step_crash_injection_for_testing(-1);
+  ASSERT_EQ(r.model.surfaces.size(), 8u);
+  for (const Surface& s : r.model.surfaces) EXPECT_NE(s.provenance.step_id, 137);
+  bool named = false;
+  for (const Diagnostic& d : r.diagnostics)
+    named = named || (d.step_id == 137 && d.message.rfind("OCCT crashed with SIGSEGV", 0) == 0 &&
+                      d.message.find("while transferring this face entity on its own") != std::string::npos);
+  EXPECT_TRUE(named);
+  EXPECT_FALSE(r.complete);
 }
 
 }  // namespace

@@ -44,6 +44,9 @@ const Regression kRegressions[] = {
     {"step_truncated_line_without_point.step", "OCCT crashed with SIGSEGV",
      "fuzz_step: a cut-off file whose LINE #198 lost its point; the product transfer reached it and "
      "StepToGeom::MakeLine dereferenced the missing point (SEGV). Now contained by the isolated reader"},
+    {"iges_solid_face_broken_by_fuzzer.igs", "while transferring this root entity on its own (in an isolated reader); dropped",
+     "fuzz_iges: one byte of a face's directory entry changed; IGESToBRep_BRepEntity::TransferFace called "
+     "NbLoops on a null IGESSolid_Face (SEGV). Contained; the other solid's faces are read root by root"},
 };
 
 // Names the case by its file in test listings (instead of a byte dump).

@@ -71,5 +71,18 @@ TEST(IsolatedRun, ExceptionInChildIsNotACrash) {
   EXPECT_FALSE(run.crashed) << run.how;
 }
 
+TEST(IsolatedRun, EntityInProgressIsTheLastUnclosedMark) {
+  std::string marks;
+  const Mark mark = [&marks](char c) { marks += c; };
+  EXPECT_EQ(entity_in_progress(marks), -1);
+  mark('P');
+  mark_entity_begin(mark, 17);
+  mark_entity_end(mark);
+  EXPECT_EQ(entity_in_progress(marks), -1);
+  mark_entity_begin(mark, 1234567);
+  EXPECT_EQ(entity_in_progress(marks), 1234567);
+  EXPECT_EQ(marks, "P#17.#1234567");
+}
+
 }  // namespace
 }  // namespace cadclash::detail
