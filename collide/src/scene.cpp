@@ -519,6 +519,12 @@ Report Scene::check(const CollideOptions& o) {
   std::vector<char> pair_intersects(pairs.size(), 0);
   std::vector<double> pair_distance(pairs.size(), std::numeric_limits<double>::infinity());
   std::vector<std::vector<SurfacePairResult>> pair_results(pairs.size());
+  struct Classified {
+    std::size_t task = 0;
+    SurfacePairResult result;
+    bool cut = false;  // the time budget ran out before its exact verification
+  };
+  std::vector<Classified> classified;
   for (std::size_t k = 0; k < first_task[cutoff]; ++k) {
     const Task& t = tasks[k];
     if (task_cut[k]) {
@@ -540,23 +546,43 @@ Report Scene::check(const CollideOptions& o) {
     r.penetration = out.penetration;
     r.triangle_pairs = out.triangle_pairs;
     pair_distance[t.pair] = std::min(pair_distance[t.pair], r.distance);
-    // Touching pairs whose triangles cross are verified too: faceted coaxial cylinders with a small
-    // radial gap cross each other although the exact faces are apart.
-    if (o.exact_verification && r.contact != ContactClass::Penetrating) {
+    classified.push_back({k, std::move(r)});
+  }
+  // Exact verification of every pair that is not penetrating, touching pairs whose triangles cross
+  // included: faceted coaxial cylinders with a small radial gap cross each other although the exact
+  // faces are apart. One exact distance takes milliseconds, so the pairs go to the threads one at a
+  // time; each answer depends on its pair alone and the merge below keeps task order, so the report
+  // is the same for any thread count (only which pairs a time budget cuts depends on it).
+  if (o.exact_verification) {
+    std::vector<std::size_t> verify;
+    for (std::size_t i = 0; i < classified.size(); ++i)
+      if (classified[i].result.contact != ContactClass::Penetrating) verify.push_back(i);
+    const auto nverify = static_cast<std::ptrdiff_t>(verify.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nverify >= 2)
+    for (std::ptrdiff_t v = 0; v < nverify; ++v) {
+      Classified& c = classified[verify[static_cast<std::size_t>(v)]];
       if (deadline.expired()) {
-        task_cut[k] = 1;
-        pair_cut[t.pair] = 1;
+        c.cut = true;
         continue;
       }
-      const Part& pa = model.parts[model.surfaces[t.sa].part];
-      const Part& pb = model.parts[model.surfaces[t.sb].part];
+      SurfacePairResult& r = c.result;
+      const Part& pa = model.parts[model.surfaces[r.surface_a].part];
+      const Part& pb = model.parts[model.surfaces[r.surface_b].part];
       if (pa.source && pb.source)
-        r.exact_distance = pa.source->exact_distance(t.sa - pa.first_surface, s.poses[r.instance_a], *pb.source,
-                                                     t.sb - pb.first_surface, s.poses[r.instance_b],
-                                                     std::max(prepared[k].tau, o.clearance));
+        r.exact_distance = pa.source->exact_distance(r.surface_a - pa.first_surface, s.poses[r.instance_a], *pb.source,
+                                                     r.surface_b - pb.first_surface, s.poses[r.instance_b],
+                                                     std::max(prepared[c.task].tau, o.clearance));
     }
-    charge[t.pair] += result_bytes(r);
-    pair_results[t.pair].push_back(std::move(r));
+  }
+  for (Classified& c : classified) {
+    const std::size_t pair = tasks[c.task].pair;
+    if (c.cut) {
+      task_cut[c.task] = 1;
+      pair_cut[pair] = 1;
+      continue;
+    }
+    charge[pair] += result_bytes(c.result);
+    pair_results[pair].push_back(std::move(c.result));
   }
 
   // 6. Containment: instance pairs whose boxes nest and whose surfaces do not cross (not decidable

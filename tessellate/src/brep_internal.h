@@ -6,7 +6,8 @@
 #include <TopoDS_Face.hxx>
 #include <gp_Trsf.hxx>
 
-#include <mutex>
+#include <optional>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,9 @@ struct BrepSource::Impl {
   double default_deflection = 0.1;          // absolute, mm
   double angular_deflection = 0.5;
   bool verify_deflection = true;
-  mutable std::mutex mutex;                 // BRepMesh writes triangulations into the shared TShapes
+  // BRepMesh writes triangulations into the shared TShapes: meshing holds it exclusively; exact
+  // distances only read the faces (OCCT's own parallel BRepExtrema does the same) and share it.
+  mutable std::shared_mutex mutex;
 };
 
 namespace detail {
@@ -43,6 +46,11 @@ bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool v
 // Part-local box enclosing the exact face: BRepBndLib::AddOptimal for analytic surfaces (cheap and
 // tight), BRepBndLib::Add (control polygons) for the rest.
 Aabb face_aabb(const TopoDS_Face& face);
+
+// Minimum distance between two shapes (here: placed faces), equal bit for bit to
+// BRepExtrema_DistShapeShape(a, b, Extrema_ExtFlag_MIN).Value(), but it stops as soon as the distance
+// is 0. nullopt when OCCT finds no solution. May throw Standard_Failure. Reads the shapes only.
+std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b);
 
 gp_Trsf to_trsf(const Pose& pose);
 Pose to_pose(const gp_Trsf& trsf);

@@ -1,13 +1,13 @@
 // BrepSource: the exact faces of one part, tessellated on demand and measured exactly.
 #include "brep_internal.h"
 
-#include <BRepExtrema_DistShapeShape.hxx>
 #include <Standard_Failure.hxx>
 #include <TopLoc_Location.hxx>
 #include <TopoDS.hxx>
 
 #include <cassert>
 #include <mutex>
+#include <shared_mutex>
 
 namespace cadclash {
 namespace {
@@ -45,7 +45,7 @@ bool BrepSource::triangulate(std::uint32_t local_index, double deflection, Trian
   std::string why;
   bool ok = false;
   {
-    std::lock_guard<std::mutex> lock(impl_->mutex);
+    std::lock_guard<std::shared_mutex> lock(impl_->mutex);
     ok = detail::mesh_face_to(impl_->faces[local_index], target, impl_->angular_deflection, impl_->verify_deflection,
                               out, achieved_deflection, why);
   }
@@ -69,17 +69,17 @@ std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Po
   const double boxes_apart = box_distance(placed_box(a.boxes[local_a], pose_a), placed_box(b.boxes[local_b], pose_b));
   if (!a.boxes[local_a].isEmpty() && !b.boxes[local_b].isEmpty() && boxes_apart > max_distance) return boxes_apart;
 
-  // Both parts' faces may be meshed by other threads; hold both (scoped_lock orders them).
-  std::unique_lock<std::mutex> lock_a(a.mutex, std::defer_lock);
-  std::unique_lock<std::mutex> lock_b(b.mutex, std::defer_lock);
+  // Either part's faces may be meshed by another thread meanwhile (triangulate holds the lock
+  // exclusively); distances only read the faces, so any number of them run at once.
+  std::shared_lock<std::shared_mutex> lock_a(a.mutex, std::defer_lock);
+  std::shared_lock<std::shared_mutex> lock_b(b.mutex, std::defer_lock);
   if (&a == &b) lock_a.lock();
   else std::lock(lock_a, lock_b);
   try {
+    // Moved() shares the face's geometry and only composes the location: nothing is copied.
     const TopoDS_Shape fa = a.faces[local_a].Moved(TopLoc_Location(detail::to_trsf(pose_a)));
     const TopoDS_Shape fb = b.faces[local_b].Moved(TopLoc_Location(detail::to_trsf(pose_b)));
-    BRepExtrema_DistShapeShape dist(fa, fb, Extrema_ExtFlag_MIN);
-    if (!dist.IsDone() || dist.NbSolution() == 0) return std::nullopt;
-    return dist.Value();
+    return detail::min_distance(fa, fb);
   } catch (const Standard_Failure&) {
     return std::nullopt;
   }

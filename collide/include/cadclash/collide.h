@@ -144,6 +144,8 @@ class SurfaceSource {
   // Exact distance between this part's surface `local_a` placed by `pose_a` and `other`'s surface
   // `local_b` placed by `pose_b`, searching only up to `max_distance` (a value > max_distance means
   // "farther than that"). Returns nullopt when either side has no exact geometry.
+  // Called from several threads at once (exact verification runs pairs in parallel), also for the
+  // same parts: must be thread-safe.
   virtual std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a,
                                                const SurfaceSource& other, std::uint32_t local_b,
                                                const Pose& pose_b, double max_distance) const {

@@ -90,8 +90,10 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
                                    const TessellationOptions& options, bool lazy,
                                    std::vector<Diagnostic>& diagnostics, bool& complete);
 
-// The SurfaceSource of a B-rep part. Thread-safe across parts: each part has its own mutex, and
-// calls on one part serialise.
+// The SurfaceSource of a B-rep part. Thread-safe: each part has a shared mutex; triangulate() calls
+// on one part serialise, exact_distance() calls only read the faces and run concurrently.
+// exact_distance is BRepExtrema_DistShapeShape's value on the two placed faces, bit for bit (the
+// same sub-shape search, stopping once the distance is 0).
 class BrepSource final : public SurfaceSource {
  public:
   struct Impl;
