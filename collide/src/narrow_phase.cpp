@@ -6,10 +6,94 @@
 #include <array>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace cadclash::detail {
 namespace {
+
+// The normal of P's plane, unnormalised, as straddle measures heights with it.
+inline Vec3 facet_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) { return (p1 - p0).cross(p2 - p0); }
+
+// False when straddle(T, P) is 0 without clipping: P has no normal, or T's vertices, as their heights
+// are computed, do not lie strictly on both sides of P's plane. Clipping only shrinks the straddle,
+// so a triangle wholly on one side needs none. `n` = facet_normal(P), p0 its first vertex.
+inline bool may_straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& n) {
+  double up = 0.0, down = 0.0;
+  for (const Vec3* v : {&v0, &v1, &v2}) {
+    const double h = n.dot(*v - p0);
+    up = std::max(up, h);
+    down = std::max(down, -h);
+  }
+  return up > 0.0 && down > 0.0 && n.squaredNorm() > 0.0;  // the length, its root, is 0 exactly when this is
+}
+
+// straddle(T, P) for a pair may_straddle lets through (n = facet_normal(P)). Plain doubles in place
+// of Eigen's expressions, with the same operations in the same order: the result is the same to the
+// bit (test_crossing_depth compares it with Eigen's evaluation).
+double clipped_straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& p1,
+                        const Vec3& p2, const Vec3& n) {
+  struct P {
+    double x, y, z;
+  };
+  const double nx = n.x(), ny = n.y(), nz = n.z();
+  // Each clip adds at most one vertex: 3 + 3.
+  P buf[2][6];
+  buf[0][0] = {v0.x(), v0.y(), v0.z()};
+  buf[0][1] = {v1.x(), v1.y(), v1.z()};
+  buf[0][2] = {v2.x(), v2.y(), v2.z()};
+  P* poly = buf[0];
+  P* next = buf[1];
+  std::size_t np = 3;
+  const Vec3* corners[3] = {&p0, &p1, &p2};
+  for (int e = 0; e < 3 && np > 0; ++e) {
+    const Vec3& a = *corners[e];
+    const Vec3& b = *corners[(e + 1) % 3];
+    // The side plane through the edge, facing P: inward = n x (b - a).
+    const double wx = b.x() - a.x(), wy = b.y() - a.y(), wz = b.z() - a.z();
+    const double ix = ny * wz - nz * wy, iy = nz * wx - nx * wz, iz = nx * wy - ny * wx;
+    double d[6];
+    bool all_in = true;
+    for (std::size_t k = 0; k < np; ++k) {
+      d[k] = (ix * (poly[k].x - a.x()) + iy * (poly[k].y - a.y())) + iz * (poly[k].z - a.z());
+      all_in = all_in && d[k] >= 0.0;
+    }
+    if (all_in) continue;  // every vertex kept and no edge crosses: the polygon stays as it is
+    std::size_t nn = 0;
+    for (std::size_t k = 0; k < np; ++k) {
+      const std::size_t k1 = k + 1 == np ? 0 : k + 1;
+      const P& x = poly[k];
+      const P& y = poly[k1];
+      const double dx = d[k], dy = d[k1];
+      if (dx >= 0.0 && nn < 6) next[nn++] = x;
+      if ((dx >= 0.0) != (dy >= 0.0) && nn < 6) {
+        const double t = dx / (dx - dy);
+        next[nn++] = {x.x + (y.x - x.x) * t, x.y + (y.y - x.y) * t, x.z + (y.z - x.z) * t};
+      }
+    }
+    std::swap(poly, next);
+    np = nn;
+  }
+  // Heights are divided by len once, after the maxima: division by len > 0 is monotone in IEEE
+  // arithmetic, so max(h_k) / len equals max(h_k / len) (and 0 / len is 0). Not when a height
+  // overflowed: then each is divided as before.
+  double up = 0.0, down = 0.0;
+  double h[6];
+  for (std::size_t k = 0; k < np; ++k) {
+    h[k] = (nx * (poly[k].x - p0.x()) + ny * (poly[k].y - p0.y())) + nz * (poly[k].z - p0.z());
+    up = std::max(up, h[k]);
+    down = std::max(down, -h[k]);
+  }
+  const double len = n.norm();
+  if (up <= std::numeric_limits<double>::max() && down <= std::numeric_limits<double>::max())
+    return std::min(up, down) / len;
+  up = 0.0, down = 0.0;
+  for (std::size_t k = 0; k < np; ++k) {
+    up = std::max(up, h[k] / len);
+    down = std::max(down, -h[k] / len);
+  }
+  return std::min(up, down);
+}
 
 // How far the part of triangle T inside the normal prism of triangle P straddles P's plane: the
 // smaller of its largest heights above and below the plane; 0 when it stays on one side. Clipping to
@@ -17,43 +101,31 @@ namespace {
 // count, only what lies over (or under) P.
 double straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& p1,
                 const Vec3& p2) {
-  const Vec3 n = (p1 - p0).cross(p2 - p0);
-  const double len = n.norm();
-  if (!(len > 0.0)) return 0.0;
-  {  // Clipping only shrinks the straddle: a triangle wholly on one side needs no clipping.
-    double up = 0.0, down = 0.0;
-    for (const Vec3* v : {&v0, &v1, &v2}) {
-      const double h = n.dot(*v - p0);
-      up = std::max(up, h);
-      down = std::max(down, -h);
-    }
-    if (!(up > 0.0 && down > 0.0)) return 0.0;
+  const Vec3 n = facet_normal(p0, p1, p2);
+  return may_straddle(v0, v1, v2, p0, n) ? clipped_straddle(v0, v1, v2, p0, p1, p2, n) : 0.0;
+}
+
+// A box of the triangle-level sweep, copied out of the Aabb in sweep order.
+struct SweepBox {
+  double lo[3], hi[3];
+};
+
+std::vector<SweepBox> sweep_boxes(const std::vector<Aabb>& boxes, const std::vector<std::uint32_t>& order) {
+  std::vector<SweepBox> out(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const Aabb& b = boxes[order[i]];
+    out[i] = {{b.min().x(), b.min().y(), b.min().z()}, {b.max().x(), b.max().y(), b.max().z()}};
   }
-  // Each clip adds at most one vertex: 3 + 3.
-  std::array<Vec3, 6> poly{v0, v1, v2}, next;
-  std::size_t np = 3;
-  const Vec3* corners[3] = {&p0, &p1, &p2};
-  for (int e = 0; e < 3 && np > 0; ++e) {
-    const Vec3& a = *corners[e];
-    const Vec3 inward = n.cross(*corners[(e + 1) % 3] - a);  // side plane through the edge, facing P
-    std::size_t nn = 0;
-    for (std::size_t k = 0; k < np; ++k) {
-      const Vec3& x = poly[k];
-      const Vec3& y = poly[(k + 1) % np];
-      const double dx = inward.dot(x - a), dy = inward.dot(y - a);
-      if (dx >= 0.0 && nn < next.size()) next[nn++] = x;
-      if ((dx >= 0.0) != (dy >= 0.0) && nn < next.size()) next[nn++] = x + (y - x) * (dx / (dx - dy));
-    }
-    poly = next;
-    np = nn;
+  return out;
+}
+
+// boxes_within for two triangles' boxes (never empty: each holds its three finite vertices).
+inline bool sweep_within(const SweepBox& a, const SweepBox& b, double margin) {
+  for (int k = 0; k < 3; ++k) {
+    if (b.lo[k] - a.hi[k] > margin) return false;
+    if (a.lo[k] - b.hi[k] > margin) return false;
   }
-  double up = 0.0, down = 0.0;
-  for (std::size_t k = 0; k < np; ++k) {
-    const double h = n.dot(poly[k] - p0) / len;
-    up = std::max(up, h);
-    down = std::max(down, -h);
-  }
-  return std::min(up, down);
+  return true;
 }
 
 double max_magnitude(const std::vector<Aabb>& boxes) {
@@ -146,6 +218,12 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
   const bool want_distance = p.margin > 0.0;
   bool done = false;
   std::uint32_t polls = 0;
+  // Normals for the penetration-only tests below: A's is reused over the run of candidates with the
+  // same triangle of A, B's are kept once computed.
+  std::size_t normal_of = ~std::size_t{0};
+  Vec3 normal_a;
+  std::vector<Vec3> normals_b;
+  std::vector<char> have_normal_b;
   auto test = [&](std::size_t i, std::size_t j) {
     if (deadline != nullptr && (++polls & 255u) == 0 && deadline->expired()) {
       out.cut = true;
@@ -157,6 +235,35 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
     const Vec3& a1 = sa.mesh.vertices[ta[1]];
     const Vec3& a2 = sa.mesh.vertices[ta[2]];
     const auto& tb = p.tri_b[j];
+    if (out.intersecting && !all) {
+      // Once the run has an intersecting pair, another can change the outcome only by raising the
+      // penetration (the maximum crossing depth; deeper than tau ends the run). A pair whose crossing
+      // depth, computed exactly as crossing_depth does, does not exceed it is skipped without the
+      // intersection test: whether it intersects changes nothing. Most candidates of a contact are
+      // decided by the plane sides alone.
+      if (normal_of != i) {
+        normal_a = facet_normal(a0, a1, a2);
+        normal_of = i;
+      }
+      if (normals_b.empty()) {
+        normals_b.resize(p.lb.size());
+        have_normal_b.assign(p.lb.size(), 0);
+      }
+      if (!have_normal_b[j]) {
+        normals_b[j] = facet_normal(tb[0], tb[1], tb[2]);
+        have_normal_b[j] = 1;
+      }
+      const Vec3& normal_b = normals_b[j];
+      if (!may_straddle(a0, a1, a2, tb[0], normal_b) || !may_straddle(tb[0], tb[1], tb[2], a0, normal_a)) return;
+      const double over_b = clipped_straddle(a0, a1, a2, tb[0], tb[1], tb[2], normal_b);
+      if (!(over_b > out.penetration)) return;
+      const double depth = std::min(over_b, clipped_straddle(tb[0], tb[1], tb[2], a0, a1, a2, normal_a));
+      if (!(depth > out.penetration)) return;
+      if (!triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) return;
+      out.penetration = depth;
+      if (depth > p.tau) done = true;
+      return;
+    }
     if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
       out.intersecting = true;
       const double depth = crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]);
@@ -185,8 +292,9 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
         if (boxes_within(p.box_a[i], p.box_b[j], p.margin)) test(i, j);
       }
   } else {
-    // Sweep over x of A's survivors (grown by the margin) and B's; candidates then visited in the
-    // same (a, b) order as the flat loops, so both variants give the same answer.
+    // Sweep over x of A's survivors (grown by the margin) and B's; candidates are then visited in
+    // the same (a, b) order as the flat loops, so both variants give the same answer. The boxes are
+    // copied in sweep order so that the inner loops read memory in sequence.
     std::vector<std::uint32_t> oa(na), ob(nb);
     for (std::size_t i = 0; i < na; ++i) oa[i] = static_cast<std::uint32_t>(begin + i);
     for (std::size_t j = 0; j < nb; ++j) ob[j] = static_cast<std::uint32_t>(j);
@@ -198,30 +306,39 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
     };
     std::sort(oa.begin(), oa.end(), by_min_a);
     std::sort(ob.begin(), ob.end(), by_min_b);
+    const std::vector<SweepBox> sa_boxes = sweep_boxes(p.box_a, oa), sb_boxes = sweep_boxes(p.box_b, ob);
     std::vector<std::array<std::uint32_t, 2>> cand;
     std::size_t ia = 0, ib = 0;
     const double m = p.margin;
     while (ia < na && ib < nb) {
-      const Aabb& ba = p.box_a[oa[ia]];
-      const Aabb& bb = p.box_b[ob[ib]];
-      if (ba.min().x() - m <= bb.min().x()) {
-        for (std::size_t k = ib; k < nb && p.box_b[ob[k]].min().x() <= ba.max().x() + m; ++k) {
+      const SweepBox& ba = sa_boxes[ia];
+      const SweepBox& bb = sb_boxes[ib];
+      if (ba.lo[0] - m <= bb.lo[0]) {
+        for (std::size_t k = ib; k < nb && sb_boxes[k].lo[0] <= ba.hi[0] + m; ++k) {
           ++counters.aabb_tests;
-          if (boxes_within(ba, p.box_b[ob[k]], m)) cand.push_back({oa[ia], ob[k]});
+          if (sweep_within(ba, sb_boxes[k], m)) cand.push_back({oa[ia], ob[k]});
         }
         ++ia;
       } else {
-        for (std::size_t k = ia; k < na && p.box_a[oa[k]].min().x() - m <= bb.max().x(); ++k) {
+        for (std::size_t k = ia; k < na && sa_boxes[k].lo[0] - m <= bb.hi[0]; ++k) {
           ++counters.aabb_tests;
-          if (boxes_within(p.box_a[oa[k]], bb, m)) cand.push_back({oa[k], ob[ib]});
+          if (sweep_within(sa_boxes[k], bb, m)) cand.push_back({oa[k], ob[ib]});
         }
         ++ib;
       }
     }
-    std::sort(cand.begin(), cand.end());
-    for (const auto& c : cand) {
-      if (done) break;
-      test(c[0], c[1]);
+    // Visit in (a, b) order: a counting sort by A's triangle, then each triangle's few b's sorted.
+    std::vector<std::uint32_t> first(na + 1, 0), by_a(cand.size());
+    for (const auto& c : cand) ++first[c[0] - begin + 1];
+    for (std::size_t i = 0; i < na; ++i) first[i + 1] += first[i];
+    {
+      std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+      for (const auto& c : cand) by_a[fill[c[0] - begin]++] = c[1];
+    }
+    for (std::size_t i = 0; i < na && !done; ++i) {
+      const auto from = by_a.begin() + first[i], to = by_a.begin() + first[i + 1];
+      std::sort(from, to);
+      for (auto it = from; it != to && !done; ++it) test(begin + i, *it);
     }
   }
   counters.triangle_tests += stats.tests;

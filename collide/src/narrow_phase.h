@@ -41,6 +41,9 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
 
 // Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
 // Polls `deadline` (when given) every 256 triangle tests and stops with out.cut set once it expired.
+// EarlyExit mode: once the run has found an intersecting pair, a later candidate is tested for
+// intersection (and counted in triangle_tests) only if its crossing depth would raise the
+// penetration; the outcome is the same as testing every candidate (test_crossing_depth).
 void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
               const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
               const Deadline* deadline = nullptr);

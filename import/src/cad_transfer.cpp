@@ -89,6 +89,18 @@ void Transfer::discard_shapes() {
   loose_ids.clear();
 }
 
+void Transfer::set_loose(const TopoDS_Shape& faces, const FaceEntityMap& entities, std::string note) {
+  TopTools_IndexedMapOfShape map;
+  TopExp::MapShapes(faces, TopAbs_FACE, map);
+  loose = faces;
+  loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
+  for (Standard_Integer f = 1; f <= map.Extent(); ++f)
+    if (const auto it = entities.find(map(f).TShape().get()); it != entities.end())
+      loose_ids[static_cast<std::size_t>(f - 1)] = it->second.id;
+  loose_note = std::move(note);
+  complete = false;
+}
+
 Handle(TDocStd_Document) new_xcaf_document() {
   Handle(TDocStd_Document) doc;
   application()->NewDocument("BinXCAF", doc);

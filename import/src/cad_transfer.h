@@ -37,6 +37,9 @@ struct Transfer {
 
   // Closes the document and forgets the faces: for a transfer that failed or was cut short.
   void discard_shapes();
+
+  // Makes `faces` the loose faces, each tagged with its entity from `entities` (by TShape).
+  void set_loose(const TopoDS_Shape& faces, const FaceEntityMap& entities, std::string note);
 };
 
 // A new XCAF document that pack_transfer can store. Throws Standard_Failure if OCCT cannot make one.

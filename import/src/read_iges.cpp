@@ -14,8 +14,6 @@
 #include <TDocStd_Document.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XSControl_TransferReader.hxx>
-#include <TopExp.hxx>
-#include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS_Compound.hxx>
 #include <XSControl_WorkSession.hxx>
 
@@ -60,15 +58,9 @@ void transfer_roots_one_by_one(IGESCAFControl_Reader& reader, const EntityLabelF
   builder.MakeCompound(faces);
   for (Standard_Integer k = 1; k <= reader.NbShapes(); ++k) builder.Add(faces, reader.Shape(k));
   const Handle(XSControl_WorkSession) ws = reader.WS();
-  const FaceEntityMap tags = map_face_entities(ws->TransferReader()->TransientProcess(), describe_iges_face(label));
-  TopTools_IndexedMapOfShape map;
-  TopExp::MapShapes(faces, TopAbs_FACE, map);
-  result.loose = faces;
-  result.loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
-  for (Standard_Integer f = 1; f <= map.Extent(); ++f)
-    if (auto it = tags.find(map(f).TShape().get()); it != tags.end()) result.loose_ids[static_cast<std::size_t>(f - 1)] = it->second.id;
-  result.loose_note = "the file could not be transferred whole; " + std::to_string(made) + " of " + std::to_string(roots) +
-                      " root entities transferred on their own into loose faces of one part";
+  result.set_loose(faces, map_face_entities(ws->TransferReader()->TransientProcess(), describe_iges_face(label)),
+                   "the file could not be transferred whole; " + std::to_string(made) + " of " + std::to_string(roots) +
+                       " root entities transferred on their own into loose faces of one part");
 }
 
 // Marks of the child (isolated_run.h): the file was parsed.

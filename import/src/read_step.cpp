@@ -271,6 +271,17 @@ std::vector<Diagnostic> unit_context_problems(const std::string& text, const std
 
 using StepItems = Handle(StepRepr_HArray1OfRepresentationItem);
 
+// Leaves only `kept` (a subsequence of its items) in `rep`; no items at all when `kept` is empty.
+void keep_items(const Handle(StepRepr_Representation)& rep, const std::vector<Handle(StepRepr_RepresentationItem)>& kept) {
+  if (kept.size() == static_cast<std::size_t>(rep->Items()->Length())) return;
+  StepItems shorter;
+  if (!kept.empty()) {
+    shorter = new StepRepr_HArray1OfRepresentationItem(1, static_cast<Standard_Integer>(kept.size()));
+    for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
+  }
+  rep->SetItems(shorter);
+}
+
 // Whether the document holds at least one face: products without any mean the attempt gave nothing.
 bool has_faces(const Handle(TDocStd_Document)& doc) {
   TDF_LabelSequence free;
@@ -370,15 +381,8 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
                                                  out.id = label(entity);
                                                  return true;
                                                });
-  TopTools_IndexedMapOfShape map;
-  TopExp::MapShapes(faces, TopAbs_FACE, map);
-  result.loose = faces;
-  result.loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
-  for (Standard_Integer f = 1; f <= map.Extent(); ++f)
-    if (auto it = tags.find(map(f).TShape().get()); it != tags.end()) result.loose_ids[static_cast<std::size_t>(f - 1)] = it->second.id;
-  result.loose_note = why + "; " + std::to_string(made) + " of " + std::to_string(tried) +
-                      " face entities recovered as loose faces of one part";
-  result.complete = false;
+  result.set_loose(faces, tags, why + "; " + std::to_string(made) + " of " + std::to_string(tried) +
+                                    " face entities recovered as loose faces of one part");
 }
 
 // Takes out of the model, before the transfer, every face of a shell and then every item of a shape
@@ -428,13 +432,7 @@ void drop_broken_shapes(const Handle(StepData_StepModel)& model, const EntityLab
       if (broken == 0) kept.push_back(items->Value(i));
       else report(items->Value(i), broken, "shape representation #" + std::to_string(label(rep)));
     }
-    if (kept.size() == static_cast<std::size_t>(items->Length())) continue;
-    StepItems shorter;
-    if (!kept.empty()) {
-      shorter = new StepRepr_HArray1OfRepresentationItem(1, static_cast<Standard_Integer>(kept.size()));
-      for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
-    }
-    rep->SetItems(shorter);
+    keep_items(rep, kept);
   }
   if (dropped > 40)
     result.diagnostics.push_back({Severity::Error, path, 0, -1, std::to_string(dropped - 40) + " more entities dropped"});
@@ -522,13 +520,7 @@ void cut_deep_mapped_items(const Handle(StepData_StepModel)& model, const Entity
     std::vector<Handle(StepRepr_RepresentationItem)> kept;
     for (Standard_Integer i = items->Lower(); i <= items->Upper(); ++i)
       if (!cut.count(dynamic_cast<const StepRepr_MappedItem*>(items->Value(i).get()))) kept.push_back(items->Value(i));
-    if (kept.size() == static_cast<std::size_t>(items->Length())) continue;
-    StepItems shorter;
-    if (!kept.empty()) {
-      shorter = new StepRepr_HArray1OfRepresentationItem(1, static_cast<Standard_Integer>(kept.size()));
-      for (std::size_t i = 0; i < kept.size(); ++i) shorter->SetValue(static_cast<Standard_Integer>(i) + 1, kept[i]);
-    }
-    rep->SetItems(shorter);
+    keep_items(rep, kept);
   }
 }
 

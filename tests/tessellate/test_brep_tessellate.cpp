@@ -1,5 +1,6 @@
 // B-rep tessellation on shapes built here: deflection honoured, outward winding, presets, lazy
 // triangles, refinement, concurrent requests, exact distances.
+#include "built_parts.h"
 #include "cadclash/tessellate.h"
 
 #include <BRepBuilderAPI_MakeVertex.hxx>
@@ -24,24 +25,10 @@
 namespace cadclash {
 namespace {
 
-struct Built {
-  Model model;
-  std::vector<Diagnostic> diagnostics;
-  bool complete = true;
-};
+using testing::Built;
 
 Built build(const std::vector<TopoDS_Shape>& shapes, const TessellationOptions& options, bool lazy) {
-  Built b;
-  std::vector<BrepPartInput> inputs;
-  for (std::size_t i = 0; i < shapes.size(); ++i) {
-    BrepPartInput in;
-    in.shape = &shapes[i];
-    in.name = "shape" + std::to_string(i);
-    in.source_file = "built-in";
-    inputs.push_back(std::move(in));
-  }
-  add_brep_parts(b.model, inputs, options, lazy, b.diagnostics, b.complete);
-  return b;
+  return testing::build_parts(shapes, options, lazy);
 }
 
 // Distance from p to the face: the interior foot point from BRepExtrema_ExtPF when there is one,

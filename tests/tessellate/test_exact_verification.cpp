@@ -2,6 +2,7 @@
 // BrepSource::exact_distance reports is OCCT's BRepExtrema_DistShapeShape value bit for bit, the
 // verified report is byte-identical for 1, 2 and 4 threads (the distances run in parallel), and a
 // pair whose triangles touch but whose exact faces are apart gets its exact distance measured.
+#include "built_parts.h"
 #include "cadclash/collide.h"
 #include "cadclash/import.h"
 #include "cadclash/tessellate.h"
@@ -29,22 +30,11 @@ namespace cadclash {
 namespace {
 
 Model build(const std::vector<TopoDS_Shape>& shapes, double deflection = 0.1) {
-  Model m;
-  std::vector<BrepPartInput> inputs;
-  for (std::size_t i = 0; i < shapes.size(); ++i) {
-    BrepPartInput in;
-    in.shape = &shapes[i];
-    in.name = "shape" + std::to_string(i);
-    in.source_file = "built-in";
-    inputs.push_back(std::move(in));
-  }
   TessellationOptions t;
   t.linear_deflection = deflection;
-  std::vector<Diagnostic> diagnostics;
-  bool complete = true;
-  add_brep_parts(m, inputs, t, false, diagnostics, complete);
-  EXPECT_TRUE(complete);
-  return m;
+  testing::Built b = testing::build_parts(shapes, t, false);
+  EXPECT_TRUE(b.complete);
+  return std::move(b.model);
 }
 
 Pose placed(const Vec3& offset, double angle_z = 0.0, double angle_x = 0.0) {

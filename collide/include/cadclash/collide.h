@@ -279,7 +279,9 @@ struct CollideCounters {
   std::uint64_t surface_pairs = 0;        // candidate surface pairs (boxes overlap)
   std::uint64_t triangles_a = 0;          // mpSk: triangles of Sk surviving the surface-pair OAABB
   std::uint64_t triangles_b = 0;          // mpSl
-  std::uint64_t triangle_tests = 0;       // exact triangle intersection tests
+  std::uint64_t triangle_tests = 0;       // exact triangle intersection tests (EarlyExit: after a surface
+                                          // pair's first intersecting triangle pair, only pairs whose
+                                          // crossing depth could raise its penetration are tested)
   std::uint64_t exact_fallbacks = 0;      // tests the float filter could not decide
   std::uint64_t distance_tests = 0;       // triangle distance computations
   std::uint64_t intersecting_pairs = 0;   // surface pairs with at least one intersecting triangle pair
