@@ -17,7 +17,7 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
       ->check(CLI::IsMember({"coarse", "normal", "fine", "very-fine"}));
   cmd.add_flag("--lazy", in.lazy, "Tessellate B-rep faces only when a query needs them");
   cmd.add_flag("--no-isolation", in.no_isolation,
-               "Read STEP/IGES/BREP in this process, not in a child (a few % faster; a file that crashes OCCT then ends the program)");
+               "Read STEP/IGES/BREP in this process, not in a child (faster import; a file that crashes OCCT then ends the program)");
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
   cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
