@@ -1,12 +1,22 @@
-// Entry of the clash viewer: reads the report embedded in the page, draws it, wires the table.
+// Entry of the clash viewer: reads the report embedded in the page, draws it, wires the table,
+// the filter and the keys.
 //
 // When everything is drawn the page sets <html data-cadclash-ready="1"> (or data-cadclash-error)
 // and exposes window.cadclashViewer for scripted checks (tests/viewer) and load-time measurements.
+// <html data-cadclash-filter> holds the filter text last applied (the box applies it after a pause
+// in typing) and data-cadclash-selected the selected pair's index.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { assertLittleEndian } from './decode.js';
 import { ClashScene } from './scene.js';
-import { fillLegend, fillTable, showSelection } from './panel.js';
+import { fillClassToggles, fillLegend, showClassCounts, showSelection } from './panel.js';
+import { PairFilter } from './filter.js';
+import { PairTable } from './pairtable.js';
+import { CLASSES } from './classes.js';
+
+// Pause in typing before the filter applies: one pass over 60 000 pairs is cheap, but redrawing a
+// big scene (the 3D view colours only the listed pairs) is not.
+const FILTER_DELAY_MS = 150;
 
 const VIEW_DIRECTION = new THREE.Vector3(1, -1.3, 0.9).normalize();  // isometric-like, z up
 
@@ -96,17 +106,12 @@ function start() {
   controls.target.set(0, 0, 0);
   fitCamera(camera, controls, sceneBox);
 
-  const table = document.getElementById('pairs');
-  const tbody = table.querySelector('tbody');
   const panel = document.getElementById('selection');
-  const counts = {};
-  for (const p of data.pairs) counts[p.class] = (counts[p.class] || 0) + 1;
   document.getElementById('title').textContent = data.files.join(', ');
   document.getElementById('summary').textContent =
     `${data.pairs.length} pairs · ${data.instances.length} instances · ${data.parts.length} parts · ` +
     `${data.surfaces.length} surfaces · ${clash.triangles.toLocaleString('en')} triangles drawn`;
-  fillTable(tbody, data);
-  fillLegend(document.getElementById('legend'), table, counts, ({ context }) => {
+  fillLegend(document.getElementById('legend'), ({ context }) => {
     showContext = context;
     requestDraw();
   });
@@ -119,27 +124,110 @@ function start() {
     err.textContent = warnings.join('\n');
   }
 
-  let selectedRow = null;
+  let selected = -1, fullDrawTimer = 0;
+  const table = new PairTable(document.getElementById('pairs-wrap'), document.getElementById('pairs'), data,
+                              (index) => selectPair(index));
+  function frameSelected() {
+    if (selected < 0) return;
+    const pair = data.pairs[selected];
+    const box = clash.worldBox(pair.instance_a, pair.surface_a).union(clash.worldBox(pair.instance_b, pair.surface_b));
+    fitCamera(camera, controls, box);
+    // Show the framed pair at once (light frame on a slow scene), then everything; a key held down
+    // steps through pairs with light frames only, the full one follows the last.
+    dragging = true;
+    requestDraw();
+    clearTimeout(fullDrawTimer);
+    fullDrawTimer = setTimeout(() => { dragging = false; requestDraw(); }, 100);
+  }
   function selectPair(index) {
     const pair = data.pairs[index];
     if (!pair) throw new RangeError(`no pair ${index}`);
-    if (selectedRow) selectedRow.classList.remove('selected');
-    selectedRow = tbody.children[index];
-    selectedRow.classList.add('selected');
-    selectedRow.scrollIntoView({ block: 'nearest' });
+    selected = index;
+    table.setSelected(index);
+    table.scrollToPair(index);
     clash.select(pair);
-    const box = clash.worldBox(pair.instance_a, pair.surface_a).union(clash.worldBox(pair.instance_b, pair.surface_b));
-    fitCamera(camera, controls, box);
     showSelection(panel, data, index);
     document.documentElement.dataset.cadclashSelected = String(index);
-    // Show the framed pair at once (light frame on a slow scene), then everything.
-    dragging = true;
-    requestDraw();
-    setTimeout(() => { dragging = false; requestDraw(); }, 100);
+    frameSelected();
   }
-  tbody.addEventListener('click', (e) => {
-    const tr = e.target.closest('tr');
-    if (tr) selectPair(Number(tr.dataset.index));
+
+  // The filter: text box and class toggles above the table.
+  const filter = new PairFilter(data);
+  const filterBox = document.getElementById('filter');
+  const toggles = document.getElementById('class-toggles');
+  const filterCount = document.getElementById('filter-count');
+  let shownClasses = Object.fromEntries(CLASSES.map((c) => [c, true]));
+  let filterTimer = 0;
+  function applyFilter() {
+    clearTimeout(filterTimer);
+    filterTimer = 0;
+    const { indices, counts } = filter.apply(filterBox.value, shownClasses);
+    table.setRows(indices);
+    if (selected >= 0) table.scrollToPair(selected);
+    showClassCounts(toggles, counts);
+    const all = data.pairs.length;
+    filterCount.textContent = `${indices.length.toLocaleString('en')} of ${all.toLocaleString('en')} pairs`;
+    clash.showOnly(indices.length === all ? null : indices);
+    requestDraw();
+    document.documentElement.dataset.cadclashFilter = filterBox.value;
+  }
+  filterBox.addEventListener('input', () => {
+    clearTimeout(filterTimer);
+    filterTimer = setTimeout(applyFilter, FILTER_DELAY_MS);
+  });
+  fillClassToggles(toggles, (shown) => {
+    shownClasses = shown;
+    applyFilter();
+  });
+  applyFilter();
+
+  // Moves the selection by `step` listed rows (from the nearest listed row when the selected pair
+  // is filtered out, from the first or last row when none is selected).
+  function moveSelection(step) {
+    const n = table.rows.length;
+    if (!n) return;
+    let pos;
+    if (selected < 0) pos = step > 0 ? 0 : n - 1;
+    else {
+      const at = table.positionOf(selected);
+      if (at >= 0) pos = at + step;
+      else {
+        const next = table.insertionPoint(selected);  // first listed row after the selection
+        pos = step > 0 ? next + step - 1 : next + step;
+      }
+    }
+    selectPair(table.rows[Math.min(Math.max(pos, 0), n - 1)]);
+  }
+  document.addEventListener('keydown', (e) => {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.target === filterBox) {
+      if (e.key === 'Escape') {
+        filterBox.value = '';
+        applyFilter();
+      } else if (e.key === 'Enter') {
+        // Done typing: apply now, leave the box so the keys below work, and frame the selected
+        // pair, or the first listed one when the filter hides the selection.
+        if (filterTimer) applyFilter();
+        filterBox.blur();
+        if (table.positionOf(selected) >= 0) frameSelected();
+        else if (table.rows.length) selectPair(table.rows[0]);
+      } else {
+        return;
+      }
+      e.preventDefault();
+      return;
+    }
+    const t = e.target;
+    if (t.isContentEditable || t.tagName === 'TEXTAREA' || t.tagName === 'SELECT' ||
+        (t.tagName === 'INPUT' && !['checkbox', 'radio', 'button'].includes(t.type))) return;
+    switch (e.key) {
+      case 'ArrowDown': case 'j': moveSelection(1); break;
+      case 'ArrowUp': case 'k': moveSelection(-1); break;
+      case 'Enter': case 'f': frameSelected(); break;
+      case '/': filterBox.focus(); filterBox.select(); break;
+      default: return;
+    }
+    e.preventDefault();
   });
 
   draw();
@@ -151,6 +239,7 @@ function start() {
 
   window.cadclashViewer = {
     stats: {
+      pairs: data.pairs.length,
       triangles: clash.triangles,
       drawCalls: clash.drawCalls,
       parseMs: tParsed - t0,
@@ -160,6 +249,8 @@ function start() {
       readyMs: tReady,  // since navigation start: includes reading and parsing the HTML file
     },
     selectPair,
+    // Scrolls the table to a listed pair's row (false when the filter hides it).
+    scrollToPair: (index) => table.scrollToPair(index),
     // Fits the whole assembly in view (the selection stays).
     frameAll() {
       fitCamera(camera, controls, sceneBox);
@@ -200,6 +291,25 @@ function start() {
       };
       const full = time(false);
       return { fullMs: full, draggingMs: time(true) };
+    },
+    // How long applying a filter text takes (list, table, counts, 3D colours), then its full frame.
+    timeFilter(text) {
+      filterBox.value = text;
+      const start = performance.now();
+      applyFilter();
+      const applied = performance.now();
+      dragging = false;
+      draw();
+      syncGpu();
+      return { filterMs: applied - start, drawMs: performance.now() - applied, listed: table.rows.length };
+    },
+    // How long one Down key takes, up to the selected pair's first frame drawn.
+    timeKeyDown() {
+      const start = performance.now();
+      document.body.dispatchEvent(new KeyboardEvent('keydown', { key: 'ArrowDown', bubbles: true }));
+      draw();
+      syncGpu();
+      return performance.now() - start;
     },
     // How long selecting a pair takes, up to its first frame drawn (light on a slow scene).
     timeSelect(index) {

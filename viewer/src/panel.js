@@ -1,5 +1,5 @@
-// The pair table and the selection panel (plain DOM).
-import { CLASSES, distanceText, formatNumber } from './classes.js';
+// The legend, the class toggles above the table and the selection panel (plain DOM).
+import { CLASSES, formatNumber } from './classes.js';
 
 export function escapeHtml(text) {
   return String(text).replace(/[&<>"']/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;' })[c]);
@@ -12,35 +12,32 @@ export function surfaceLabel(surface) {
   return surface.source_name || surface.name;
 }
 
-function sideCell(data, instanceId, surfaceId) {
-  const inst = data.instances[instanceId];
-  const part = data.parts[inst.part];
-  const surface = surfaceId >= 0 ? data.surfaces[surfaceId] : null;
-  return `<b>${escapeHtml(surfaceLabel(surface))}</b> ${escapeHtml(part.name)}<br>` +
-         `<span class="muted">${escapeHtml(inst.path)}</span>`;
-}
-
-// Fills the table body in one go (a string is far faster than nodes for thousands of rows).
-export function fillTable(tbody, data) {
-  const rows = data.pairs.map((p, i) =>
-    `<tr class="${p.class}" data-index="${i}"><td class="num">${i + 1}</td>` +
-    `<td class="cls"><span class="chip"></span>${p.class}</td><td class="num">${distanceText(p)}</td>` +
-    `<td>${sideCell(data, p.instance_a, p.surface_a)}</td><td>${sideCell(data, p.instance_b, p.surface_b)}</td></tr>`);
-  tbody.innerHTML = rows.join('');
-}
-
-// Legend with one checkbox per class that hides that class's rows.
-export function fillLegend(legend, table, counts, onChange) {
-  const items = CLASSES.map((c) =>
-    `<label class="${c}"><input type="checkbox" data-class="${c}" checked><span class="chip"></span>${c} (${counts[c] || 0})</label>`);
+// The colour key over the 3D view, with the box that hides the grey context.
+export function fillLegend(legend, onChange) {
+  const items = CLASSES.map((c) => `<span class="${c}"><span class="chip"></span>${c}</span>`);
   items.push('<label><input type="checkbox" id="show-context" checked>other surfaces</label>');
-  items.push('<label><span class="chip selA"></span>A</label><label><span class="chip selB"></span>B</label>');
+  items.push('<span><span class="chip selA"></span>A</span><span><span class="chip selB"></span>B</span>');
   legend.innerHTML = items.join('');
   legend.addEventListener('change', (e) => {
-    const cls = e.target.dataset.class;
-    if (cls) table.classList.toggle('hide-' + cls, !e.target.checked);
-    else if (e.target.id === 'show-context') onChange({ context: e.target.checked });
+    if (e.target.id === 'show-context') onChange({ context: e.target.checked });
   });
+}
+
+// One checkbox per class above the table; onChange(shown) gets {class: checked}.
+export function fillClassToggles(box, onChange) {
+  box.innerHTML = CLASSES.map((c) =>
+    `<label class="${c}" title="list ${c} pairs"><input type="checkbox" data-class="${c}" checked>` +
+    `<span class="chip"></span>${c} <span class="count" data-count="${c}"></span></label>`).join('');
+  box.addEventListener('change', () => {
+    const shown = {};
+    for (const input of box.querySelectorAll('input[data-class]')) shown[input.dataset.class] = input.checked;
+    onChange(shown);
+  });
+}
+
+// How many pairs of each class match the filter text.
+export function showClassCounts(box, counts) {
+  for (const c of CLASSES) box.querySelector(`[data-count="${c}"]`).textContent = (counts[c] || 0).toLocaleString('en');
 }
 
 function sideRows(data, label, instanceId, surfaceId) {

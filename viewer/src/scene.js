@@ -104,24 +104,29 @@ export class ClashScene {
     return inner.length ? inner : [pair.instance_a, pair.instance_b];
   }
 
+  // Calls mark(instance, surface) for every surface a pair colours.
+  forPairSurfaces(index, mark) {
+    const p = this.data.pairs[index];
+    if (p.class === 'containment' && (p.surface_a < 0 || p.surface_b < 0)) {
+      if (!this.inner.has(index)) this.inner.set(index, this.innerInstances(p));
+      for (const inst of this.inner.get(index)) {
+        const part = this.data.parts[this.data.instances[inst].part];
+        for (let s = 0; s < part.surface_count; ++s) mark(inst, part.first_surface + s);
+      }
+      return;
+    }
+    mark(p.instance_a, p.surface_a);
+    mark(p.instance_b, p.surface_b);
+  }
+
   buildHighlights() {
+    this.inner = new Map();  // containment pair -> its inner instances
     // Most severe class per (instance, surface).
     const worst = new Map();
-    const mark = (instance, surface, cls) => {
+    this.data.pairs.forEach((p, i) => this.forPairSurfaces(i, (instance, surface) => {
       const key = instance + ':' + surface;
-      worst.set(key, moreSevere(worst.get(key), cls));
-    };
-    for (const p of this.data.pairs) {
-      if (p.class === 'containment' && (p.surface_a < 0 || p.surface_b < 0)) {
-        for (const inst of this.innerInstances(p)) {
-          const part = this.data.parts[this.data.instances[inst].part];
-          for (let s = 0; s < part.surface_count; ++s) mark(inst, part.first_surface + s, p.class);
-        }
-        continue;
-      }
-      mark(p.instance_a, p.surface_a, p.class);
-      mark(p.instance_b, p.surface_b, p.class);
-    }
+      worst.set(key, moreSevere(worst.get(key), p.class));
+    }));
     // Group by (surface, class) so instances of one part share a draw call.
     const groups = new Map();
     for (const [key, cls] of worst) {
@@ -137,10 +142,37 @@ export class ClashScene {
       const mesh = new THREE.InstancedMesh(g, this.classMaterials[cls], instances.length);
       instances.sort((x, y) => x - y).forEach((inst, k) => mesh.setMatrixAt(k, this.matrices[inst]));
       mesh.computeBoundingSphere();
+      mesh.userData = { surface, instances };
       this.highlights.add(mesh);
       ++this.drawCalls;
     }
     this.root.add(this.highlights);
+  }
+
+  // Colours only the surfaces of the listed pairs (null: all); the others are drawn as context.
+  // An unlisted copy is scaled to nothing rather than removed, so the buffers keep their size.
+  // A surface keeps the colour of its most severe pair, listed or not.
+  showOnly(listed) {
+    if (listed === null && !this.filtered) return;
+    const surfaces = this.data.surfaces.length + 1;  // + 1: surface -1 (whole part) maps to 0
+    let keep = null;
+    if (listed !== null) {
+      keep = new Set();
+      for (const i of listed) this.forPairSurfaces(i, (inst, surf) => keep.add(inst * surfaces + surf + 1));
+    }
+    const hidden = new THREE.Matrix4().makeScale(0, 0, 0);
+    for (const mesh of this.highlights.children) {
+      const { surface, instances } = mesh.userData;
+      let shown = 0;
+      instances.forEach((inst, k) => {
+        const on = keep === null || keep.has(inst * surfaces + surface + 1);
+        mesh.setMatrixAt(k, on ? this.matrices[inst] : hidden);
+        if (on) ++shown;
+      });
+      mesh.instanceMatrix.needsUpdate = true;
+      mesh.visible = shown > 0;
+    }
+    this.filtered = listed !== null;
   }
 
   surfaceGeometry(surfaceId) {
