@@ -23,7 +23,7 @@ namespace {
 using cadclash::Vec3;
 using cadclash::test::Tri;
 
-enum class Mode { Raw, Lattice, PlaneLattice, ScaledLattice, Count };
+enum class Mode { Raw, Lattice, PlaneLattice, ScaledLattice, ExtremeLattice, Count };
 
 Vec3 lattice_vec(FuzzedDataProvider& in, int r) {
   return {double(in.ConsumeIntegralInRange(-r, r)), double(in.ConsumeIntegralInRange(-r, r)),
@@ -50,6 +50,7 @@ std::array<Vec3, 6> decode(FuzzedDataProvider& in) {
       return p;
     case Mode::Lattice:
     case Mode::ScaledLattice:
+    case Mode::ExtremeLattice:
       for (Vec3& v : p) v = lattice_vec(in, 4);
       break;
     case Mode::PlaneLattice: {
@@ -59,7 +60,12 @@ std::array<Vec3, 6> decode(FuzzedDataProvider& in) {
     }
     case Mode::Count: break;
   }
-  if (mode == Mode::ScaledLattice || in.ConsumeBool()) {
+  if (mode == Mode::ExtremeLattice) {
+    // Anywhere in the double range, down to subnormal lattice steps: squares and products of
+    // coordinates leave the range there (the distance once lost 3 x 2^-1074 to an underflow).
+    const double s = std::ldexp(1.0, in.ConsumeIntegralInRange(-1074, 1000));
+    for (Vec3& v : p) v = v * s;
+  } else if (mode == Mode::ScaledLattice || in.ConsumeBool()) {
     // Power-of-two scale and an integer shift: exact, so the lattice's coplanarity survives.
     const double s = std::ldexp(1.0, in.ConsumeIntegralInRange(-40, 40));
     const Vec3 t = lattice_vec(in, 1) * std::ldexp(1.0, in.ConsumeIntegralInRange(0, 40));
@@ -104,18 +110,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (triangles_within(a0, a1, a2, b0, b1, b2, 0.0, stats) != expected) fail("triangles_within(d = 0) disagrees with the oracle", p);
   // "True iff triangle_distance <= d": the early outs must never contradict the distance. Checked a
   // little away from d, by 2^-40 of d plus 2^-44 of the pair's extent (the scale of the distance's
-  // documented error): exactly at d, triangles_within can say false, e.g. for a touching pair 1e13
-  // across whose distance rounds to the smallest subnormal (reported to collide/ as a contract gap).
-  // CADCLASH_FUZZ_SKIP_WITHIN=1 skips these checks (triangles_within has known false negatives on
-  // slivers, reported to collide/; the intersection checks above still run).
-  static const bool skip_within = std::getenv("CADCLASH_FUZZ_SKIP_WITHIN") != nullptr;
-  if (skip_within) return 0;
+  // documented error) and at least one ulp of d: exactly at d, triangles_within can say false, e.g.
+  // for a touching pair 1e13 across whose distance rounds to the smallest subnormal.
   double extent = 0;
   for (const Vec3& v : p) extent = std::max(extent, (v - a0).cwiseAbs().maxCoeff());
   const double margin = std::ldexp(d, -40) + std::ldexp(extent, -44);
-  if (std::isfinite(d) && !triangles_within(a0, a1, a2, b0, b1, b2, d + margin, stats))
+  const double above = std::max(d + margin, std::nextafter(d, HUGE_VAL));
+  const double below = std::min(d - margin, std::nextafter(d, 0.0));
+  if (std::isfinite(d) && !triangles_within(a0, a1, a2, b0, b1, b2, above, stats))
     fail("triangles_within(d just above triangle_distance) is false", p, d);
-  if (d > 0 && std::isfinite(d) && triangles_within(a0, a1, a2, b0, b1, b2, d - margin, stats))
+  if (d > 0 && std::isfinite(d) && triangles_within(a0, a1, a2, b0, b1, b2, below, stats))
     fail("triangles_within(d just below triangle_distance) is true", p, d);
   return 0;
 }

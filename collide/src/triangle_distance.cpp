@@ -94,15 +94,9 @@ inline double point_face2(const P3& p, const Face& f) {
   return norm2(w - (l1 * f.e1 + l2 * f.e2));
 }
 
-// Squared distance between the closed triangles, assuming they do not intersect. Stops as soon as
-// a candidate is <= stop2 (returning that candidate).
-double disjoint_distance2(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
-                          const Vec3& b1, const Vec3& b2, double stop2) {
-  // Work relative to a0 so that the error scales with the triangles' extent, not their position.
-  const P3 o{a0.x(), a0.y(), a0.z()};
-  const P3 A[3] = {{0.0, 0.0, 0.0}, P3{a1.x(), a1.y(), a1.z()} - o, P3{a2.x(), a2.y(), a2.z()} - o};
-  const P3 B[3] = {P3{b0.x(), b0.y(), b0.z()} - o, P3{b1.x(), b1.y(), b1.z()} - o,
-                   P3{b2.x(), b2.y(), b2.z()} - o};
+// Squared distance between the closed triangles given relative to a0 (A[0] = 0), assuming they do
+// not intersect. Stops as soon as a candidate is <= stop2 (returning that candidate).
+double disjoint_distance2_relative(const P3 (&A)[3], const P3 (&B)[3], double stop2) {
   const Edge ea[3] = {make_edge(A[0], A[1]), make_edge(A[1], A[2]), make_edge(A[2], A[0])};
   const Edge eb[3] = {make_edge(B[0], B[1]), make_edge(B[1], B[2]), make_edge(B[2], B[0])};
   double best = std::numeric_limits<double>::infinity();
@@ -124,6 +118,47 @@ double disjoint_distance2(const Vec3& a0, const Vec3& a1, const Vec3& a2, const 
   if (fb.proper)
     for (const P3& v : A) best = std::min(best, point_face2(v, fb));
   return best;
+}
+
+// Disjoint closed sets are at a positive distance: keep "0 iff intersecting" even if it rounds.
+inline double positive(double d) { return std::max(d, std::numeric_limits<double>::denorm_min()); }
+
+// Distance between the closed triangles, assuming they do not intersect; stops as soon as a
+// candidate is clearly <= stop (see triangles_within). Works relative to a0 so that the error
+// scales with the triangles' extent, not their position. The candidates square lengths and the
+// face and edge–edge terms take fourth powers, so a pair whose extent is far from 1 (fuzz_triangles
+// found two points 3 x 2^-1074 apart whose squared distance underflowed to 0) is first scaled by a
+// power of two to an extent near 1: exact, so nothing but the range changes, and pairs already in
+// range are computed exactly as before.
+double disjoint_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                         const Vec3& b1, const Vec3& b2, double stop) {
+  const Vec3* in[6] = {&a0, &a1, &a2, &b0, &b1, &b2};
+  P3 R[6];
+  double ext = 0.0;
+  auto relative = [&](double pre) {
+    const P3 o = pre * load(a0);
+    ext = 0.0;
+    for (int i = 0; i < 6; ++i) {
+      R[i] = pre * load(*in[i]) - o;
+      ext = std::max({ext, std::abs(R[i].x), std::abs(R[i].y), std::abs(R[i].z)});
+    }
+  };
+  // A difference of finite coordinates overflows only beyond DBL_MAX / 2; a quarter of them cannot,
+  // and dividing by 4 is exact except below the normal range, where it costs nothing at that extent.
+  double pre = 1.0;
+  relative(pre);
+  if (!(ext <= std::numeric_limits<double>::max())) relative(pre = 0.25);
+  int shift = 0;  // the result is scaled by 2^shift / pre
+  if (ext > 0.0 && (ext < 0x1p-200 || ext > 0x1p200)) {
+    shift = std::ilogb(ext);
+    // Per component: 2^-shift itself is out of range for a subnormal extent.
+    for (P3& r : R) r = {std::ldexp(r.x, -shift), std::ldexp(r.y, -shift), std::ldexp(r.z, -shift)};
+  }
+  // Powers of two throughout, applied in an order that overflows only when the value itself does.
+  const double stop_scaled = std::ldexp(stop * pre, -shift);
+  const double stop2 = stop_scaled * stop_scaled * (1.0 - 0x1p-50);
+  const P3 A[3] = {R[0], R[1], R[2]}, B[3] = {R[3], R[4], R[5]};
+  return positive(std::ldexp(std::sqrt(disjoint_distance2_relative(A, B, stop2)), shift) / pre);
 }
 
 // True when every vertex of (q0, q1, q2) is certainly farther than d from the plane of
@@ -170,17 +205,13 @@ bool plane_separates(const P3& p0, const P3& p1, const P3& p2, const P3& q0, con
   return true;
 }
 
-// Disjoint closed sets are at a positive distance: keep "0 iff intersecting" even if it rounds.
-inline double positive_sqrt(double d2) {
-  return std::max(std::sqrt(d2), std::numeric_limits<double>::denorm_min());
-}
 
 }  // namespace
 
 double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                          const Vec3& b1, const Vec3& b2, TrianglePredicateStats& stats) {
   if (triangles_intersect(a0, a1, a2, b0, b1, b2, stats)) return 0.0;
-  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, 0.0));
+  return disjoint_distance(a0, a1, a2, b0, b1, b2, 0.0);
 }
 
 double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
@@ -191,7 +222,7 @@ double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
 
 double triangle_distance_apart(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                                const Vec3& b1, const Vec3& b2) {
-  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, 0.0));
+  return disjoint_distance(a0, a1, a2, b0, b1, b2, 0.0);
 }
 
 bool triangles_within(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
@@ -215,10 +246,9 @@ bool triangles_within(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3
                         plane_separates(B[0], B[1], B[2], A[0], A[1], A[2], d)))
     return false;
   if (triangles_intersect(a0, a1, a2, b0, b1, b2, stats)) return true;
-  // Stop early only when the candidate is clearly below d^2, so that the answer is the one
-  // triangle_distance(...) <= d gives, to the last bit.
-  const double stop2 = d * d * (1.0 - 0x1p-50);
-  return positive_sqrt(disjoint_distance2(a0, a1, a2, b0, b1, b2, stop2)) <= d;
+  // Stop early only when the candidate is clearly below d (squared, less 2^-50), so that the answer
+  // is the one triangle_distance(...) <= d gives, to the last bit.
+  return disjoint_distance(a0, a1, a2, b0, b1, b2, d) <= d;
 }
 
 }  // namespace cadclash::detail

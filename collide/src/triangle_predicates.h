@@ -51,7 +51,8 @@ bool triangles_intersect_exact(const Vec3& a0, const Vec3& a1, const Vec3& a2,
 // 1e-15 x extent against a long-double reference). Every candidate is the distance between two
 // points of the triangles, so slivers and nearly parallel edges cannot make it too small.
 // Disjoint triangles get a result > 0 even if it rounds to below the smallest normal double.
-// Degenerate triangles are measured as the segments or points they are.
+// Degenerate triangles are measured as the segments or points they are. Holds over the whole double
+// range: pairs far below or above an extent of 1 are scaled by a power of two first (exact).
 // Precondition: all coordinates are finite.
 double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2,
                          const Vec3& b0, const Vec3& b1, const Vec3& b2);

@@ -208,10 +208,9 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, const 
   out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); });
   std::string why;
   if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
-  out.warning = Diagnostic{Severity::Warning, path, 0, -1,
-                           (out.child.isolated ? "the isolated reader's result could not be read back (" + why + ")"
-                                               : "could not start an isolated reader (" + out.child.how + ")") +
-                               "; read in this process, unprotected from OCCT crashes"};
+  out.warning = unprotected_read_warning(path, out.child.isolated
+                                                   ? "the isolated reader's result could not be read back (" + why + ")"
+                                                   : "could not start an isolated reader (" + out.child.how + ")");
   out.child = ChildRun{};
   out.child.isolated = false;
   out.transfer = transfer([&out](char c) { out.child.marks += c; });

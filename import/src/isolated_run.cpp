@@ -123,6 +123,10 @@ std::int64_t entity_in_progress(const std::string& marks) {
   return i > hash + 1 ? id : -1;
 }
 
+Diagnostic unprotected_read_warning(const std::string& path, const std::string& why) {
+  return {Severity::Warning, path, 0, -1, why + "; read in this process, unprotected from OCCT crashes"};
+}
+
 ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
                            const std::function<ImportResult(bool probe)>& read) {
   if (!options.isolate_cad_readers) return read(false);
@@ -133,8 +137,7 @@ ImportResult read_isolated(const std::string& path, const char* format, const Im
   if (!child.isolated) {
     ImportResult result = read(false);
     result.diagnostics.insert(result.diagnostics.begin(),
-                              {Severity::Warning, path, 0, -1, "could not start an isolated reader (" + child.how +
-                                                                   "); read in this process, unprotected from OCCT crashes"});
+                              unprotected_read_warning(path, "could not start an isolated reader (" + child.how + ")"));
     return result;
   }
   if (!child.crashed) return read(false);

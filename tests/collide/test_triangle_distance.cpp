@@ -227,6 +227,62 @@ TEST(TrianglesWithin, AgreesWithDistance) {
   EXPECT_FALSE(triangles_within(unit[0], unit[1], unit[2], unit[0], unit[1], unit[2], -1.0, stats));
 }
 
+// fuzz_triangles: two triangles collapsed to points 3 x 2^-1074 apart. The squared distance
+// underflowed to 0, so the distance came out as 2^-1074 and triangles_within disagreed with it.
+TEST(TriangleDistance, SubnormalPointsAreMeasuredExactly) {
+  const Vec3 a(-0x0.0000000000003p-1022, -8, -8), b(0, -8, -8);
+  const double d = dist(Tri{a, a, a}, Tri{b, b, b});
+  EXPECT_EQ(d, 0x0.0000000000003p-1022);
+  TrianglePredicateStats stats;
+  EXPECT_TRUE(triangles_within(a, a, a, b, b, b, d, stats));
+  EXPECT_FALSE(triangles_within(a, a, a, b, b, b, std::nextafter(d, 0.0), stats));
+}
+
+// The known configurations scaled by powers of two over the whole double range: the squares and
+// fourth powers inside the distance left the range at extents below ~2^-256 or above ~2^256, losing
+// candidates (too large a distance) or returning inf.
+TEST(TriangleDistance, ScaleInvariantOverTheDoubleRange) {
+  const Tri unit{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  struct Config {
+    Tri b;
+    double distance;
+  };
+  const Config configs[] = {
+      {Tri{Vec3(0, 0, 0.25), Vec3(1, 0, 0.25), Vec3(0, 1, 0.25)}, 0.25},     // face over face
+      {Tri{Vec3(3, 0, 0), Vec3(4, 0, 0), Vec3(3, 1, 0)}, 2.0},               // vertex to vertex
+      {Tri{Vec3(0.5, -1, 2), Vec3(0.5, 1, 2), Vec3(0.5, 0, 5)}, 2.0},        // skew edges
+      {Tri{Vec3(0.25, 0.25, 0.5), Vec3(0.25, 0.25, 3), Vec3(0.375, 0.25, 3)}, 0.5},  // vertex over face
+      {Tri{Vec3(2, 0, 0), Vec3(2, 0, 0), Vec3(2, 0, 0)}, 1.0},               // a point
+  };
+  for (int k : {-1060, -1000, -700, -400, -200, 0, 200, 400, 700, 1000}) {
+    const double s = std::ldexp(1.0, k);
+    const Tri a{unit[0] * s, unit[1] * s, unit[2] * s};
+    for (const Config& c : configs) {
+      const Tri b{c.b[0] * s, c.b[1] * s, c.b[2] * s};
+      const double expected = c.distance * s;
+      const double d = dist(a, b);
+      EXPECT_NEAR(d, expected, 1e-14 * expected) << "scale 2^" << k << ", expected " << expected;
+      // 1e-12 away, or one ulp where the subnormal grid is coarser than that.
+      const double above = std::max(expected * (1 + 1e-12), std::nextafter(expected, HUGE_VAL));
+      const double below = std::min(expected * (1 - 1e-12), std::nextafter(expected, 0.0));
+      TrianglePredicateStats stats;
+      EXPECT_TRUE(triangles_within(a[0], a[1], a[2], b[0], b[1], b[2], above, stats)) << "scale 2^" << k;
+      EXPECT_FALSE(triangles_within(a[0], a[1], a[2], b[0], b[1], b[2], below, stats)) << "scale 2^" << k;
+    }
+  }
+}
+
+// Coordinates near the top of the double range: their differences overflow unless scaled first.
+TEST(TriangleDistance, CoordinatesNearTheLargestDouble) {
+  const double big = 0x1p1022;
+  const Tri a{Vec3(-big, 0, 0), Vec3(-big, big, 0), Vec3(-big, 0, big)};
+  const Tri b{Vec3(big, 0, 0), Vec3(big, big, 0), Vec3(big, 0, big)};
+  EXPECT_EQ(dist(a, b), 0x1p1023);
+  const Tri far{Vec3(-0x1.cp1023, 0, 0), Vec3(-0x1.cp1023, 1, 0), Vec3(-0x1.cp1023, 0, 1)};
+  const Tri near{Vec3(0x1p1020, 0, 0), Vec3(0x1p1020, 1, 0), Vec3(0x1p1020, 0, 1)};
+  EXPECT_NEAR(dist(far, near), 0x1.cp1023 + 0x1p1020, 0x1p1000);
+}
+
 // fuzz_triangles: a segment (a0 == a1) against a sliver whose edge b0-b2 is a subnormal, at 2^37.
 // The plane early out of triangles_within judged them apart for d above their distance: the sliver's
 // normal underflows, and its error bound assumed it would not.
