@@ -18,6 +18,9 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_flag("--lazy", in.lazy, "Tessellate B-rep faces only when a query needs them");
   cmd.add_flag("--no-isolation", in.no_isolation,
                "Read STEP/IGES/BREP in this process, not in a child (faster import; a file that crashes OCCT then ends the program)");
+  cmd.add_option("--import-time-limit", in.import_time_limit,
+                 "Seconds the isolated reader of one STEP/IGES/BREP file may take; past it the file is reported as not read (0: no limit)")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
   cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
@@ -42,6 +45,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   }
   options.lazy = in.lazy;
   options.isolate_cad_readers = !in.no_isolation;
+  options.reader_time_limit_seconds = in.import_time_limit;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
   if (in.repair) {

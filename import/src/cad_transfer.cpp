@@ -89,10 +89,10 @@ void Transfer::discard_shapes() {
   loose_ids.clear();
 }
 
-void Transfer::set_loose(const TopoDS_Shape& faces, const FaceEntityMap& entities, std::string note) {
+void Transfer::set_loose(const TopoDS_Shape& compound, const FaceEntityMap& entities, std::string note) {
   TopTools_IndexedMapOfShape map;
-  TopExp::MapShapes(faces, TopAbs_FACE, map);
-  loose = faces;
+  TopExp::MapShapes(compound, TopAbs_FACE, map);
+  loose = compound;
   loose_ids.assign(static_cast<std::size_t>(map.Extent()), -1);
   for (Standard_Integer f = 1; f <= map.Extent(); ++f)
     if (const auto it = entities.find(map(f).TShape().get()); it != entities.end())
@@ -198,14 +198,15 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   return r.ok;
 }
 
-IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, const std::function<Transfer(const Mark&)>& transfer) {
+IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
+                                   const std::function<Transfer(const Mark&)>& transfer) {
   IsolatedTransfer out;
   if (!isolate) {
     out.transfer = transfer([&out](char c) { out.child.marks += c; });
     out.child.isolated = false;
     return out;
   }
-  out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); });
+  out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); }, time_limit_seconds);
   std::string why;
   if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
   out.warning = unprotected_read_warning(path, out.child.isolated

@@ -39,7 +39,7 @@ struct Transfer {
   void discard_shapes();
 
   // Makes `faces` the loose faces, each tagged with its entity from `entities` (by TShape).
-  void set_loose(const TopoDS_Shape& faces, const FaceEntityMap& entities, std::string note);
+  void set_loose(const TopoDS_Shape& compound, const FaceEntityMap& entities, std::string note);
 };
 
 // A new XCAF document that pack_transfer can store. Throws Standard_Failure if OCCT cannot make one.
@@ -53,13 +53,14 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why);
 
 // A transfer made in a child process (run_in_child) and brought back; made here when `isolate` is
 // false. When no child could be started or its bytes could not be read back, the transfer is made
-// here instead and `warning` says so.
+// here instead and `warning` says so. The child is stopped after `time_limit_seconds` (> 0; 0 = none).
 struct IsolatedTransfer {
   ChildRun child;       // child.crashed: `transfer` is empty
   Transfer transfer;
   std::optional<Diagnostic> warning;
 };
-IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, const std::function<Transfer(const Mark&)>& transfer);
+IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
+                                   const std::function<Transfer(const Mark&)>& transfer);
 
 // Tessellates and walks the transfer into parts and instances (add_xcaf_document / add_brep_parts).
 ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options);

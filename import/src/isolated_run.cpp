@@ -2,13 +2,16 @@
 #include "isolated_run.h"
 #include "readers.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <sstream>
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,7 +39,7 @@ void default_crash_handlers() {
 
 }  // namespace
 
-ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) {
+ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds) {
   static std::mutex one_at_a_time;
   const std::lock_guard<std::mutex> lock(one_at_a_time);
   ChildRun run;
@@ -74,8 +77,24 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) 
     _exit(0);  // no atexit handlers or static destructors: they belong to the parent
   }
   close(fds[1]);
-  char buffer[64];
+  const bool limited = time_limit_seconds > 0.0;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(limited ? std::min(time_limit_seconds, 1e9) : 0.0));
+  char buffer[4096];
   for (;;) {
+    if (limited) {
+      // A hanging child writes nothing: wait for its pipe no longer than the time left.
+      const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) {
+        run.timed_out = true;
+        kill(pid, SIGKILL);
+        break;
+      }
+      pollfd ready{fds[0], POLLIN, 0};
+      const int polled = poll(&ready, 1, static_cast<int>(std::min<std::int64_t>(left.count(), 1 << 30)));
+      if (polled == 0 || (polled < 0 && errno == EINTR)) continue;
+    }
     const ssize_t n = read(fds[0], buffer, sizeof buffer);
     if (n > 0) {
       run.marks.append(buffer, static_cast<std::size_t>(n));
@@ -85,8 +104,8 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) 
   }
   close(fds[0]);
   const std::size_t end = run.marks.find(kFinished);
-  const bool finished = end != std::string::npos;
-  if (finished) {
+  const bool finished = end != std::string::npos && !run.timed_out;
+  if (end != std::string::npos) {
     run.payload = run.marks.substr(end + 1);
     run.marks.resize(end);
   }
@@ -94,7 +113,10 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work) 
   pid_t waited = -1;
   while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
   }
-  if (waited == pid && WIFSIGNALED(status)) {
+  if (run.timed_out) {
+    run.crashed = true;
+    run.how = "the time limit";
+  } else if (waited == pid && WIFSIGNALED(status)) {
     run.crashed = true;
     run.how = signal_text(WTERMSIG(status));
   } else if (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0) {
@@ -123,17 +145,44 @@ std::int64_t entity_in_progress(const std::string& marks) {
   return i > hash + 1 ? id : -1;
 }
 
+ReaderClock::ReaderClock(double limit_seconds) : limit_(limit_seconds), start_(std::chrono::steady_clock::now()) {}
+
+double ReaderClock::left() const {
+  if (!(limit_ > 0.0)) return 0.0;
+  const std::chrono::duration<double> used = std::chrono::steady_clock::now() - start_;
+  return std::max(limit_ - used.count(), 1e-3);  // spent: the next child is stopped at once
+}
+
+std::string ReaderClock::limit_text() const {
+  std::ostringstream out;
+  out << "within the time limit of " << limit_ << " s";
+  return out.str();
+}
+
+std::optional<Diagnostic> unapplied_time_limit(const std::string& path, const ImportOptions& options) {
+  if (!(options.reader_time_limit_seconds > 0.0) || options.isolate_cad_readers) return std::nullopt;
+  return Diagnostic{Severity::Warning, path, 0, -1,
+                    "the reader time limit needs the isolated reader, which is off; not applied"};
+}
+
 Diagnostic unprotected_read_warning(const std::string& path, const std::string& why) {
   return {Severity::Warning, path, 0, -1, why + "; read in this process, unprotected from OCCT crashes"};
 }
 
 ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
                            const std::function<ImportResult(bool probe)>& read) {
-  if (!options.isolate_cad_readers) return read(false);
-  const ChildRun child = run_in_child([&](const Mark&) {
-    read(true);
-    return std::string();
-  });
+  if (!options.isolate_cad_readers) {
+    ImportResult result = read(false);
+    if (auto warning = unapplied_time_limit(path, options)) result.diagnostics.insert(result.diagnostics.begin(), *warning);
+    return result;
+  }
+  const ReaderClock clock(options.reader_time_limit_seconds);
+  const ChildRun child = run_in_child(
+      [&](const Mark&) {
+        read(true);
+        return std::string();
+      },
+      clock.left());
   if (!child.isolated) {
     ImportResult result = read(false);
     result.diagnostics.insert(result.diagnostics.begin(),
@@ -141,6 +190,9 @@ ImportResult read_isolated(const std::string& path, const char* format, const Im
     return result;
   }
   if (!child.crashed) return read(false);
+  if (child.timed_out)
+    return failed_import(path, std::string("the isolated reader did not finish reading the ") + format + " file " +
+                                   clock.limit_text() + "; stopped, nothing could be read");
   return failed_import(path, std::string("OCCT crashed with ") + child.how + " while reading the " + format +
                                  " file (in an isolated reader); nothing could be read");
 }

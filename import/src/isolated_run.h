@@ -7,7 +7,9 @@
 
 #include "cadclash/import.h"
 
+#include <chrono>
 #include <cstdint>
+#include <optional>
 #include <functional>
 #include <string>
 
@@ -16,7 +18,8 @@ namespace cadclash::detail {
 // How a child run ended.
 struct ChildRun {
   bool isolated = true;   // false when no child could be started (the work was not run at all)
-  bool crashed = false;   // the child ended by a signal or a non-zero exit
+  bool crashed = false;   // the child ended by a signal or a non-zero exit, or was stopped
+  bool timed_out = false; // stopped at the time limit (crashed is true too)
   std::string how;        // "SIGSEGV (segmentation fault)", "exit status 1", or why no child started
   std::string marks;      // the progress marks the child reported, in order (see `work` below)
   std::string payload;    // what `work` returned, when the child finished
@@ -30,8 +33,27 @@ using Mark = std::function<void(char)>;
 // Preconditions:
 // - `work` uses no OpenMP and starts no threads (a forked child has only the calling thread);
 // - `work` writes nothing to stdout (the child's stdout is /dev/null).
-// Process-wide, one child runs at a time.
-ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work);
+// Process-wide, one child runs at a time. A child still running after `time_limit_seconds` (> 0;
+// 0 = none) is killed, and the run is `timed_out`.
+ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds = 0.0);
+
+// The time an import's isolated readers have left (ImportOptions::reader_time_limit_seconds), over
+// every child of one file.
+class ReaderClock {
+ public:
+  explicit ReaderClock(double limit_seconds);
+  // Seconds left for the next child, > 0; 0 when there is no limit.
+  double left() const;
+  // "within the time limit of 2 s", for messages.
+  std::string limit_text() const;
+
+ private:
+  double limit_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// The warning for a time limit that cannot be applied (no isolation), or nothing.
+std::optional<Diagnostic> unapplied_time_limit(const std::string& path, const ImportOptions& options);
 
 // Marks that name the entity a child is working on: "#<id>" before it, "." after it. A child that
 // crashes inside the entity leaves an unclosed "#<id>", so the next child can skip that entity.
@@ -47,7 +69,8 @@ Diagnostic unprotected_read_warning(const std::string& path, const std::string& 
 
 // For readers with a single way through the file: runs `read(true)` (a probe: stop before
 // tessellating) in a child, then `read(false)` here if the child finished, else returns an error
-// naming `path` and the crash. Without isolation (options or a failed fork) only `read(false)` runs.
+// naming `path` and the crash (or the time limit). Without isolation (options or a failed fork)
+// only `read(false)` runs.
 ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
                            const std::function<ImportResult(bool probe)>& read);
 

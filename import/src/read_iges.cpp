@@ -133,8 +133,10 @@ ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   std::set<std::int64_t> skip;  // root entities a child crashed on
   constexpr std::size_t kMaxSkips = 20;
   bool one_by_one = false;
+  const ReaderClock clock(options.reader_time_limit_seconds);
+  if (auto warning = unapplied_time_limit(path, options)) notes.push_back(*warning);
   for (;;) {
-    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, [&](const Mark& mark) {
+    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(), [&](const Mark& mark) {
       return read_iges_transfer(path, one_by_one, skip, mark);
     });
     if (run.warning) notes.push_back(*run.warning);
@@ -146,6 +148,13 @@ ImportResult read_iges(const std::string& path, const ImportOptions& options) {
     }
     const bool parsed = run.child.marks.find(kParsed) != std::string::npos;
     const std::int64_t root = entity_in_progress(run.child.marks);
+    if (run.child.timed_out) {
+      notes.push_back({Severity::Error, path, 0, root,
+                       std::string("the isolated reader did not finish ") + clock.limit_text() + " while " +
+                           (!parsed ? "parsing the file" : "transferring its shapes") + (root >= 0 ? ", at this entity" : "") +
+                           "; stopped, nothing more is read from the file"});
+      break;
+    }
     if (one_by_one && root >= 0 && skip.size() < kMaxSkips && skip.insert(root).second) {
       notes.push_back({Severity::Error, path, 0, root,
                        "OCCT crashed with " + run.child.how + " while transferring this root entity on its own (in an isolated reader); dropped"});

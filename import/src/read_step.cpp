@@ -52,6 +52,8 @@
 #include <unordered_set>
 #include <utility>
 
+#include <unistd.h>
+
 namespace cadclash::detail {
 namespace {
 
@@ -325,6 +327,7 @@ enum class Attempt {
 constexpr char kParsed = 'P', kTransferred = 'T', kShapes = 'S', kLoose = 'L';
 
 std::atomic<std::int64_t> crash_injected_at{-1};  // see set_step_crash_injection_for_testing
+std::atomic<std::int64_t> hang_injected_at{-1};   // see set_step_hang_injection_for_testing
 
 struct AttemptRun {
   Attempt attempt = Attempt::Whole;
@@ -356,6 +359,8 @@ void recover_loose_faces(STEPControl_Reader& step, const Handle(StepData_StepMod
     if (run.skip != nullptr && run.skip->count(label(entity))) continue;  // read_step names it
     mark_entity_begin(run.mark, label(entity));
     if (label(entity) == crash_injected_at.load(std::memory_order_relaxed)) std::raise(SIGSEGV);
+    if (label(entity) == hang_injected_at.load(std::memory_order_relaxed))
+      for (;;) pause();  // only a signal ends it: the time limit's SIGKILL
     try {
       step.ClearShapes();
       if (step.TransferEntity(entity) && step.NbShapes() > 0) {
@@ -706,6 +711,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
 }  // namespace
 
 void set_step_crash_injection_for_testing(std::int64_t face_id) { crash_injected_at.store(face_id, std::memory_order_relaxed); }
+void set_step_hang_injection_for_testing(std::int64_t face_id) { hang_injected_at.store(face_id, std::memory_order_relaxed); }
 
 // OCCT's translators dereference the missing parameters of malformed entities (StepToGeom::MakeLine
 // on a LINE whose point was cut off), so each attempt runs in a child process, which sends back the
@@ -731,8 +737,10 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
   Attempt attempt = Attempt::Whole;
   std::set<std::int64_t> skip;  // face entities a child crashed on, each one
   constexpr std::size_t kMaxSkips = 20;
+  const ReaderClock clock(options.reader_time_limit_seconds);
+  if (auto warning = unapplied_time_limit(path, options)) notes.push_back(*warning);
   for (;;) {
-    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers,
+    IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(),
                                              [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
@@ -750,16 +758,23 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
       attempt = Attempt::LooseFaces;
       continue;
     }
-    if (const std::int64_t face = entity_in_progress(child.marks);
-        attempt == Attempt::LooseFaces && face >= 0 && skip.size() < kMaxSkips && skip.insert(face).second) {
-      notes.push_back({Severity::Error, path, 0, face,
-                       "OCCT crashed with " + child.how + " while transferring this face entity on its own (in an isolated reader); dropped"});
-      continue;
-    }
     const char* stage = !parsed ? "parsing the file"
                         : attempt == Attempt::LooseFaces ? "transferring its faces one by one"
                         : attempt == Attempt::Whole ? "transferring its shapes"
                                                     : "transferring its shapes without the broken faces";
+    const std::int64_t in_progress = entity_in_progress(child.marks);
+    if (child.timed_out) {
+      // Another attempt would meet the same slow entity: what earlier attempts made is all there is.
+      notes.push_back({Severity::Error, path, 0, in_progress,
+                       std::string("the isolated reader did not finish ") + clock.limit_text() + " while " + stage +
+                           (in_progress >= 0 ? ", at this entity" : "") + "; stopped, nothing more is read from the file"});
+      break;
+    }
+    if (attempt == Attempt::LooseFaces && in_progress >= 0 && skip.size() < kMaxSkips && skip.insert(in_progress).second) {
+      notes.push_back({Severity::Error, path, 0, in_progress,
+                       "OCCT crashed with " + child.how + " while transferring this face entity on its own (in an isolated reader); dropped"});
+      continue;
+    }
     const char* next = !parsed || attempt == Attempt::LooseFaces ? "nothing more could be read"
                        : attempt == Attempt::Whole ? "read again without the faces that reach entities it could not read whole"
                                                    : "read again as loose faces";

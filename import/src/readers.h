@@ -13,6 +13,8 @@ ImportResult read_step(const std::string& path, const ImportOptions& options);
 // Fault injection for the tests of the isolated reader: the STEP reader raises SIGSEGV when it
 // transfers face entity #face_id on its own (loose faces); -1 turns it off.
 void set_step_crash_injection_for_testing(std::int64_t face_id);
+// The same, but the reader hangs there (until the time limit kills it). Only with isolation.
+void set_step_hang_injection_for_testing(std::int64_t face_id);
 ImportResult read_iges(const std::string& path, const ImportOptions& options);
 ImportResult read_brep(const std::string& path, const ImportOptions& options);
 

@@ -33,6 +33,7 @@ struct LoadArgs {
   double sharp_angle = 60.0;
   bool planar = false;
   bool isolate = true;
+  double time_limit = 0.0;
 };
 
 // Same steps and defaults as the CLI's import_inputs(), without printing: (diagnostics, complete).
@@ -55,6 +56,8 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   }
   options.lazy = a.lazy;
   options.isolate_cad_readers = a.isolate;
+  if (!(a.time_limit >= 0.0)) throw pyb::value_error("time_limit must be >= 0 seconds (0: no limit)");
+  options.reader_time_limit_seconds = a.time_limit;
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;
@@ -139,13 +142,13 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate) {
+             bool planar, bool isolate, double time_limit) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
-                               fill_holes, segment, sharp_angle, planar, isolate});
+                               fill_holes, segment, sharp_angle, planar, isolate, time_limit});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
-          pyb::arg("planar"), pyb::arg("isolate"))
+          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"))
       .def_property_readonly("_query_deflection", [](const ModelCore& c) { return c.state->query_deflection; })
       .def("_counts",
            [](const ModelCore& c) {

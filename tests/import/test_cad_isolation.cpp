@@ -68,8 +68,8 @@ INSTANTIATE_TEST_SUITE_P(Files, CadIsolation,
                          ::testing::Values("external/as1-tu-203.stp", "cad/valid_two_solids.step",
                                            "cad/mesh_fail_degenerate.step", "cad/truncated.step",
                                            "cad/dangling_ref.step", "external/bearing.iges"),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                           std::string name = std::filesystem::path(info.param).stem().string();
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           std::string name = std::filesystem::path(param_info.param).stem().string();
                            for (char& c : name)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return name;
@@ -118,6 +118,45 @@ TEST(CadIsolation, FaceThatCrashesOnItsOwnIsSkippedAndNamed) {
                       d.message.find("while transferring this face entity on its own") != std::string::npos);
   EXPECT_TRUE(named);
   EXPECT_FALSE(r.complete);
+}
+
+// A face on which the reader hangs (injected: the child pauses at face #137) is stopped by the time
+// limit: an error names the file, the limit and the face, and the import returns.
+TEST(CadIsolation, HangingReaderIsStoppedAtTheTimeLimitAndNamed) {
+  const std::string path = file_without_shape_representations();
+  ImportOptions options;
+  options.reader_time_limit_seconds = 1.0;
+  detail::set_step_hang_injection_for_testing(137);
+  const ImportResult r = import_file(path, options);
+  detail::set_step_hang_injection_for_testing(-1);
+  EXPECT_FALSE(r.complete);
+  bool named = false;
+  for (const Diagnostic& d : r.diagnostics)
+    named = named || (d.severity == Severity::Error && d.file == path && d.step_id == 137 &&
+                      d.message.rfind("the isolated reader did not finish within the time limit of 1 s", 0) == 0 &&
+                      d.message.find("stopped, nothing more is read from the file") != std::string::npos);
+  EXPECT_TRUE(named);
+  // Without a hang, the same limit leaves the read as it was.
+  const ImportResult fine = import_file(path, options);
+  const ImportResult unlimited = import_file(path);
+  expect_same_models(fine, unlimited);
+}
+
+// Without isolation the limit cannot be applied: a warning says so, and the file is read.
+TEST(CadIsolation, TimeLimitWithoutIsolationIsReportedAsNotApplied) {
+  ImportOptions options;
+  options.isolate_cad_readers = false;
+  options.reader_time_limit_seconds = 5.0;
+  const std::string data = CADCLASH_DATA_DIR;
+  for (const std::string& path : {data + "/cad/valid_two_solids.step", data + "/external/bearing.iges",
+                                  data + "/external/Ball.brep"}) {
+    const ImportResult r = import_file(path, options);
+    ASSERT_FALSE(r.diagnostics.empty()) << path;
+    EXPECT_EQ(r.diagnostics.front().severity, Severity::Warning);
+    EXPECT_EQ(r.diagnostics.front().message,
+              "the reader time limit needs the isolated reader, which is off; not applied");
+    EXPECT_FALSE(r.model.surfaces.empty()) << path;
+  }
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <string>
 
+#include <unistd.h>
+
 namespace cadclash::detail {
 namespace {
 
@@ -45,6 +47,32 @@ TEST(IsolatedRun, AbortAndNonZeroExitAreCrashes) {
   const ChildRun exited = run_in_child([](const Mark&) -> std::string { std::_Exit(3); });
   EXPECT_TRUE(exited.crashed);
   EXPECT_EQ(exited.how, "exit status 3");
+}
+
+// A child that never answers is killed at the time limit; its marks so far are kept.
+TEST(IsolatedRun, HangingChildIsStoppedAtTheTimeLimit) {
+  const ChildRun run = run_in_child(
+      [](const Mark& mark) -> std::string {
+        mark('P');
+        mark_entity_begin(mark, 42);
+        for (;;) pause();
+      },
+      0.5);
+  EXPECT_TRUE(run.crashed);
+  EXPECT_TRUE(run.timed_out);
+  EXPECT_EQ(run.how, "the time limit");
+  EXPECT_EQ(entity_in_progress(run.marks), 42);
+  EXPECT_EQ(run.payload, "");
+  // A limit that is not reached changes nothing, and a payload larger than a pipe still arrives.
+  const std::string big(1 << 20, 'y');
+  const ChildRun quick = run_in_child([&](const Mark& mark) {
+    mark('P');
+    return big;
+  }, 60.0);
+  EXPECT_FALSE(quick.crashed) << quick.how;
+  EXPECT_FALSE(quick.timed_out);
+  EXPECT_EQ(quick.marks, "P");
+  EXPECT_EQ(quick.payload, big);
 }
 
 // A child whose status cannot be collected (the host reaps children itself) is judged by whether it

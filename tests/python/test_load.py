@@ -102,11 +102,23 @@ def test_step_that_crashes_occt_is_contained(data_dir):
     assert [s.step_id for s in model.surfaces] == [17]
 
 
+def test_time_limit_stops_the_isolated_reader(data_dir):
+    # Two solids cannot be parsed and transferred in a millisecond: the reader is stopped, an error
+    # names the limit, and nothing is read; a generous limit changes nothing.
+    step = data_dir / "cad" / "valid_two_solids.step"
+    with pytest.raises(cadclash.InputError) as stopped:
+        cadclash.load(step, time_limit=0.001)
+    assert any("did not finish within the time limit of 0.001 s" in d.message for d in stopped.value.diagnostics)
+    assert len(cadclash.load(step, time_limit=60).surfaces) == len(cadclash.load(step).surfaces)
+
+
 def test_bad_arguments(boxes):
     with pytest.raises(ValueError, match="preset"):
         cadclash.load(boxes, preset="ultra")
     with pytest.raises(ValueError, match="deflection"):
         cadclash.load(boxes, deflection=0.0)
+    with pytest.raises(ValueError, match="time_limit"):
+        cadclash.load(boxes, time_limit=-1)
 
 
 def test_mesh_post_processing_switches(data_dir):

@@ -71,4 +71,23 @@ TEST(CliCad, TessellateAs1ToGlbKeepsInstancesAndStepIds) {
   EXPECT_EQ(faces, 160u);
 }
 
+// --import-time-limit: a reader that cannot finish in time (as1 cannot be parsed in a millisecond)
+// is stopped with an error naming the file and the limit, and the run fails as an input error; the
+// same limit without isolation is reported as not applied.
+TEST(CliCad, ImportTimeLimitStopsTheReaderAndSaysSo) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!std::filesystem::exists(step)) GTEST_SKIP() << step << " missing: run scripts/setup.sh";
+  const CliRun stopped = cadclash("check '" + step + "' --import-time-limit 0.001");
+  EXPECT_EQ(stopped.code, 1) << stopped.err;
+  EXPECT_NE(stopped.err.find(step + ": error: the isolated reader did not finish within the time limit of 0.001 s"),
+            std::string::npos)
+      << stopped.err;
+  const CliRun unapplied = cadclash("info '" + step + "' --import-time-limit 0.001 --no-isolation");
+  EXPECT_EQ(unapplied.code, 0) << unapplied.err;
+  EXPECT_NE(unapplied.err.find(step + ": warning: the reader time limit needs the isolated reader, which is off; not applied"),
+            std::string::npos)
+      << unapplied.err;
+  EXPECT_EQ(cadclash("check '" + step + "' --import-time-limit -1").code, 2);  // a usage error
+}
+
 }  // namespace

@@ -62,6 +62,12 @@ struct ImportOptions {
   // Turn it off only for trusted files, or in a host that must not fork (fork copies only the
   // calling thread; a thread of the host holding a lock OCCT needs would hang the child).
   bool isolate_cad_readers = true;
+  // STEP/IGES/BREP with isolate_cad_readers: seconds the isolated reader of one file may take over
+  // all its attempts; 0 = no limit. Past it the child is killed and the file reported with an error
+  // naming what it was reading (the entity #id when known); an earlier attempt's faces are kept.
+  // Tessellation runs in this process afterwards and is not covered. Without isolation it cannot be
+  // applied (a warning says so).
+  double reader_time_limit_seconds = 0.0;
 };
 
 struct ImportResult {
