@@ -19,7 +19,7 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_flag("--no-isolation", in.no_isolation,
                "Read STEP/IGES/BREP in this process, not in a child (faster import; a file that crashes OCCT then ends the program)");
   cmd.add_option("--import-time-limit", in.import_time_limit,
-                 "Seconds the isolated reader of one STEP/IGES/BREP file may take; past it the file is reported as not read (0: no limit)")
+                 "Seconds the isolated reader of one STEP/IGES/BREP file may take, and again its tessellation; what is not done by then is reported as not read or not tessellated (0: no limit)")
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
@@ -46,6 +46,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.lazy = in.lazy;
   options.isolate_cad_readers = !in.no_isolation;
   options.reader_time_limit_seconds = in.import_time_limit;
+  options.tessellation.time_limit_seconds = in.import_time_limit;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
   if (in.repair) {

@@ -24,7 +24,7 @@ struct InputOptions {
   std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
   bool lazy = false;
   bool no_isolation = false;
-  double import_time_limit = 0.0;  // seconds per CAD file's isolated reader; 0 = none
+  double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   // Mesh post-processing (mesh parts only; see tessellate.h).
   bool repair = false;
   bool fill_holes = false;  // with --repair

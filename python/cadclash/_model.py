@@ -251,7 +251,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     process, so a file that crashes OCCT gives an error diagnostic (and the faces that could still be
     read) instead of ending Python; ``isolate=False`` is the CLI's ``--no-isolation``. ``time_limit``
     (seconds, 0 = none; the CLI's ``--import-time-limit``) stops an isolated reader that takes longer
-    on one file, with an error diagnostic naming it. Several files form one scene;
+    on one file, and then the file's tessellation, with error diagnostics naming what was not done. Several files form one scene;
     each file's instance paths are then prefixed with "/<file name>".
 
     Returns the model with ``diagnostics`` and ``complete`` set: a partly bad file keeps its good

@@ -58,6 +58,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   options.isolate_cad_readers = a.isolate;
   if (!(a.time_limit >= 0.0)) throw pyb::value_error("time_limit must be >= 0 seconds (0: no limit)");
   options.reader_time_limit_seconds = a.time_limit;
+  options.tessellation.time_limit_seconds = a.time_limit;
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;

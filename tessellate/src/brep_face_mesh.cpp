@@ -9,6 +9,8 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <IMeshTools_Parameters.hxx>
+#include <Message_ProgressIndicator.hxx>
+#include <Message_ProgressScope.hxx>
 #include <Poly_PolygonOnTriangulation.hxx>
 #include <Poly_Triangulation.hxx>
 #include <Standard_Failure.hxx>
@@ -19,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 namespace cadclash::detail {
@@ -90,16 +93,56 @@ double boundary_gap(const TopoDS_Face& face, const Handle(Poly_Triangulation)& t
   return worst;
 }
 
+// BRepMesh polls UserBreak between its stages and faces (from its worker threads too).
+class DeadlineIndicator : public Message_ProgressIndicator {
+ public:
+  explicit DeadlineIndicator(std::chrono::steady_clock::time_point at) : at_(at) {}
+  Standard_Boolean UserBreak() override { return std::chrono::steady_clock::now() >= at_; }
+  void Show(const Message_ProgressScope&, const Standard_Boolean) override {}
+
+ private:
+  std::chrono::steady_clock::time_point at_;
+};
+
 }  // namespace
 
-bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why) {
+MeshDeadline MeshDeadline::after(double seconds) {
+  MeshDeadline d;
+  if (!(seconds > 0.0)) return d;
+  d.limit_seconds = seconds;
+  d.at = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(std::min(seconds, 1e9)));
+  return d;
+}
+
+std::string MeshDeadline::reason() const {
+  std::ostringstream out;
+  out << "the tessellation time limit of " << limit_seconds << " s ran out";
+  return out.str();
+}
+
+bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why,
+                  const MeshDeadline& deadline) {
   IMeshTools_Parameters params;
   params.Deflection = deflection;
   params.Angle = angular;
   params.Relative = Standard_False;  // relative deflections are resolved per part by the caller
   params.InParallel = parallel ? Standard_True : Standard_False;
   try {
-    BRepMesh_IncrementalMesh mesher(shape, params);
+    if (!deadline.at) {
+      BRepMesh_IncrementalMesh mesher(shape, params);
+      return true;
+    }
+    if (deadline.passed()) {
+      why = deadline.reason();
+      return false;
+    }
+    const Handle(DeadlineIndicator) indicator = new DeadlineIndicator(*deadline.at);
+    BRepMesh_IncrementalMesh mesher(shape, params, indicator->Start());
+    if (deadline.passed()) {
+      why = deadline.reason();
+      return false;
+    }
     return true;
   } catch (const Standard_Failure& e) {
     why = std::string("BRepMesh failed: ") + e.GetMessageString();
@@ -154,10 +197,16 @@ bool read_face_triangles(const TopoDS_Face& face, bool measure, TriangleMesh& ou
 }
 
 bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool verify, TriangleMesh& out,
-                  double& achieved, std::string& why) {
+                  double& achieved, std::string& why, const MeshDeadline& deadline) {
   double param = target;
   bool have = false;
   for (int attempt = 0; attempt < 2; ++attempt) {
+    if (deadline.passed()) {
+      // No time to refine: a triangulation the face already has is kept, with its honest deflection.
+      if (have || read_face_triangles(face, verify, out, achieved)) return true;
+      why = deadline.reason();
+      return false;
+    }
     TopLoc_Location loc;
     const Handle(Poly_Triangulation)& tri = BRep_Tool::Triangulation(face, loc);
     // BRepMesh accepts an existing triangulation up to ~1.1x the requested deflection; a refinement
@@ -167,7 +216,7 @@ bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool v
         BRepTools::Clean(face);
       } catch (const Standard_Failure&) {
       }
-      if (!run_brepmesh(face, param, angular, false, why)) return have;
+      if (!run_brepmesh(face, param, angular, false, why, deadline)) return have;
     }
     TriangleMesh mesh;
     double got = 0.0;

@@ -6,6 +6,7 @@
 #include <TopoDS_Face.hxx>
 #include <gp_Trsf.hxx>
 
+#include <chrono>
 #include <optional>
 #include <shared_mutex>
 #include <string>
@@ -29,9 +30,20 @@ struct BrepSource::Impl {
 
 namespace detail {
 
+// When meshing must stop (TessellationOptions::time_limit_seconds); by default, never.
+struct MeshDeadline {
+  std::optional<std::chrono::steady_clock::time_point> at;
+  double limit_seconds = 0.0;  // for messages
+  static MeshDeadline after(double seconds);  // seconds <= 0: never
+  bool passed() const { return at && std::chrono::steady_clock::now() >= *at; }
+  std::string reason() const;  // "the tessellation time limit of 2 s ran out"
+};
+
 // Runs BRepMesh_IncrementalMesh on `shape` (a face or a compound of faces) with an absolute linear
-// deflection. Returns false and fills `why` when OCCT throws.
-bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why);
+// deflection, asking it to stop at `deadline`. Returns false and fills `why` when OCCT throws or the
+// deadline stopped it (some faces may then have triangles).
+bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why,
+                  const MeshDeadline& deadline = {});
 
 // Reads the face's triangulation into `out` (part-local, outward winding). When `measure` is set,
 // `achieved` is max(triangulation deflection, distance from each triangle centroid to the surface
@@ -40,8 +52,9 @@ bool read_face_triangles(const TopoDS_Face& face, bool measure, TriangleMesh& ou
 
 // Makes the face's triangulation meet `target` (re-meshing when it has none or a coarser one, and
 // finer once more, at half, when the measured error still exceeds target) and reads it.
+// Past `deadline` nothing is meshed (false, why = its reason) and no refinement is tried.
 bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool verify, TriangleMesh& out,
-                  double& achieved, std::string& why);
+                  double& achieved, std::string& why, const MeshDeadline& deadline = {});
 
 // Part-local box enclosing the exact face: BRepBndLib::AddOptimal for analytic surfaces (cheap and
 // tight), BRepBndLib::Add (control polygons) for the rest.

@@ -63,6 +63,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   assert(options.linear_deflection > 0.0);
   std::vector<PartId> ids;
   ids.reserve(parts.size());
+  const detail::MeshDeadline deadline = detail::MeshDeadline::after(options.time_limit_seconds);
   for (const BrepPartInput& in : parts) {
     assert(in.shape != nullptr);
     auto impl = std::make_unique<BrepSource::Impl>();
@@ -143,7 +144,8 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
       builder.MakeCompound(compound);
       for (const TopoDS_Face& f : impl->faces) builder.Add(compound, f);
       std::string why;
-      const bool meshed = detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why);
+      const bool meshed =
+          detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why, deadline);
       (void)meshed;  // faces left without triangles are retried one by one below
 
       std::vector<char> good(n, 0);
@@ -163,7 +165,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
           double achieved = 0.0;
           std::string face_why;
           if (detail::mesh_face_to(impl->faces[i], deflection, options.angular_deflection, options.verify_deflection,
-                                   surfaces[i].mesh, achieved, face_why)) {
+                                   surfaces[i].mesh, achieved, face_why, deadline)) {
             surfaces[i].deflection = achieved;
             good[i] = 1;
           } else {

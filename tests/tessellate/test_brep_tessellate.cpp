@@ -152,6 +152,36 @@ TEST(BrepTessellate, DeflectionIsHonoured) {
   }
 }
 
+// TessellationOptions::time_limit_seconds: a limit that has run out before meshing starts leaves every
+// face without triangles, each named with the limit; a limit not reached changes nothing.
+TEST(BrepTessellate, TimeLimitLeavesFacesUnmeshedAndNamed) {
+  const std::vector<TopoDS_Shape> shapes{torus(), cylinder(), sphere()};
+  TessellationOptions o;
+  o.time_limit_seconds = 1e-9;
+  const Built cut = build(shapes, o, false);
+  EXPECT_FALSE(cut.complete);
+  ASSERT_EQ(cut.diagnostics.size(), cut.model.surfaces.size());
+  for (const Surface& s : cut.model.surfaces) {
+    EXPECT_FALSE(s.has_triangles) << s.name;
+    EXPECT_TRUE(s.mesh.triangles.empty()) << s.name;
+  }
+  for (const Diagnostic& d : cut.diagnostics) {
+    EXPECT_EQ(d.severity, Severity::Error);
+    EXPECT_NE(d.message.find("could not be tessellated (the tessellation time limit of 1e-09 s ran out)"),
+              std::string::npos)
+        << d.message;
+  }
+  o.time_limit_seconds = 3600;
+  const Built limited = build(shapes, o, false);
+  const Built unlimited = build(shapes, TessellationOptions{}, false);
+  EXPECT_TRUE(limited.complete);
+  ASSERT_EQ(limited.model.surfaces.size(), unlimited.model.surfaces.size());
+  for (std::size_t i = 0; i < limited.model.surfaces.size(); ++i) {
+    EXPECT_EQ(limited.model.surfaces[i].mesh.triangles, unlimited.model.surfaces[i].mesh.triangles);
+    EXPECT_EQ(limited.model.surfaces[i].deflection, unlimited.model.surfaces[i].deflection);
+  }
+}
+
 TEST(BrepTessellate, FinerDeflectionGivesMoreTriangles) {
   std::size_t previous = 0;
   for (double d : {1.0, 0.1, 0.01}) {

@@ -39,6 +39,11 @@ struct TessellationOptions {
   // stored achieved deflection is max(BRepMesh's own figure, the measured error), so it may exceed
   // the request where even the finer mesh did not meet it: it is what collide should trust.
   bool verify_deflection = true;
+  // Seconds one add_brep_parts call (at import: one file) may spend meshing; 0 = no limit. Past it
+  // BRepMesh is asked to stop (it checks between faces, not inside one) and no face is re-meshed;
+  // each face left without triangles keeps its surface and gets an error naming it and the limit.
+  // Lazy tessellation (triangulate, require_triangles) is not limited.
+  double time_limit_seconds = 0.0;
 };
 
 // Named settings a user understands, like Mayo's and FreeCAD's mesh quality choices.
