@@ -209,9 +209,10 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double
   out.child = run_in_child([&](const Mark& mark) { return pack_transfer(transfer(mark)); }, time_limit_seconds);
   std::string why;
   if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
-  out.warning = unprotected_read_warning(path, out.child.isolated
-                                                   ? "the isolated reader's result could not be read back (" + why + ")"
-                                                   : "could not start an isolated reader (" + out.child.how + ")");
+  out.warning = Diagnostic{Severity::Warning, path, 0, -1,
+                           (out.child.isolated ? "the isolated reader's result could not be read back (" + why + ")"
+                                               : "could not start an isolated reader (" + out.child.how + ")") +
+                               "; read in this process, unprotected from OCCT crashes"};
   out.child = ChildRun{};
   out.child.isolated = false;
   out.transfer = transfer([&out](char c) { out.child.marks += c; });
@@ -240,8 +241,10 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
     const auto ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation,
                                     options.lazy, result.diagnostics, result.complete);
     result.model.instances.push_back(Instance{"/" + in.name, ids[0], Pose::Identity()});
-    result.diagnostics.push_back({Severity::Error, path, 0, -1, t.loose_note});
-    result.complete = false;
+    if (!t.loose_note.empty()) {
+      result.diagnostics.push_back({Severity::Error, path, 0, -1, t.loose_note});
+      result.complete = false;
+    }
   }
   return result;
 }

@@ -23,7 +23,7 @@ struct Transfer {
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;
   // Or loose faces of one part: a compound, the entity #id of each face in TopExp::MapShapes order,
-  // and the error that says how many were recovered.
+  // and the error that says how many were recovered (none for a .brep's shape, one part by design).
   TopoDS_Shape loose;
   std::vector<std::int64_t> loose_ids;
   std::string loose_note;

@@ -1,6 +1,5 @@
 // fork + pipe + waitpid: a child that dies leaves this process untouched.
 #include "isolated_run.h"
-#include "readers.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -163,38 +162,6 @@ std::optional<Diagnostic> unapplied_time_limit(const std::string& path, const Im
   if (!(options.reader_time_limit_seconds > 0.0) || options.isolate_cad_readers) return std::nullopt;
   return Diagnostic{Severity::Warning, path, 0, -1,
                     "the reader time limit needs the isolated reader, which is off; not applied"};
-}
-
-Diagnostic unprotected_read_warning(const std::string& path, const std::string& why) {
-  return {Severity::Warning, path, 0, -1, why + "; read in this process, unprotected from OCCT crashes"};
-}
-
-ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
-                           const std::function<ImportResult(bool probe)>& read) {
-  if (!options.isolate_cad_readers) {
-    ImportResult result = read(false);
-    if (auto warning = unapplied_time_limit(path, options)) result.diagnostics.insert(result.diagnostics.begin(), *warning);
-    return result;
-  }
-  const ReaderClock clock(options.reader_time_limit_seconds);
-  const ChildRun child = run_in_child(
-      [&](const Mark&) {
-        read(true);
-        return std::string();
-      },
-      clock.left());
-  if (!child.isolated) {
-    ImportResult result = read(false);
-    result.diagnostics.insert(result.diagnostics.begin(),
-                              unprotected_read_warning(path, "could not start an isolated reader (" + child.how + ")"));
-    return result;
-  }
-  if (!child.crashed) return read(false);
-  if (child.timed_out)
-    return failed_import(path, std::string("the isolated reader did not finish reading the ") + format + " file " +
-                                   clock.limit_text() + "; stopped, nothing could be read");
-  return failed_import(path, std::string("OCCT crashed with ") + child.how + " while reading the " + format +
-                                 " file (in an isolated reader); nothing could be read");
 }
 
 }  // namespace cadclash::detail

@@ -63,15 +63,4 @@ void mark_entity_end(const Mark& mark);
 // The entity whose "#<id>" mark is the last one and unclosed; -1 when there is none.
 std::int64_t entity_in_progress(const std::string& marks);
 
-// The warning for a read that had to run in this process after all: "<why>; read in this process,
-// unprotected from OCCT crashes", naming `path`.
-Diagnostic unprotected_read_warning(const std::string& path, const std::string& why);
-
-// For readers with a single way through the file: runs `read(true)` (a probe: stop before
-// tessellating) in a child, then `read(false)` here if the child finished, else returns an error
-// naming `path` and the crash (or the time limit). Without isolation (options or a failed fork)
-// only `read(false)` runs.
-ImportResult read_isolated(const std::string& path, const char* format, const ImportOptions& options,
-                           const std::function<ImportResult(bool probe)>& read);
-
 }  // namespace cadclash::detail

@@ -1,5 +1,5 @@
 // OCCT's native .brep through BRepTools::Read: one part named after the file, one instance.
-#include "cad_xcaf.h"
+#include "cad_transfer.h"
 #include "isolated_run.h"
 #include "readers.h"
 
@@ -9,6 +9,7 @@
 #include <TopoDS_Shape.hxx>
 
 #include <fstream>
+#include <optional>
 #include <string>
 
 namespace cadclash::detail {
@@ -24,43 +25,57 @@ bool has_topology_header(const std::string& path) {
   return head.find("CASCADE Topology V") != std::string::npos;
 }
 
-// `probe`: stop after reading the shape (see read_isolated).
-ImportResult read_brep_once(const std::string& path, const ImportOptions& options, bool probe) {
-  ImportResult result;
+// The shape as a loose part (no entity ids, no note: a .brep is one part by design). Runs in the
+// isolated reader's child.
+Transfer read_brep_shape(const std::string& path) {
+  Transfer t;
+  t.kind = SourceKind::BrepFace;
+  auto fail = [&](std::string message) {
+    t.diagnostics.push_back({Severity::Error, path, 0, -1, std::move(message)});
+    t.complete = false;
+    return std::move(t);
+  };
   try {
-    if (!has_topology_header(path))
-      return failed_import(path, "not an OCCT .brep: no 'CASCADE Topology' header in its first 64 KB");
+    if (!has_topology_header(path)) return fail("not an OCCT .brep: no 'CASCADE Topology' header in its first 64 KB");
     TopoDS_Shape shape;
     BRep_Builder builder;
     if (!BRepTools::Read(shape, path.c_str(), builder) || shape.IsNull())
-      return failed_import(path, "cannot read BREP file (not an OCCT .brep, or damaged)");
+      return fail("cannot read BREP file (not an OCCT .brep, or damaged)");
     // Triangulations stored in the file were made with unknown settings; ours follow the options.
     BRepTools::Clean(shape, Standard_True);
-    if (probe) return result;
-    BrepPartInput in;
-    in.shape = &shape;
-    in.name = cad_file_stem(path);
-    in.source_file = path;
-    in.kind = SourceKind::BrepFace;
-    const std::vector<PartId> ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation,
-                                                   options.lazy, result.diagnostics, result.complete);
-    if (result.model.parts[ids[0]].surface_count == 0)
-      result.diagnostics.push_back({Severity::Warning, path, 0, -1, "the shape has no faces"});
-    Instance instance;
-    instance.path = "/" + in.name;
-    instance.part = ids[0];
-    result.model.instances.push_back(std::move(instance));
+    t.loose = shape;
   } catch (const Standard_Failure& e) {
-    return failed_import(path, std::string("OCCT failed while reading BREP: ") + e.GetMessageString());
+    return fail(std::string("OCCT failed while reading BREP: ") + e.GetMessageString());
   }
-  return result;
+  return t;
 }
 
 }  // namespace
 
+// Read in the isolated reader's child, which sends the shape back in OCCT's binary format
+// (cad_transfer.h): this process never parses the file.
 ImportResult read_brep(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
-  return read_isolated(path, "BREP", options, [&](bool probe) { return read_brep_once(path, options, probe); });
+  const ReaderClock clock(options.reader_time_limit_seconds);
+  std::optional<Diagnostic> unapplied = unapplied_time_limit(path, options);
+  IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(),
+                                           [&](const Mark&) { return read_brep_shape(path); });
+  ImportResult result;
+  if (run.child.timed_out) {
+    result = failed_import(path, "the isolated reader did not finish reading the BREP file " + clock.limit_text() +
+                                     "; stopped, nothing could be read");
+  } else if (run.child.crashed) {
+    result = failed_import(path, "OCCT crashed with " + run.child.how +
+                                     " while reading the BREP file (in an isolated reader); nothing could be read");
+  } else {
+    const bool shape = !run.transfer.loose.IsNull();
+    result = finish_transfer(std::move(run.transfer), path, options);
+    if (shape && result.model.parts.size() == 1 && result.model.parts[0].surface_count == 0)
+      result.diagnostics.push_back({Severity::Warning, path, 0, -1, "the shape has no faces"});
+  }
+  if (run.warning) result.diagnostics.insert(result.diagnostics.begin(), *run.warning);
+  if (unapplied) result.diagnostics.insert(result.diagnostics.begin(), *unapplied);
+  return result;
 }
 
 }  // namespace cadclash::detail
