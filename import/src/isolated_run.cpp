@@ -152,9 +152,10 @@ double ReaderClock::left() const {
   return std::max(limit_ - used.count(), 1e-3);  // spent: the next child is stopped at once
 }
 
-std::string ReaderClock::limit_text() const {
+std::string ReaderClock::stopped_message(const std::string& stage, std::int64_t entity) const {
   std::ostringstream out;
-  out << "within the time limit of " << limit_ << " s";
+  out << "the isolated reader did not finish within the time limit of " << limit_ << " s while " << stage
+      << (entity >= 0 ? ", at this entity" : "") << "; stopped, nothing more is read from the file";
   return out.str();
 }
 

@@ -44,8 +44,9 @@ class ReaderClock {
   explicit ReaderClock(double limit_seconds);
   // Seconds left for the next child, > 0; 0 when there is no limit.
   double left() const;
-  // "within the time limit of 2 s", for messages.
-  std::string limit_text() const;
+  // The error for a reader stopped at the limit: "the isolated reader did not finish within the time
+  // limit of 2 s while <stage>[, at this entity]; stopped, nothing more is read from the file".
+  std::string stopped_message(const std::string& stage, std::int64_t entity) const;
 
  private:
   double limit_;

@@ -62,8 +62,7 @@ ImportResult read_brep(const std::string& path, const ImportOptions& options) {
                                            [&](const Mark&) { return read_brep_shape(path); });
   ImportResult result;
   if (run.child.timed_out) {
-    result = failed_import(path, "the isolated reader did not finish reading the BREP file " + clock.limit_text() +
-                                     "; stopped, nothing could be read");
+    result = failed_import(path, clock.stopped_message("reading the file", -1));
   } else if (run.child.crashed) {
     result = failed_import(path, "OCCT crashed with " + run.child.how +
                                      " while reading the BREP file (in an isolated reader); nothing could be read");

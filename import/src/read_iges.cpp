@@ -150,9 +150,7 @@ ImportResult read_iges(const std::string& path, const ImportOptions& options) {
     const std::int64_t root = entity_in_progress(run.child.marks);
     if (run.child.timed_out) {
       notes.push_back({Severity::Error, path, 0, root,
-                       std::string("the isolated reader did not finish ") + clock.limit_text() + " while " +
-                           (!parsed ? "parsing the file" : "transferring its shapes") + (root >= 0 ? ", at this entity" : "") +
-                           "; stopped, nothing more is read from the file"});
+                       clock.stopped_message(!parsed ? "parsing the file" : "transferring its shapes", root)});
       break;
     }
     if (one_by_one && root >= 0 && skip.size() < kMaxSkips && skip.insert(root).second) {

@@ -765,9 +765,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     const std::int64_t in_progress = entity_in_progress(child.marks);
     if (child.timed_out) {
       // Another attempt would meet the same slow entity: what earlier attempts made is all there is.
-      notes.push_back({Severity::Error, path, 0, in_progress,
-                       std::string("the isolated reader did not finish ") + clock.limit_text() + " while " + stage +
-                           (in_progress >= 0 ? ", at this entity" : "") + "; stopped, nothing more is read from the file"});
+      notes.push_back({Severity::Error, path, 0, in_progress, clock.stopped_message(stage, in_progress)});
       break;
     }
     if (attempt == Attempt::LooseFaces && in_progress >= 0 && skip.size() < kMaxSkips && skip.insert(in_progress).second) {

@@ -144,6 +144,22 @@ TEST(CadIsolation, HangingReaderIsStoppedAtTheTimeLimitAndNamed) {
   expect_same_models(fine, unlimited);
 }
 
+// A .brep is read only in the child, so the limit covers it: 3.8 MB of text cannot be parsed in the
+// millisecond a spent limit leaves.
+TEST(CadIsolation, BrepReaderIsStoppedAtTheTimeLimit) {
+  const std::string path = std::string(CADCLASH_DATA_DIR) + "/external/Bottom.brep";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing: run scripts/setup.sh";
+  ImportOptions options;
+  options.reader_time_limit_seconds = 1e-6;
+  const ImportResult r = import_file(path, options);
+  EXPECT_FALSE(r.complete);
+  EXPECT_TRUE(r.model.surfaces.empty());
+  ASSERT_FALSE(r.diagnostics.empty());
+  EXPECT_EQ(r.diagnostics.front().message,
+            "the isolated reader did not finish within the time limit of 1e-06 s while reading the file; stopped, "
+            "nothing more is read from the file");
+}
+
 // Without isolation the limit cannot be applied: a warning says so, and the file is read.
 TEST(CadIsolation, TimeLimitWithoutIsolationIsReportedAsNotApplied) {
   ImportOptions options;
