@@ -158,8 +158,15 @@ double winding_number(const Vec3& p, std::span<const Surface* const> surfaces) {
 void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
                   const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, PreparedPair& out,
                   CollideCounters& counters) {
+  prepare_pair_reach(sa, bvh_a, sb, bvh_b, t_ab, t_ba, options, options.tolerance + sa.deflection + sb.deflection,
+                     out, counters);
+}
+
+void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
+                        const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, double tau,
+                        PreparedPair& out, CollideCounters& counters) {
   out = PreparedPair{};
-  out.tau = options.tolerance + sa.deflection + sb.deflection;
+  out.tau = tau;
   const double search = std::max(out.tau, options.clearance);
   if (options.use_oaabb) {
     // Surface-pair OAABB in A's frame: where a triangle of one side can come within `search` of the
@@ -363,6 +370,28 @@ const char* contact_class_name(ContactClass c) {
     case ContactClass::Touching: return "touching";
     case ContactClass::Clearance: return "clearance";
     case ContactClass::Containment: return "containment";
+    case ContactClass::Undecided: return "undecided";
+  }
+  return "unknown";
+}
+
+const char* decided_by_name(DecidedBy d) {
+  switch (d) {
+    case DecidedBy::Mesh: return "mesh";
+    case DecidedBy::MeshExact: return "mesh-exact";
+    case DecidedBy::Analytic: return "analytic";
+    case DecidedBy::Refined: return "refined";
+    case DecidedBy::Exact: return "exact";
+    case DecidedBy::Undecided: return "undecided";
+  }
+  return "unknown";
+}
+
+const char* decision_mode_name(DecisionMode m) {
+  switch (m) {
+    case DecisionMode::Certified: return "certified";
+    case DecisionMode::Fast: return "fast";
+    case DecisionMode::Exact: return "exact";
   }
   return "unknown";
 }

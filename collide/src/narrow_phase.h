@@ -39,6 +39,12 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
                   const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, PreparedPair& out,
                   CollideCounters& counters);
 
+// prepare_pair with the touching bound given: `tau` is the depth past which a crossing ends the run
+// and, with options.clearance, the search reach (certified decisions search T + both bands + r).
+void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
+                        const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, double tau,
+                        PreparedPair& out, CollideCounters& counters);
+
 // Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
 // Polls `deadline` (when given) every 256 triangle tests and stops with out.cut set once it expired.
 // EarlyExit mode: once the run has found an intersecting pair, a later candidate is tested for

@@ -95,12 +95,35 @@ struct Provenance {
 
 class SurfaceSource;
 
+// The exact surface a face lies on, part-local, when it is one of the elementary kinds. Lets
+// collide prove two faces apart without OCCT (see "Certified decisions" below).
+enum class SurfaceShape : std::uint8_t { Other, Plane, Cylinder, Cone, Sphere, Torus };
+
+struct AnalyticSurface {
+  SurfaceShape shape = SurfaceShape::Other;
+  Vec3 origin = Vec3::Zero();  // plane: a point on it; cylinder: a point on the axis; cone: the apex;
+                               // sphere, torus: the centre
+  Vec3 axis = Vec3::UnitZ();   // plane: unit normal; cylinder, cone, torus: unit axis direction
+  double radius = 0.0;         // cylinder, sphere: radius; torus: major radius (centre to tube axis)
+  double radius2 = 0.0;        // torus: minor (tube) radius; cone: half-angle, radians in (0, pi/2)
+};
+
 struct Surface {
   std::string name;        // unique within its part
   PartId part = kInvalidId;
   Provenance provenance;
   Aabb aabb;               // part-local; encloses the exact surface (B-rep) or its triangles (mesh)
   double deflection = 0.0; // achieved bound on the distance between triangles and the exact surface; 0 for meshes
+  // Model uncertainty ε (mm): how far the stated geometry may be from the intended one. B-rep faces:
+  // the largest OCCT tolerance of the face, its edges and vertices (never below Precision::Confusion,
+  // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger. Meshes: the single-precision
+  // representation bound 2^-24 · (largest coordinate magnitude of the part), or the importer's
+  // model_tolerance when given. Two faces touch when their exact distance <= tolerance + εa + εb.
+  double uncertainty = 0.0;
+  // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
+  // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
+  bool exact_triangles = false;
+  AnalyticSurface analytic;  // shape Other when the face is not elementary or the source is a mesh
   bool has_triangles = false;  // false while a lazy source has not yet been asked for them
   TriangleMesh mesh;       // part-local triangles (empty until has_triangles)
 };
@@ -214,10 +237,54 @@ std::size_t triangle_count(const Model& model);
 //   inner instance's box lies in the outer's box, and no surface pair of the two intersects. The
 //   reported surface ids are kInvalidId (whole instances).
 
-enum class ContactClass : std::uint8_t { Penetrating, Touching, Clearance, Containment };
+//
+// Certified decisions (CollideOptions::decision == Certified, the default)
+// ------------------------------------------------------------------------
+// The classes above are statements about the EXACT faces, not their triangles. Two faces are in
+// contact when their exact distance d* <= T = tolerance + εa + εb (Surface::uncertainty). What the
+// triangles tell about d* is an interval [lo, hi]:
+//   intersecting triangles:   [0, δa + δb + r]
+//   mesh distance dm:         [max(0, dm - δa - δb - r), dm + δa + δb + r]
+// with δ the surfaces' achieved deflections and r a computed bound on the round-off of mapping B's
+// vertices into A's frame (from the poses' magnitudes) and of the triangle arithmetic (triangle_distance
+// is accurate to 64·2^-53 of the pair's extent). hi <= T: certainly in contact; lo > T: certainly apart;
+// else ambiguous. A pair is penetrating only when its crossing depth exceeds T + δa + δb + r (the
+// exact faces cross); a contact whose crossing depth is only within the bands is touching.
+// Ambiguous pairs are refined, cheapest first, until decided:
+//   analytic  the other face's triangles lie provably off a plane, cylinder or sphere (Surface::analytic)
+//             by more than T + its deflection: a lower bound on d* (proves "apart" only);
+//   refined   both faces re-tessellated at a tenth of their deflection by their SurfaceSource (cached
+//             in the Scene) and the interval taken again;
+//   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces), interval [d*, d*].
+// A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
+// class Undecided and its interval, never as touching. Clearance (T < d* <= clearance) is judged on
+// the mesh distance (or d* when it was computed). Results do not depend on the thread count.
+// Fast: the classes above on the triangles alone (τ = tolerance + δa + δb), decided_by Mesh, as
+// before certification. Exact: every reported pair's d* from SurfaceSource::exact_distance where the
+// faces have exact geometry; pairs farther than T become clearance (<= clearance) or leave the report
+// (counted in CollideCounters::dismissed_pairs).
 
-// Returns "penetrating", "touching", "clearance" or "containment".
+enum class ContactClass : std::uint8_t { Penetrating, Touching, Clearance, Containment, Undecided };
+
+// Returns "penetrating", "touching", "clearance", "containment" or "undecided".
 const char* contact_class_name(ContactClass c);
+
+enum class DecisionMode : std::uint8_t { Certified, Fast, Exact };
+
+// What settled a surface pair's class (see "Certified decisions").
+enum class DecidedBy : std::uint8_t {
+  Mesh,       // the triangles' interval, with deflection bands
+  MeshExact,  // the triangles' interval where both surfaces' triangles are the surfaces (no band but r)
+  Analytic,   // a plane/cylinder/sphere lower bound
+  Refined,    // re-tessellation of the two faces
+  Exact,      // the exact B-rep distance
+  Undecided,  // nothing above could decide it
+};
+
+// Returns "mesh", "mesh-exact", "analytic", "refined", "exact" or "undecided".
+const char* decided_by_name(DecidedBy d);
+// Returns "certified", "fast" or "exact".
+const char* decision_mode_name(DecisionMode m);
 
 enum class CollideMode : std::uint8_t {
   EarlyExit,          // per surface pair, stop at the first triangle pair that decides the class
@@ -251,6 +318,7 @@ struct CollideOptions {
   std::size_t flat_limit = 4096;  // Auto switches to the BVH above this many candidate pairs
   bool detect_containment = true;
   bool exact_verification = false;  // ask SurfaceSource::exact_distance for touching/clearance pairs
+  DecisionMode decision = DecisionMode::Certified;  // see "Certified decisions"
   double tessellation_deflection = 0.0;  // passed to require_triangles (<= 0: each source's default)
   // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
   // results of the instance pairs it finished, with Report::complete false (see Report).
@@ -286,6 +354,15 @@ struct CollideCounters {
   std::uint64_t distance_tests = 0;       // triangle distance computations
   std::uint64_t intersecting_pairs = 0;   // surface pairs with at least one intersecting triangle pair
   std::uint64_t tessellated_surfaces = 0; // surfaces this query asked require_triangles for
+  // Decisions (Certified and Exact modes): reported or dismissed surface pairs by what settled them,
+  // and the work the refinements did.
+  std::uint64_t decided_mesh = 0, decided_mesh_exact = 0, decided_analytic = 0, decided_refined = 0,
+                decided_exact = 0, undecided = 0;
+  std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
+  std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
+  std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
+  std::uint64_t dismissed_pairs = 0;    // candidate pairs the triangles' band would call touching
+                                        // (fast mode's answer) that a certificate proved apart
 };
 
 struct CollideTimings {  // seconds; never part of a determinism comparison
@@ -302,6 +379,10 @@ struct SurfacePairResult {
   double distance = 0.0;      // min triangle distance; 0 when intersecting; for Containment, the min
                               // distance when within the search margin, else +infinity
   double penetration = 0.0;   // crossing-depth estimate (see above); in EarlyExit mode a lower bound
+  DecidedBy decided_by = DecidedBy::Mesh;
+  // Bounds on the exact face distance d* from the evidence that decided the pair (see "Certified
+  // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].
+  double distance_lo = 0.0, distance_hi = 0.0;
   // exact_verification only: SurfaceSource::exact_distance for every pair that is not penetrating
   // (touching pairs with crossing triangles included: faceted coaxial cylinders with a small gap
   // cross), when both parts have exact geometry (a value > the search margin means "farther").

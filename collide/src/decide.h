@@ -1,0 +1,92 @@
+// The certified decision of one candidate surface pair (collide.h, "Certified decisions"): what the
+// triangles prove about the exact faces, and the analytic certificate. Internal to cadclash::collide.
+#pragma once
+
+#include "cadclash/collide.h"
+#include "narrow_phase.h"
+
+#include <limits>
+#include <optional>
+
+namespace cadclash::detail {
+
+// Bounds on the exact distance d* of two faces.
+struct Interval {
+  double lo = 0.0;
+  double hi = std::numeric_limits<double>::infinity();
+};
+
+// A computed bound r on the rounding between the triangle arithmetic and exact arithmetic on the
+// placed geometry, for an instance pair: mapping B's vertices (part-local magnitude <= mag_b) into
+// A's frame with pose_a⁻¹·pose_b composed in doubles, the rotations' deviation from orthonormal (as
+// stored), the vertices' own evaluation on their surfaces, and triangle_distance's error (64·2^-53
+// of the pair's extent). Every term is a count of roundings times the magnitude it applies to.
+double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, double mag_b);
+
+// The touching threshold T = tolerance + εa + εb of two surfaces.
+double touch_threshold(const Surface& a, const Surface& b, double tolerance);
+
+// How far the triangle level must search so that every pair with d* <= T is seen: T + δa + δb + r.
+double certified_reach(const Surface& a, const Surface& b, double tolerance, double roundoff);
+
+// What the triangles say about d*: [0, band] when they intersect, else [dm - band, dm + band]
+// clamped at 0, with band = δa + δb + r. dm = +inf (nothing within the search) gives lo = the
+// search reach (no pair nearer than that exists) and hi = +inf.
+Interval mesh_interval(const PairOutcome& o, double band, double reach);
+
+enum class Verdict : std::uint8_t { Contact, Apart, Ambiguous };
+
+// Contact when hi <= threshold, apart when lo > threshold, else ambiguous.
+Verdict verdict(const Interval& d, double threshold);
+
+// True when the triangles prove the exact faces cross deeper than `threshold`: they intersect with a
+// crossing depth above threshold + band.
+bool certainly_penetrating(const PairOutcome& o, double threshold, double band);
+
+// Lower bound on the distance between the exact surface `an` (given in frame F) and every point of the
+// triangles of `mesh` mapped into F by `to_f`, over the triangles whose boxes come within `reach` of
+// `region` (a box in F); returns `reach` when none does (a farther triangle cannot matter) and nullopt
+// for shapes without a certificate (Other, Cone, Torus). Subtract the mesh's deflection and the
+// round-off to bound the exact faces' distance. Plane: signed heights (linear over a triangle);
+// cylinder and sphere: the distance to the axis or centre is convex, so its maximum over a triangle
+// is at a vertex (the inside case) and its minimum is the triangle's distance to the axis or centre.
+std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh& mesh, const Pose& to_f,
+                                   const Aabb& region, double reach);
+
+// `an` (part-local of one frame) expressed in another frame by `t`.
+AnalyticSurface transform_analytic(const AnalyticSurface& an, const Pose& t);
+
+}  // namespace cadclash::detail
+
+#include "budget.h"
+#include "refine.h"
+
+#include <span>
+#include <vector>
+
+namespace cadclash::detail {
+
+// One candidate surface pair the triangle level finished (the decision stage's input).
+struct DecideTask {
+  InstanceId ia = kInvalidId, ib = kInvalidId;
+  SurfaceId sa = kInvalidId, sb = kInvalidId;
+  const PairOutcome* outcome = nullptr;  // null when a surface has no triangles: decided exactly
+  Pose t_ab = Pose::Identity(), t_ba = Pose::Identity();
+  double roundoff = 0.0;                 // pair_roundoff of the instance pair
+};
+
+struct DecideResult {
+  std::optional<SurfacePairResult> result;  // nullopt: not reported (apart)
+  bool cut = false;                         // the deadline stopped its refinement: no answer
+};
+
+// The decision stage (collide.h, "Certified decisions"), per options.decision. Refinements run in
+// parallel, each answer depending on its pair alone; results come back in task order, so the report
+// is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface).
+// Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`.
+std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses,
+                                       std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
+                                       const CollideOptions& options, int threads, const Deadline& deadline,
+                                       CollideCounters& counters);
+
+}  // namespace cadclash::detail

@@ -1,0 +1,175 @@
+// The certified decision's pieces: the round-off bound against a long-double reference under large
+// rigid motions, the triangles' interval and verdict, and the analytic lower bounds.
+#include "decide.h"
+#include "triangle_predicates.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace cadclash {
+namespace {
+
+using detail::analytic_gap;
+using detail::Interval;
+using detail::mesh_interval;
+using detail::pair_roundoff;
+using detail::PairOutcome;
+using detail::Verdict;
+using detail::verdict;
+
+using Mat4L = Eigen::Matrix<long double, 4, 4>;
+
+Pose random_pose(std::mt19937_64& rng, double offset) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vec3 axis(u(rng), u(rng), u(rng));
+  axis.normalize();
+  Pose p = Pose::Identity();
+  p.linear() = Eigen::AngleAxisd(3.0 * u(rng), axis).toRotationMatrix();
+  p.translation() = Vec3(u(rng), u(rng), u(rng)) * offset;
+  return p;
+}
+
+// A's triangle lies in its plane z = 0; B's small triangle is placed (by its pose) above A's interior
+// at height h, so the exact distance of the placed triangles is B's lowest vertex height, computed
+// here in long double from the stored doubles (pose_a⁻¹ inverted exactly, not transposed).
+TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
+  std::mt19937_64 rng(7);
+  const Vec3 a0(-50, -50, 0), a1(50, -50, 0), a2(0, 60, 0);
+  const Vec3 b0(-1, -1, 0), b1(1, -1, 0.5), b2(0, 1.2, 0.25);
+  const double mag_a = Vec3(50, 60, 0).norm(), mag_b = Vec3(1, 1.2, 0.5).norm();
+  double worst_ratio = 0.0;
+  for (double offset : {0.0, 1e3, 1e6, 1e9}) {
+    for (int k = 0; k < 2000; ++k) {
+      const Pose pa = random_pose(rng, offset);
+      // Heights from well above the rounding of composing the poses at this offset to 0.1.
+      std::uniform_real_distribution<double> hh(std::log10(std::max(1e-9, 1e-12 * offset)), -1.0);
+      Pose rel = random_pose(rng, 0.0);
+      rel.linear() = Eigen::AngleAxisd(0.3 * (k % 7), Vec3::UnitZ()).toRotationMatrix();
+      rel.translation() = Vec3(0.1 * (k % 5), -0.2, std::pow(10.0, hh(rng)));
+      const Pose pb = pa * rel;  // B's pose as a user's assembly would store it: rounded doubles
+      const Pose t_ab = pa.inverse(Eigen::Isometry) * pb;
+      const double got = detail::triangle_distance(a0, a1, a2, t_ab * b0, t_ab * b1, t_ab * b2);
+      const Mat4L ma = pa.matrix().cast<long double>(), mb = pb.matrix().cast<long double>();
+      const Mat4L rel_ld = ma.inverse() * mb;
+      long double ref = 1e300L;
+      for (const Vec3& v : {b0, b1, b2}) {
+        const Eigen::Matrix<long double, 4, 1> p = rel_ld * Eigen::Matrix<long double, 4, 1>(v.x(), v.y(), v.z(), 1);
+        ref = std::min(ref, p(2));
+      }
+      ASSERT_GT(ref, 0.0L);
+      const double r = pair_roundoff(pa, pb, mag_a, mag_b);
+      const double err = static_cast<double>(std::fabs(static_cast<long double>(got) - ref));
+      ASSERT_LE(err, r) << "offset " << offset << " case " << k;
+      worst_ratio = std::max(worst_ratio, err / r);
+    }
+    // Useful, not only safe: for neighbours 1e6 mm from the origin, far below the smallest model
+    // uncertainty (1e-7 mm).
+    const Pose pa = random_pose(rng, offset);
+    Pose pb = pa;
+    pb.translation() += Vec3(3, 4, 5);
+    if (offset <= 1e6) EXPECT_LT(pair_roundoff(pa, pb, mag_a, mag_b), 1e-8) << "offset " << offset;
+  }
+  std::printf("worst error / bound: %.3g\n", worst_ratio);
+}
+
+TEST(PairRoundoff, GrowsWithTheMagnitudes) {
+  const Pose id = Pose::Identity();
+  Pose far = id;
+  far.translation() = Vec3(1e6, 0, 0);
+  EXPECT_GT(pair_roundoff(far, far, 10, 10), pair_roundoff(id, id, 10, 10));
+  EXPECT_GT(pair_roundoff(id, id, 1e3, 1e3), pair_roundoff(id, id, 10, 10));
+  EXPECT_GT(pair_roundoff(id, id, 1, 1), 0.0);
+}
+
+TEST(MeshInterval, IntersectingDistantAndBeyondTheSearch) {
+  PairOutcome o;
+  o.intersecting = true;
+  Interval d = mesh_interval(o, 0.1, 1.0);
+  EXPECT_EQ(d.lo, 0.0);
+  EXPECT_EQ(d.hi, 0.1);
+  o = PairOutcome{};
+  o.distance = 0.5;
+  d = mesh_interval(o, 0.1, 1.0);
+  EXPECT_DOUBLE_EQ(d.lo, 0.4);
+  EXPECT_DOUBLE_EQ(d.hi, 0.6);
+  o.distance = 0.05;
+  EXPECT_EQ(mesh_interval(o, 0.1, 1.0).lo, 0.0);
+  o.distance = std::numeric_limits<double>::infinity();
+  d = mesh_interval(o, 0.1, 1.0);
+  EXPECT_EQ(d.lo, 1.0);
+  EXPECT_TRUE(std::isinf(d.hi));
+}
+
+TEST(Verdict, ThreeWays) {
+  EXPECT_EQ(verdict({0.0, 1e-9}, 2e-7), Verdict::Contact);
+  EXPECT_EQ(verdict({0.03, 0.2}, 2e-7), Verdict::Apart);
+  EXPECT_EQ(verdict({0.0, 0.2}, 2e-7), Verdict::Ambiguous);
+  EXPECT_EQ(verdict({2e-7, 2e-7}, 2e-7), Verdict::Contact);  // d* <= T touches
+}
+
+TriangleMesh one_triangle(Vec3 a, Vec3 b, Vec3 c) {
+  TriangleMesh m;
+  m.vertices = {a, b, c};
+  m.triangles = {{0, 1, 2}};
+  return m;
+}
+
+AnalyticSurface shape(SurfaceShape s, Vec3 origin, Vec3 axis, double radius) {
+  AnalyticSurface a;
+  a.shape = s;
+  a.origin = origin;
+  a.axis = axis;
+  a.radius = radius;
+  return a;
+}
+
+const Aabb kEverywhere(Vec3::Constant(-1e3), Vec3::Constant(1e3));
+
+TEST(AnalyticGap, PlaneUsesSignedHeights) {
+  const auto plane = shape(SurfaceShape::Plane, Vec3(0, 0, 1), Vec3::UnitZ(), 0);
+  const auto above = one_triangle(Vec3(0, 0, 1.03), Vec3(1, 0, 1.05), Vec3(0, 1, 1.04));
+  EXPECT_NEAR(*analytic_gap(plane, above, Pose::Identity(), kEverywhere, 1.0), 0.03, 1e-12);
+  const auto below = one_triangle(Vec3(0, 0, 0.9), Vec3(1, 0, 0.95), Vec3(0, 1, 0.96));
+  EXPECT_NEAR(*analytic_gap(plane, below, Pose::Identity(), kEverywhere, 1.0), 0.04, 1e-12);
+  const auto crossing = one_triangle(Vec3(0, 0, 0.9), Vec3(1, 0, 1.05), Vec3(0, 1, 0.96));
+  EXPECT_EQ(*analytic_gap(plane, crossing, Pose::Identity(), kEverywhere, 1.0), 0.0);
+  // Mapped by a pose: the same triangle moved 1 up is 1 farther.
+  Pose up = Pose::Identity();
+  up.translation() = Vec3(0, 0, 0.5);
+  EXPECT_NEAR(*analytic_gap(plane, above, up, kEverywhere, 1.0), 0.53, 1e-12);
+  // Farther than the reach from the region: cannot matter, the reach is returned.
+  const Aabb region(Vec3(100, 100, 0), Vec3(101, 101, 2));
+  EXPECT_EQ(*analytic_gap(plane, crossing, Pose::Identity(), region, 1.0), 1.0);
+}
+
+TEST(AnalyticGap, CylinderInsideAndOutside) {
+  const auto cyl = shape(SurfaceShape::Cylinder, Vec3(0, 0, 0), Vec3::UnitZ(), 5.0);
+  // A bolt's facet 0.03 inside the hole: every vertex at radius 4.97.
+  const double r = 4.97;
+  const auto inside = one_triangle(Vec3(r, 0, 0), Vec3(r * std::cos(0.3), r * std::sin(0.3), 0), Vec3(r, 0, 3));
+  EXPECT_NEAR(*analytic_gap(cyl, inside, Pose::Identity(), kEverywhere, 1.0), 0.03, 1e-12);
+  // Outside: a flat triangle tangent-ish at distance 5.03 from the axis (its nearest point is interior
+  // to an edge, not a vertex).
+  const auto outside = one_triangle(Vec3(5.03, -1, -1), Vec3(5.03, 1, -1), Vec3(5.03, 0, 2));
+  EXPECT_NEAR(*analytic_gap(cyl, outside, Pose::Identity(), kEverywhere, 1.0), 0.03, 1e-12);
+  // A chord of the cylinder itself (vertices on it, middle inside): gap 0.
+  const auto chord = one_triangle(Vec3(5, 0, 0), Vec3(0, 5, 0), Vec3(5, 0, 1));
+  EXPECT_EQ(*analytic_gap(cyl, chord, Pose::Identity(), kEverywhere, 1.0), 0.0);
+}
+
+TEST(AnalyticGap, SphereAndUnsupportedShapes) {
+  const auto sph = shape(SurfaceShape::Sphere, Vec3(1, 2, 3), Vec3::UnitZ(), 2.0);
+  const auto outside = one_triangle(Vec3(1, 2, 5.1), Vec3(2, 2, 5.1), Vec3(1, 3, 5.1));
+  EXPECT_NEAR(*analytic_gap(sph, outside, Pose::Identity(), kEverywhere, 1.0), 0.1, 1e-12);
+  const auto inside = one_triangle(Vec3(1, 2, 4.5), Vec3(1.5, 2, 4.5), Vec3(1, 2.5, 4.5));
+  const double rmax = Vec3(0.5, 0, 1.5).norm();
+  EXPECT_NEAR(*analytic_gap(sph, inside, Pose::Identity(), kEverywhere, 1.0), 2.0 - rmax, 1e-12);
+  EXPECT_FALSE(analytic_gap(shape(SurfaceShape::Torus, Vec3::Zero(), Vec3::UnitZ(), 3), outside,
+                            Pose::Identity(), kEverywhere, 1.0));
+  EXPECT_FALSE(analytic_gap(AnalyticSurface{}, outside, Pose::Identity(), kEverywhere, 1.0));
+}
+
+}  // namespace
+}  // namespace cadclash
