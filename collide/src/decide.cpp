@@ -45,12 +45,18 @@ double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, doubl
   return map + gamma(8) * (mag_a + mag_b) + 128.0 * kUnit * frame;
 }
 
-double touch_threshold(const Surface& a, const Surface& b, double tolerance) {
-  return tolerance + a.uncertainty + b.uncertainty;
+double effective_uncertainty(const Surface& s, double part_magnitude) {
+  return s.uncertainty > 0.0 ? s.uncertainty : 0x1p-24 * part_magnitude;
 }
 
-double certified_reach(const Surface& a, const Surface& b, double tolerance, double roundoff) {
-  return touch_threshold(a, b, tolerance) + a.deflection + b.deflection + roundoff;
+double box_norm(const Aabb& box) {
+  if (box.isEmpty()) return 0.0;
+  return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
+}
+
+bool triangles_are_exact(const Model& model, SurfaceId s) {
+  const Surface& surf = model.surfaces[s];
+  return surf.exact_triangles || (!model.parts[surf.part].source && surf.deflection == 0.0);
 }
 
 Interval mesh_interval(const PairOutcome& o, double band, double reach) {
@@ -136,6 +142,65 @@ std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh
     if (gap <= 0.0) break;
   }
   return gap;
+}
+
+namespace {
+
+// Bounds of the distance to a cylinder's axis (or a sphere's centre) over the points of another
+// surface within the region, then the gap to that surface's radius.
+double radial_gap(double radius, double rho_lo, double rho_hi) {
+  return std::max({0.0, radius - rho_hi, rho_lo - radius});
+}
+
+// Plane `p` against cylinder or sphere `q`: heights of q's points over p's plane.
+std::optional<double> plane_against(const AnalyticSurface& p, const AnalyticSurface& q, const Vec3& centre,
+                                    double half) {
+  const Vec3 n = p.axis.normalized();
+  if (q.shape == SurfaceShape::Sphere) return std::max(0.0, std::abs(n.dot(q.origin - p.origin)) - q.radius);
+  if (q.shape != SurfaceShape::Cylinder) return std::nullopt;
+  // q's points are p0 + s·a + r·w with |w| = 1; over the region |s| <= half + r + |c - p0|.
+  const Vec3 a = q.axis.normalized();
+  const Vec3 p0 = q.origin + (centre - q.origin).dot(a) * a;
+  const double span = half + q.radius + (centre - p0).norm();
+  const double h0 = std::abs(n.dot(p0 - p.origin));
+  return std::max(0.0, h0 - std::abs(n.dot(a)) * span - q.radius);
+}
+
+}  // namespace
+
+std::optional<double> analytic_pair_gap(const AnalyticSurface& a, const AnalyticSurface& b, const Aabb& region) {
+  if (region.isEmpty()) return std::nullopt;
+  const Vec3 centre = region.center();
+  const double half = 0.5 * region.diagonal().norm();
+  using S = SurfaceShape;
+  if (a.shape == S::Plane && b.shape == S::Plane) {
+    // b's points within the region: their heights over a's plane vary by at most sinθ times their
+    // distance from the foot of the centre on b's plane.
+    const Vec3 n1 = a.axis.normalized(), n2 = b.axis.normalized();
+    const double hc2 = n2.dot(centre - b.origin);
+    const Vec3 c2 = centre - hc2 * n2;
+    const double sin_t = n1.cross(n2).norm();
+    return std::max(0.0, std::abs(n1.dot(c2 - a.origin)) - sin_t * (half + std::abs(hc2)));
+  }
+  if (a.shape == S::Plane) return plane_against(a, b, centre, half);
+  if (b.shape == S::Plane) return plane_against(b, a, centre, half);
+  if (a.shape == S::Sphere && b.shape == S::Sphere) {
+    const double e = (a.origin - b.origin).norm();
+    return radial_gap(a.radius, std::abs(e - b.radius), e + b.radius);
+  }
+  if (a.shape == S::Cylinder && b.shape == S::Cylinder) {
+    // b's points p + r2·w (p on b's axis, w ⊥ b's axis): their distance to a's axis lies within
+    // [r2·cosθ - E, r2 + E], E bounding p's distance to a's axis over the region.
+    const Vec3 a1 = a.axis.normalized(), a2 = b.axis.normalized();
+    const Vec3 p0 = b.origin + (centre - b.origin).dot(a2) * a2;
+    const Vec3 w0 = p0 - a.origin;
+    const double e0 = (w0 - w0.dot(a1) * a1).norm();
+    const double sin_t = a1.cross(a2).norm();
+    const double cos_t = std::sqrt(std::max(0.0, 1.0 - sin_t * sin_t));
+    const double E = e0 + sin_t * (half + b.radius + (centre - p0).norm());
+    return radial_gap(a.radius, b.radius * cos_t - E, b.radius + E);
+  }
+  return std::nullopt;
 }
 
 }  // namespace cadclash::detail

@@ -23,11 +23,25 @@ struct Interval {
 // of the pair's extent). Every term is a count of roundings times the magnitude it applies to.
 double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, double mag_b);
 
-// The touching threshold T = tolerance + εa + εb of two surfaces.
-double touch_threshold(const Surface& a, const Surface& b, double tolerance);
+// ε of a surface as the decision uses it: Surface::uncertainty, or when that is 0 the
+// single-precision representation bound 2^-24 of its part's largest coordinate magnitude.
+double effective_uncertainty(const Surface& s, double part_magnitude);
+
+// The largest Euclidean norm of a point of `box` (0 for an empty box).
+double box_norm(const Aabb& box);
+
+// The touching threshold T = tolerance + εa + εb (effective uncertainties).
+inline double touch_threshold(double eps_a, double eps_b, double tolerance) { return tolerance + eps_a + eps_b; }
 
 // How far the triangle level must search so that every pair with d* <= T is seen: T + δa + δb + r.
-double certified_reach(const Surface& a, const Surface& b, double tolerance, double roundoff);
+inline double certified_reach(const Surface& a, double eps_a, const Surface& b, double eps_b, double tolerance,
+                              double roundoff) {
+  return touch_threshold(eps_a, eps_b, tolerance) + a.deflection + b.deflection + roundoff;
+}
+
+// True when the surface's triangles are the surface: Surface::exact_triangles, or a part without a
+// SurfaceSource whose triangles carry no deflection (a mesh).
+bool triangles_are_exact(const Model& model, SurfaceId s);
 
 // What the triangles say about d*: [0, band] when they intersect, else [dm - band, dm + band]
 // clamped at 0, with band = δa + δb + r. dm = +inf (nothing within the search) gives lo = the
@@ -52,6 +66,13 @@ bool certainly_penetrating(const PairOutcome& o, double threshold, double band);
 // is at a vertex (the inside case) and its minimum is the triangle's distance to the axis or centre.
 std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh& mesh, const Pose& to_f,
                                    const Aabb& region, double reach);
+
+// Lower bound on the distance between the points of surfaces `a` and `b` (both in one frame) that lie
+// in `region` (a box enclosing every place where the faces can come within the threshold), from
+// their parameters alone: plane, cylinder and sphere against each other. Tilts are not assumed away:
+// the angle between normals or axes, as computed, widens the bound over the region's size. nullopt
+// for other combinations. Subtract both ε and the round-off to bound the exact faces' distance.
+std::optional<double> analytic_pair_gap(const AnalyticSurface& a, const AnalyticSurface& b, const Aabb& region);
 
 // `an` (part-local of one frame) expressed in another frame by `t`.
 AnalyticSurface transform_analytic(const AnalyticSurface& an, const Pose& t);
@@ -84,7 +105,8 @@ struct DecideResult {
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
 // is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`.
-std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses,
+// `eps` holds every surface's effective_uncertainty.
+std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
                                        CollideCounters& counters);

@@ -47,11 +47,11 @@ void settle(Pending& p, Verdict v, DecidedBy by, const PairOutcome* o, double cl
 }
 
 // Step 1: the interval of the model's triangles.
-Pending from_mesh(const Model& m, const DecideTask& t, const CollideOptions& o) {
+Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask& t, const CollideOptions& o) {
   const Surface& a = m.surfaces[t.sa];
   const Surface& b = m.surfaces[t.sb];
   Pending p;
-  p.threshold = touch_threshold(a, b, o.tolerance);
+  p.threshold = touch_threshold(eps[t.sa], eps[t.sb], o.tolerance);
   p.band = a.deflection + b.deflection + t.roundoff;
   const double reach = p.threshold + p.band;
   if (t.outcome == nullptr) {  // no triangles on one side: only the boxes are known
@@ -59,7 +59,8 @@ Pending from_mesh(const Model& m, const DecideTask& t, const CollideOptions& o) 
     return p;
   }
   p.d = mesh_interval(*t.outcome, p.band, reach);
-  const DecidedBy by = a.exact_triangles && b.exact_triangles ? DecidedBy::MeshExact : DecidedBy::Mesh;
+  const DecidedBy by =
+      triangles_are_exact(m, t.sa) && triangles_are_exact(m, t.sb) ? DecidedBy::MeshExact : DecidedBy::Mesh;
   const Verdict v = verdict(p.d, p.threshold);
   if (o.decision == DecisionMode::Exact && !(v == Verdict::Apart && p.d.lo > std::max(p.threshold, o.clearance)))
     return p;  // the exact step decides (faces without exact geometry fall back to this verdict there)
@@ -68,20 +69,29 @@ Pending from_mesh(const Model& m, const DecideTask& t, const CollideOptions& o) 
 }
 
 // Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
-void analytic(const Model& m, const DecideTask& t, Pending& p, const CollideOptions& o) {
+void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
   const Surface& a = m.surfaces[t.sa];
   const Surface& b = m.surfaces[t.sb];
   const double r = t.roundoff;
   double lb = 0.0;
+  // The two surfaces' parameters: where the faces can come within T of each other, both lie in A's
+  // face box and in B's grown by T.
+  const Aabb box_b = transform_box(own_box(b), t.t_ab);
+  const Aabb region = own_box(a).intersection(pad_box(box_b, p.threshold));
+  if (region.isEmpty()) {
+    lb = box_distance(own_box(a), box_b);  // the boxes enclose the exact faces
+  } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab), region)) {
+    lb = std::max(lb, *g - eps[t.sa] - eps[t.sb] - r);
+  }
   if (b.has_triangles) {
     const double reach = p.threshold + b.deflection + r;
     if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab, own_box(a), reach))
-      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - a.uncertainty);
+      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps[t.sa]);
   }
   if (a.has_triangles) {
     const double reach = p.threshold + a.deflection + r;
     if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba, own_box(b), reach))
-      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - b.uncertainty);
+      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps[t.sb]);
   }
   if (!(lb > p.threshold)) return;
   p.d.lo = std::max(p.d.lo, lb);
@@ -171,7 +181,7 @@ std::optional<SurfacePairResult> fast(const Model& m, const DecideTask& t, const
 
 }  // namespace
 
-std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses,
+std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
                                        CollideCounters& counters) {
@@ -187,9 +197,9 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 #pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     const auto ku = static_cast<std::size_t>(k);
-    pending[ku] = from_mesh(model, tasks[ku], o);
+    pending[ku] = from_mesh(model, eps, tasks[ku], o);
     if (!pending[ku].settled && o.decision == DecisionMode::Certified && tasks[ku].outcome != nullptr)
-      analytic(model, tasks[ku], pending[ku], o);
+      analytic(model, eps, tasks[ku], pending[ku], o);
   }
   for (const Pending& p : pending) counters.ambiguous_pairs += !p.settled;
 
@@ -230,12 +240,11 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     }
     if (exact_step(model, poses, tasks[k], p, o, task_counters[k])) continue;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
-    const Surface& a = model.surfaces[tasks[k].sa];
-    const Surface& b = model.surfaces[tasks[k].sb];
     if (tasks[k].outcome != nullptr)
       settle(p, verdict(p.d, p.threshold),
-             a.exact_triangles && b.exact_triangles ? DecidedBy::MeshExact : DecidedBy::Mesh, tasks[k].outcome,
-             o.clearance);
+             triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb) ? DecidedBy::MeshExact
+                                                                                               : DecidedBy::Mesh,
+             tasks[k].outcome, o.clearance);
   }
 
   for (std::size_t k = 0; k < tasks.size(); ++k) {

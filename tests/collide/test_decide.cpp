@@ -171,5 +171,41 @@ TEST(AnalyticGap, SphereAndUnsupportedShapes) {
   EXPECT_FALSE(analytic_gap(AnalyticSurface{}, outside, Pose::Identity(), kEverywhere, 1.0));
 }
 
+TEST(AnalyticPairGap, CoaxialCylindersParallelPlanesAndTilts) {
+  using detail::analytic_pair_gap;
+  const Aabb region(Vec3(-6, -6, 0), Vec3(6, 6, 10));
+  const auto bore = shape(SurfaceShape::Cylinder, Vec3(0, 0, 0), Vec3::UnitZ(), 5.05);
+  const auto rod = shape(SurfaceShape::Cylinder, Vec3(0, 0, -3), Vec3::UnitZ(), 5.0);
+  EXPECT_NEAR(*analytic_pair_gap(bore, rod, region), 0.05, 1e-12);
+  EXPECT_NEAR(*analytic_pair_gap(rod, bore, region), 0.05, 1e-12);
+  // Tilted by 1e-9 rad: the bound shrinks by about the tilt times the region, never grows.
+  auto tilted = rod;
+  tilted.axis = Vec3(1e-9, 0, 1).normalized();
+  const double g = *analytic_pair_gap(bore, tilted, region);
+  EXPECT_LT(g, 0.05);
+  EXPECT_GT(g, 0.05 - 1e-7);
+  // Offset axes: a rod 0.05 off-centre touches the bore.
+  auto shifted = rod;
+  shifted.origin = Vec3(0.05, 0, 0);
+  EXPECT_EQ(*analytic_pair_gap(bore, shifted, region), 0.0);
+  // Parallel planes 0.03 apart, and tilted by 1e-6: the height changes by at most 1e-6 x the region.
+  const auto p1 = shape(SurfaceShape::Plane, Vec3(0, 0, 1), Vec3::UnitZ(), 0);
+  auto p2 = shape(SurfaceShape::Plane, Vec3(0, 0, 1.03), -Vec3::UnitZ(), 0);
+  EXPECT_NEAR(*analytic_pair_gap(p1, p2, region), 0.03, 1e-12);
+  p2.axis = Vec3(1e-6, 0, -1).normalized();
+  const double gp = *analytic_pair_gap(p1, p2, region);
+  EXPECT_LT(gp, 0.03);
+  EXPECT_GT(gp, 0.03 - 2e-5);
+  // A rod lying 0.02 above a plane, and a ball 0.1 above it.
+  auto lying = shape(SurfaceShape::Cylinder, Vec3(0, 0, 6.02), Vec3::UnitX(), 5.0);
+  EXPECT_NEAR(*analytic_pair_gap(p1, lying, region), 0.02, 1e-12);
+  EXPECT_NEAR(*analytic_pair_gap(lying, p1, region), 0.02, 1e-12);
+  const auto ball = shape(SurfaceShape::Sphere, Vec3(0, 0, 3.1), Vec3::UnitZ(), 2.0);
+  EXPECT_NEAR(*analytic_pair_gap(p1, ball, region), 0.1, 1e-12);
+  // Unsupported combinations give no certificate.
+  EXPECT_FALSE(analytic_pair_gap(rod, ball, region));
+  EXPECT_FALSE(analytic_pair_gap(shape(SurfaceShape::Torus, Vec3::Zero(), Vec3::UnitZ(), 3), p1, region));
+}
+
 }  // namespace
 }  // namespace cadclash

@@ -118,7 +118,8 @@ struct Surface {
   // the largest OCCT tolerance of the face, its edges and vertices (never below Precision::Confusion,
   // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger. Meshes: the single-precision
   // representation bound 2^-24 · (largest coordinate magnitude of the part), or the importer's
-  // model_tolerance when given. Two faces touch when their exact distance <= tolerance + εa + εb.
+  // model_tolerance when given. 0 (a Model built by hand) means that same bound, derived by collide
+  // from the part's box. Two faces touch when their exact distance <= tolerance + εa + εb.
   double uncertainty = 0.0;
   // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
   // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
