@@ -24,7 +24,9 @@ struct Pending {
   bool cut = false;
 };
 
-Aabb own_box(const Surface& s) { return s.aabb.isEmpty() ? mesh_aabb(s.mesh) : s.aabb; }
+// A box enclosing the exact face: Surface::aabb does for B-rep faces, but for a mesh it encloses the
+// triangles, which may lie up to the deflection inside the surface they stand for.
+Aabb own_box(const Surface& s) { return pad_box(s.aabb.isEmpty() ? mesh_aabb(s.mesh) : s.aabb, s.deflection); }
 
 // The class of a pair proved apart: clearance when its distance (the exact one when known, else the
 // mesh's) is within the clearance, else not reported.
@@ -283,6 +285,55 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     results[k].result = std::move(r);
   }
   return results;
+}
+
+}  // namespace cadclash::detail
+
+// ---------------------------------------------------------------------------------------------
+// Stage 5 of Scene::check: the decision of every finished task, into the per-instance-pair results.
+// ---------------------------------------------------------------------------------------------
+#include "scene_stages.h"
+
+namespace cadclash::detail {
+
+void decision_stage(SceneData& s, QueryState& q) {
+  const Model& model = s.model;
+  const std::size_t npairs = q.pairs.size();
+  q.pair_cut.assign(npairs, 0);
+  for (std::size_t k = 0; k < npairs; ++k) q.pair_cut[k] = q.pairs[k].cut;
+  q.pair_intersects.assign(npairs, 0);
+  q.pair_distance.assign(npairs, std::numeric_limits<double>::infinity());
+  q.pair_results.assign(npairs, {});
+  std::vector<DecideTask> decide;
+  std::vector<std::size_t> task_of;  // decide[i] is task task_of[i]
+  for (std::size_t k = 0; k < q.first_task[q.cutoff]; ++k) {
+    const Task& t = q.tasks[k];
+    if (q.task_cut[k]) {
+      q.pair_cut[t.pair] = 1;
+      continue;
+    }
+    const InstancePair& ip = q.pairs[t.pair];
+    const bool usable = model.surfaces[t.sa].has_triangles && model.surfaces[t.sb].has_triangles;
+    if (usable && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
+    decide.push_back({ip.a, ip.b, t.sa, t.sb, usable ? &q.outcomes[k] : nullptr, ip.t_ab, ip.t_ba, ip.roundoff});
+    task_of.push_back(k);
+  }
+  std::vector<DecideResult> results =
+      decide_pairs(model, s.poses, s.eps, decide, s.refined, q.o, q.threads, q.deadline, q.report.counters);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const std::size_t k = task_of[i];
+    const std::size_t pair = q.tasks[k].pair;
+    if (results[i].cut) {
+      q.task_cut[k] = 1;
+      q.pair_cut[pair] = 1;
+      continue;
+    }
+    if (!results[i].result) continue;
+    SurfacePairResult& r = *results[i].result;
+    q.pair_distance[pair] = std::min(q.pair_distance[pair], r.distance);
+    q.charge[pair] += result_bytes(r);
+    q.pair_results[pair].push_back(std::move(r));
+  }
 }
 
 }  // namespace cadclash::detail

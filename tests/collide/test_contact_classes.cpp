@@ -1,6 +1,7 @@
 // One labelled scene per contact class (definitions in collide.h).
 #include "scene_fixtures.h"
 
+#include <cstdio>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -76,15 +77,30 @@ TEST(ContactClass, CoaxialCylinderInHoleTouchesThroughDeflection) {
   const PartId nut = add_part(m, "nut", {cylinder_surface("bore", 5.0, 0.0, 10.0, 36, 0.1, false)});
   add_instance(m, "/bolt", bolt);
   add_instance(m, "/nut", nut);
-  Report r = collide(m, 0, 1);
+  CollideOptions fast;
+  fast.decision = DecisionMode::Fast;
+  Report r = collide(m, 0, 1, fast);
   ASSERT_EQ(r.pairs.size(), 1u);
   EXPECT_EQ(r.pairs[0].contact, ContactClass::Touching);
   EXPECT_LE(r.pairs[0].penetration, m.surfaces[0].deflection + m.surfaces[1].deflection);
-  // Without the deflections the chords' crossing looks like penetration: the tolerance needs them.
-  m.surfaces[0].deflection = m.surfaces[1].deflection = 0.0;
+  // Certified: the chords only say the exact faces are within both deflections of each other, and
+  // without exact geometry nothing can say more. Reported as undecided with that interval, never as
+  // touching.
   r = collide(m, 0, 1);
   ASSERT_EQ(r.pairs.size(), 1u);
-  EXPECT_EQ(r.pairs[0].contact, ContactClass::Penetrating);
+  EXPECT_EQ(r.pairs[0].contact, ContactClass::Undecided);
+  EXPECT_EQ(r.pairs[0].decided_by, DecidedBy::Undecided);
+  EXPECT_EQ(r.pairs[0].distance_lo, 0.0);
+  EXPECT_GE(r.pairs[0].distance_hi, m.surfaces[0].deflection + m.surfaces[1].deflection);
+  EXPECT_EQ(r.counters.undecided, 1u);
+  // Without the deflections the chords' crossing looks like penetration: the tolerance needs them.
+  m.surfaces[0].deflection = m.surfaces[1].deflection = 0.0;
+  for (const CollideOptions& o : {fast, CollideOptions{}}) {
+    r = collide(m, 0, 1, o);
+    ASSERT_EQ(r.pairs.size(), 1u);
+    EXPECT_EQ(r.pairs[0].contact, ContactClass::Penetrating);
+  }
+  EXPECT_EQ(r.pairs[0].decided_by, DecidedBy::MeshExact);
 }
 
 TEST(ContactClass, ThinnerBoltInHoleIsClearance) {
@@ -114,11 +130,37 @@ TEST(ContactClass, PlaneTangentToFacetedCylinderTouches) {
   add_instance(m, "/plate", plate);
   CollideOptions o;
   o.tolerance = 1e-9;
+  o.decision = DecisionMode::Fast;
   Report r = collide(m, 0, 1, o);
   ASSERT_EQ(r.pairs.size(), 1u);
   EXPECT_EQ(r.pairs[0].contact, ContactClass::Touching);
   EXPECT_FALSE(r.pairs[0].intersecting);
   EXPECT_NEAR(r.pairs[0].distance, m.surfaces[0].deflection, 1e-9);
+  // Certified without exact geometry: the gap of one sagitta may be the faceting or a real gap.
+  o.decision = DecisionMode::Certified;
+  r = collide(m, 0, 1, o);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  EXPECT_EQ(r.pairs[0].contact, ContactClass::Undecided);
+  EXPECT_EQ(r.pairs[0].distance_lo, 0.0);
+  EXPECT_NEAR(r.pairs[0].distance_hi, 2.0 * m.surfaces[0].deflection, 1e-9);
+  // Told the roller's exact shape, the mesh-only plate is proved 0 from it within the band... still
+  // only a lower bound of 0: a plane tangent to a cylinder is in contact, which needs exact geometry.
+  m.surfaces[0].analytic.shape = SurfaceShape::Cylinder;
+  m.surfaces[0].analytic.axis = Vec3::UnitZ();
+  m.surfaces[0].analytic.radius = 10.0;
+  r = collide(m, 0, 1, o);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  EXPECT_EQ(r.pairs[0].contact, ContactClass::Undecided);
+  // Moved 0.05 away (more than the band of one sagitta), the cylinder's parameters prove it apart.
+  m.instances[1].pose.translation().x() += 0.05;
+  o.decision = DecisionMode::Fast;
+  const bool fast_touches = !collide(m, 0, 1, o).pairs.empty();
+  o.decision = DecisionMode::Certified;
+  r = collide(m, 0, 1, o);
+  EXPECT_TRUE(r.pairs.empty());
+  if (fast_touches) EXPECT_EQ(r.counters.decided_analytic, 1u);
+  m.instances[1].pose.translation().x() -= 0.05;
+  o.decision = DecisionMode::Fast;
   // A mesh without a recorded deflection is taken literally: the gap is a clearance.
   m.surfaces[0].deflection = 0.0;
   o.clearance = 1.0;

@@ -318,7 +318,6 @@ struct CollideOptions {
   TriangleLevel triangle_level = TriangleLevel::Auto;
   std::size_t flat_limit = 4096;  // Auto switches to the BVH above this many candidate pairs
   bool detect_containment = true;
-  bool exact_verification = false;  // ask SurfaceSource::exact_distance for touching/clearance pairs
   DecisionMode decision = DecisionMode::Certified;  // see "Certified decisions"
   double tessellation_deflection = 0.0;  // passed to require_triangles (<= 0: each source's default)
   // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
@@ -384,9 +383,8 @@ struct SurfacePairResult {
   // Bounds on the exact face distance d* from the evidence that decided the pair (see "Certified
   // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].
   double distance_lo = 0.0, distance_hi = 0.0;
-  // exact_verification only: SurfaceSource::exact_distance for every pair that is not penetrating
-  // (touching pairs with crossing triangles included: faceted coaxial cylinders with a small gap
-  // cross), when both parts have exact geometry (a value > the search margin means "farther").
+  // SurfaceSource::exact_distance when the decision asked for it (exact step; DecisionMode::Exact asks
+  // for every pair with exact geometry); a value > max(T, clearance) means "farther than that".
   std::optional<double> exact_distance;
   // AllTrianglePairs only: intersecting (triangle index in Sk, triangle index in Sl), sorted.
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;

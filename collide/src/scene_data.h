@@ -1,0 +1,114 @@
+// What a prepared Scene keeps between queries (SceneData) and what one check() builds as it runs
+// through its stages (QueryState). Internal to cadclash::collide; the stages are in stage_*.cpp and
+// declared in scene_stages.h.
+#pragma once
+
+#include "budget.h"
+#include "cadclash/collide.h"
+#include "narrow_phase.h"
+#include "refine.h"
+#include "surface_bvh.h"
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace cadclash::detail {
+
+struct SceneData {
+  Model& model;
+  SceneSelection selection;
+  std::vector<Pose> poses;
+  std::vector<Aabb> part_box;       // part-local union of its surfaces' boxes
+  std::vector<double> part_norm;    // largest norm of a point of part_box (round-off bounds)
+  std::vector<double> eps;          // per surface: effective_uncertainty (decide.h)
+  std::vector<Aabb> world_box;      // per instance
+  std::vector<char> dirty;
+  std::vector<SurfaceBvh> bvh;
+  std::vector<char> bvh_ready;
+  std::vector<RefinedSurface> refined;  // finer faces made for refinement, kept for later queries
+  std::vector<char> in_a, in_b;
+  std::set<std::pair<InstanceId, InstanceId>> excluded;
+  std::unordered_map<std::string, InstanceId> by_path;
+
+  SceneData(Model& m, SceneSelection sel);
+
+  SurfaceId first(PartId p) const { return model.parts[p].first_surface; }
+  SurfaceId end(PartId p) const { return model.parts[p].first_surface + model.parts[p].surface_count; }
+  Aabb surface_box(SurfaceId s) const;
+  // Deflection a surface's triangles have, or will have when tessellated on demand.
+  double deflection(SurfaceId s, const CollideOptions& o) const;
+  // What a surface adds to the search reach: its deflection, plus its uncertainty unless fast.
+  double reach_share(SurfaceId s, const CollideOptions& o) const;
+  double part_reach_share(PartId p, const CollideOptions& o) const;
+  bool selected(InstanceId i, InstanceId j) const;
+};
+
+// One overlapping instance pair: what the object and surface levels found.
+struct InstancePair {
+  InstanceId a = kInvalidId, b = kInvalidId;
+  Pose t_ab = Pose::Identity(), t_ba = Pose::Identity();  // B → A and A → B
+  double roundoff = 0.0;  // pair_roundoff (decide.h); 0 in fast mode
+  std::vector<std::array<SurfaceId, 2>> candidates;
+  int containment = 0;  // 1: B's box inside A's (test B inside A); 2: the reverse; 0: neither
+  CollideCounters counters;
+  bool cut = false;  // the time budget ran out before its surface level
+};
+
+struct Task {
+  std::uint32_t pair = 0;  // index into the instance pairs
+  SurfaceId sa = kInvalidId, sb = kInvalidId;
+};
+
+struct QueryState {
+  const CollideOptions& o;
+  std::chrono::steady_clock::time_point t0;
+  Deadline deadline;
+  int threads = 1;
+  Report report;
+
+  std::vector<InstancePair> pairs;
+  std::vector<Task> tasks;
+  std::vector<std::size_t> first_task;  // tasks of pair k: [first_task[k], first_task[k+1])
+  // The memory budget's ledger: per instance pair, the bytes it makes this query build. Each surface
+  // is charged to the first pair (in pair order) that needs it, so the prefix of pairs that fits the
+  // budget does not depend on how the work was spread over threads.
+  std::vector<std::uint64_t> charge;
+  std::vector<SurfaceId> needed;           // in order of first need
+  std::vector<std::uint32_t> first_need;   // per surface: first pair needing it, or kInvalidId
+  std::uint32_t cutoff = 0;                // pairs from here on do not fit the memory budget
+
+  // Lazy tessellation: what this query asked for, made, and built (released past the cutoff).
+  std::vector<SurfaceId> asked, tessellated, built;
+  std::vector<double> old_deflection;  // parallel to `tessellated`
+
+  // Triangle level, per task.
+  std::vector<PreparedPair> prepared;
+  std::vector<PairOutcome> outcomes;
+  std::vector<CollideCounters> task_counters;
+  std::vector<char> task_cut;
+
+  // Per instance pair.
+  std::vector<char> pair_cut, pair_intersects, contained;
+  std::vector<double> pair_distance;
+  std::vector<std::vector<SurfacePairResult>> pair_results;
+
+  QueryState(const CollideOptions& options, std::chrono::steady_clock::time_point start);
+  // Moves the cutoff to the first pair whose running charge exceeds the budget. Charges only grow,
+  // so the cutoff can only move earlier as more is charged.
+  void apply_memory_budget();
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0);
+
+// Bytes a reported pair holds (charged against the memory budget).
+inline std::uint64_t result_bytes(const SurfacePairResult& r) {
+  return sizeof(r) + r.triangle_pairs.size() * sizeof(r.triangle_pairs[0]);
+}
+void add(CollideCounters& into, const CollideCounters& c);
+
+}  // namespace cadclash::detail

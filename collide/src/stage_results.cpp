@@ -1,0 +1,60 @@
+// Stage 7: the kept prefix of instance pairs — its results, counters and charge; the rest listed as
+// unexamined — and what was built only for pairs past the memory budget given back.
+#include "scene_stages.h"
+
+#include <algorithm>
+#include <tuple>
+
+namespace cadclash::detail {
+namespace {
+
+// Leaves the model and the scene as if the query had stopped at the cutoff.
+void release_past_cutoff(SceneData& s, const QueryState& q) {
+  for (std::size_t i = 0; i < q.tessellated.size(); ++i) {
+    if (q.first_need[q.tessellated[i]] < q.cutoff) continue;
+    Surface& surf = s.model.surfaces[q.tessellated[i]];
+    surf.mesh = TriangleMesh{};
+    surf.has_triangles = false;
+    surf.deflection = q.old_deflection[i];
+  }
+  for (SurfaceId sid : q.built) {
+    if (q.first_need[sid] < q.cutoff) continue;
+    s.bvh[sid] = SurfaceBvh{};
+    s.bvh_ready[sid] = 0;
+  }
+}
+
+}  // namespace
+
+void results_stage(SceneData& s, QueryState& q) {
+  Report& report = q.report;
+  CollideCounters& total = report.counters;
+  for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
+    if (k >= q.cutoff || q.pair_cut[k]) report.unexamined_pairs.push_back({q.pairs[k].a, q.pairs[k].b});
+    if (k >= q.cutoff) continue;
+    add(total, q.pairs[k].counters);
+    report.memory_charged += q.charge[k];
+    for (std::size_t t = q.first_task[k]; t < q.first_task[k + 1]; ++t) {
+      if (q.task_cut[t]) continue;
+      add(total, q.task_counters[t]);
+      if (q.outcomes[t].intersecting) ++total.intersecting_pairs;
+    }
+    for (SurfacePairResult& r : q.pair_results[k]) report.pairs.push_back(std::move(r));
+  }
+  for (SurfaceId sid : q.asked) total.tessellated_surfaces += q.first_need[sid] < q.cutoff;
+  const bool memory_cut = q.cutoff < q.pairs.size();
+  const bool time_cut =
+      std::any_of(q.pair_cut.begin(), q.pair_cut.begin() + q.cutoff, [](char c) { return c != 0; });
+  report.complete = !memory_cut && !time_cut;
+  if (memory_cut && time_cut) report.stopped_by = "time and memory budget";
+  else if (memory_cut) report.stopped_by = "memory budget";
+  else if (time_cut) report.stopped_by = "time budget";
+  std::sort(report.unexamined_pairs.begin(), report.unexamined_pairs.end());
+  if (memory_cut) release_past_cutoff(s, q);
+  std::sort(report.pairs.begin(), report.pairs.end(), [](const SurfacePairResult& x, const SurfacePairResult& y) {
+    return std::tie(x.instance_a, x.instance_b, x.surface_a, x.surface_b) <
+           std::tie(y.instance_a, y.instance_b, y.surface_a, y.surface_b);
+  });
+}
+
+}  // namespace cadclash::detail

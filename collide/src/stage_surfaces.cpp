@@ -1,0 +1,116 @@
+// Stage 2: the object and surface levels (OAABB of the instance pair, surviving surfaces, candidate
+// surface pairs), then the task list and the memory ledger.
+#include "box_util.h"
+#include "decide.h"
+#include "scene_stages.h"
+
+#include <omp.h>
+
+namespace cadclash::detail {
+namespace {
+
+// The object and surface levels of one instance pair take microseconds: only many pairs pay a team.
+constexpr std::ptrdiff_t kMinParallelPairs = 64;
+
+void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o) {
+  const Model& model = s.model;
+  const Instance& ia = model.instances[ip.a];
+  const Instance& ib = model.instances[ip.b];
+  ip.t_ab = s.poses[ip.a].inverse(Eigen::Isometry) * s.poses[ip.b];
+  ip.t_ba = ip.t_ab.inverse(Eigen::Isometry);
+  if (o.decision != DecisionMode::Fast)
+    ip.roundoff = pair_roundoff(s.poses[ip.a], s.poses[ip.b], s.part_norm[ia.part], s.part_norm[ib.part]);
+  CollideCounters& c = ip.counters;
+  if (o.detect_containment) {
+    const Aabb& wa = s.world_box[ip.a];
+    const Aabb& wb = s.world_box[ip.b];
+    if (!wa.isEmpty() && !wb.isEmpty()) {
+      if (wa.contains(wb)) ip.containment = 1;
+      else if (wb.contains(wa)) ip.containment = 2;
+    }
+  }
+  if (!o.use_oaabb) {
+    for (SurfaceId sa = s.first(ia.part); sa < s.end(ia.part); ++sa)
+      for (SurfaceId sb = s.first(ib.part); sb < s.end(ib.part); ++sb) ip.candidates.push_back({sa, sb});
+    c.surface_pairs += ip.candidates.size();
+    return;
+  }
+  const double tol_margin = std::max(
+      o.tolerance + s.part_reach_share(ia.part, o) + s.part_reach_share(ib.part, o) + ip.roundoff, o.clearance);
+  // The OAABB in A's frame, then its single update into B's frame.
+  const Aabb oaabb = pad_box(s.part_box[ia.part], tol_margin)
+                         .intersection(transform_box(pad_box(s.part_box[ib.part], tol_margin), ip.t_ab));
+  ++c.aabb_updates;
+  if (oaabb.isEmpty()) return;
+  const Aabb oaabb_b = transform_box(oaabb, ip.t_ba);
+  ++c.aabb_updates;
+  std::vector<SurfaceId> surv_a, surv_b;
+  for (SurfaceId sid = s.first(ia.part); sid < s.end(ia.part); ++sid) {
+    ++c.aabb_tests;
+    if (boxes_overlap(s.surface_box(sid), oaabb)) surv_a.push_back(sid);
+  }
+  for (SurfaceId sid = s.first(ib.part); sid < s.end(ib.part); ++sid) {
+    ++c.aabb_tests;
+    if (boxes_overlap(s.surface_box(sid), oaabb_b)) surv_b.push_back(sid);
+  }
+  c.surfaces_a += surv_a.size();
+  c.surfaces_b += surv_b.size();
+  std::vector<Aabb> box_b(surv_b.size());
+  for (std::size_t k = 0; k < surv_b.size(); ++k) {
+    box_b[k] = transform_box(s.surface_box(surv_b[k]), ip.t_ab);
+    ++c.aabb_updates;
+  }
+  for (SurfaceId sa : surv_a) {
+    const Aabb box_a = s.surface_box(sa);
+    for (std::size_t k = 0; k < surv_b.size(); ++k) {
+      const double m =
+          std::max(o.tolerance + s.reach_share(sa, o) + s.reach_share(surv_b[k], o) + ip.roundoff, o.clearance);
+      ++c.aabb_tests;
+      if (boxes_within(box_a, box_b[k], m + kRelativePad * (1.0 + box_magnitude(box_b[k]))))
+        ip.candidates.push_back({sa, surv_b[k]});
+    }
+  }
+  c.surface_pairs += ip.candidates.size();
+}
+
+}  // namespace
+
+void surface_level_stage(const SceneData& s, QueryState& q) {
+  const Model& model = s.model;
+  const auto npairs = static_cast<std::ptrdiff_t>(q.pairs.size());
+#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (npairs >= kMinParallelPairs)
+  for (std::ptrdiff_t k = 0; k < npairs; ++k) {
+    InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
+    if (q.deadline.expired()) ip.cut = true;
+    else surface_level(s, ip, q.o);
+  }
+  q.charge.assign(q.pairs.size(), 0);
+  q.first_task.assign(q.pairs.size() + 1, 0);
+  q.first_need.assign(model.surfaces.size(), kInvalidId);
+  for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
+    const InstancePair& ip = q.pairs[k];
+    q.first_task[k] = q.tasks.size();
+    q.charge[k] += ip.candidates.size() * sizeof(ip.candidates[0]);
+    auto need = [&](SurfaceId sid) {
+      if (q.first_need[sid] != kInvalidId) return;
+      q.first_need[sid] = k;
+      q.needed.push_back(sid);
+    };
+    for (const auto& c : ip.candidates) {
+      q.tasks.push_back({k, c[0], c[1]});
+      need(c[0]);
+      need(c[1]);
+    }
+    if (ip.containment) {
+      for (InstanceId i : {ip.a, ip.b}) {
+        const PartId p = model.instances[i].part;
+        for (SurfaceId sid = s.first(p); sid < s.end(p); ++sid) need(sid);
+      }
+    }
+  }
+  q.first_task[q.pairs.size()] = q.tasks.size();
+  q.cutoff = static_cast<std::uint32_t>(q.pairs.size());
+  q.apply_memory_budget();
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,113 @@
+// Stage 4: the triangle level, Version 1 (one item per surface pair) or 2 (surface pair × block of
+// A's triangles), over the tasks of the pairs within the memory budget. With the time budget out,
+// remaining items are skipped and marked cut (an OpenMP loop cannot break).
+#include "decide.h"
+#include "scene_stages.h"
+
+#include <omp.h>
+
+#include <algorithm>
+
+namespace cadclash::detail {
+namespace {
+
+// Work blocks of Version 2: this many of A's surviving triangles per item.
+constexpr std::size_t kV2Block = 64;
+constexpr std::ptrdiff_t kMinParallel = 4;
+
+bool usable(const Model& m, const Task& t) {
+  return m.surfaces[t.sa].has_triangles && m.surfaces[t.sb].has_triangles;
+}
+
+// The search reach of a task: the fast band, or everything a certified decision needs to see.
+double task_tau(const SceneData& s, const QueryState& q, const Task& t) {
+  const Surface& a = s.model.surfaces[t.sa];
+  const Surface& b = s.model.surfaces[t.sb];
+  if (q.o.decision == DecisionMode::Fast) return q.o.tolerance + a.deflection + b.deflection;
+  return certified_reach(a, s.eps[t.sa], b, s.eps[t.sb], q.o.tolerance, q.pairs[t.pair].roundoff);
+}
+
+void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes) {
+  const Task& t = q.tasks[k];
+  if (!usable(s.model, t)) return;
+  const InstancePair& ip = q.pairs[t.pair];
+  prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
+                     task_tau(s, q, t), q.prepared[k], q.task_counters[k]);
+  bytes[k] = prepared_bytes(q.prepared[k]);
+}
+
+void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
+  const auto n = static_cast<std::ptrdiff_t>(ntasks);
+#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (q.deadline.expired()) {
+      q.task_cut[ku] = 1;
+      continue;
+    }
+    prepare(s, q, ku, bytes);
+    run_pair(s.model.surfaces[q.tasks[ku].sa], q.prepared[ku], 0, q.prepared[ku].la.size(), q.o, q.outcomes[ku],
+             q.task_counters[ku], &q.deadline);
+    q.prepared[ku] = PreparedPair{};  // free the survivors as we go
+  }
+}
+
+// Version 2 holds every survivor list at once: they are charged, and the budget applied, before the
+// blocks run, so pairs past the new cutoff are released unrun.
+void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
+  const auto n = static_cast<std::ptrdiff_t>(ntasks);
+#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    if (q.deadline.expired()) q.task_cut[static_cast<std::size_t>(k)] = 1;
+    else prepare(s, q, static_cast<std::size_t>(k), bytes);
+  }
+  for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
+  q.apply_memory_budget();
+  for (std::size_t k = q.first_task[q.cutoff]; k < ntasks; ++k) q.prepared[k] = PreparedPair{};
+  ntasks = q.first_task[q.cutoff];
+  struct Item {
+    std::size_t task, begin, end;
+  };
+  std::vector<Item> items;
+  for (std::size_t k = 0; k < ntasks; ++k)
+    for (std::size_t b = 0; b < q.prepared[k].la.size(); b += kV2Block)
+      items.push_back({k, b, std::min(q.prepared[k].la.size(), b + kV2Block)});
+  std::vector<PairOutcome> item_out(items.size());
+  std::vector<CollideCounters> item_counters(items.size());
+  const auto nitems = static_cast<std::ptrdiff_t>(items.size());
+#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (nitems >= kMinParallel)
+  for (std::ptrdiff_t i = 0; i < nitems; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Item& it = items[iu];
+    if (q.deadline.expired()) item_out[iu].cut = true;
+    else run_pair(s.model.surfaces[q.tasks[it.task].sa], q.prepared[it.task], it.begin, it.end, q.o, item_out[iu],
+                  item_counters[iu], &q.deadline);
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) {  // fixed order: independent of the thread count
+    merge_outcome(q.outcomes[items[i].task], std::move(item_out[i]));
+    add(q.task_counters[items[i].task], item_counters[i]);
+  }
+  for (std::size_t k = 0; k < ntasks; ++k) q.prepared[k] = PreparedPair{};
+}
+
+}  // namespace
+
+void triangle_level_stage(SceneData& s, QueryState& q) {
+  const std::size_t ntasks = q.first_task[q.cutoff];
+  q.prepared.assign(q.tasks.size(), PreparedPair{});
+  q.outcomes.assign(q.tasks.size(), PairOutcome{});
+  q.task_counters.assign(q.tasks.size(), CollideCounters{});
+  q.task_cut.assign(q.tasks.size(), 0);
+  std::vector<std::uint64_t> bytes(q.tasks.size(), 0);
+  if (q.o.version == ParallelVersion::V1) {
+    run_v1(s, q, ntasks, bytes);
+    for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
+    q.apply_memory_budget();
+  } else {
+    run_v2(s, q, ntasks, bytes);
+  }
+  for (std::size_t k = 0; k < q.first_task[q.cutoff]; ++k)
+    if (q.outcomes[k].cut) q.task_cut[k] = 1;
+}
+
+}  // namespace cadclash::detail
