@@ -66,6 +66,9 @@ struct Method {
   Reference reference = Reference::Intersecting;
   bool is_default = false;  // the row ratios are taken against (per subset)
   bool is_reference_t = false;
+  // The mesh answer (DecisionMode::Fast) the peers' pair sets are compared with: they decide on the
+  // same triangles, not on the exact faces as the certified default does.
+  bool is_mesh_reference = false, is_mesh_reference_t = false;
 };
 
 struct Row {
@@ -231,6 +234,10 @@ std::vector<Method> methods_for(const cb::Workload& w, int threads, const cb::Su
     x.options.schedule = cadclash::Schedule::Dynamic;
   });
   cad("brute", "brute force (no OAABB)", [](Method& x) { x.options.use_oaabb = false; });
+  cad("fast", "cadclash --fast (the triangles' band, not certified)", [](Method& x) {
+    x.options.decision = cadclash::DecisionMode::Fast;
+    x.is_mesh_reference = true;
+  });
   peer("fcl-obbrss", cb::make_fcl_obbrss_peer, Reference::Intersecting);
   peer("fcl-aabb", cb::make_fcl_aabb_peer, Reference::Intersecting);
   peer("cgal", cb::make_cgal_peer, Reference::Intersecting);
@@ -239,6 +246,12 @@ std::vector<Method> methods_for(const cb::Workload& w, int threads, const cb::Su
     x.options.tolerance = w.deflection;
     x.reference = Reference::WithinT;
     x.is_reference_t = true;
+  });
+  cad("t-fast", "cadclash --fast, tolerance t", [&](Method& x) {
+    x.options.tolerance = w.deflection;
+    x.options.decision = cadclash::DecisionMode::Fast;
+    x.reference = Reference::WithinT;
+    x.is_mesh_reference_t = true;
   });
   const double t = w.deflection;
   peer("occt-t", [t] { return cb::make_occt_peer(t); }, Reference::WithinT);
@@ -267,9 +280,13 @@ void finish(WorkloadResult& r) {
   // (or the tolerance-t row), restricted to what the row checked.
   const Row* full_default = nullptr;
   const Row* t_row = nullptr;
+  const Row* mesh_row = nullptr;
+  const Row* mesh_t_row = nullptr;
   for (const Row& row : r.rows) {
     if (row.method.is_default && row.method.subset.whole()) full_default = &row;
     if (row.method.is_reference_t) t_row = &row;
+    if (row.method.is_mesh_reference) mesh_row = &row;
+    if (row.method.is_mesh_reference_t) mesh_t_row = &row;
   }
   for (Row& row : r.rows) {
     const Row* ratio_ref = full_default;
@@ -277,9 +294,15 @@ void finish(WorkloadResult& r) {
       if (d.method.is_default && same_subset(d.method.subset, row.method.subset)) ratio_ref = &d;
     if (ratio_ref && !ratio_ref->times.empty() && !row.times.empty())
       row.ratio = median(row.times) / median(ratio_ref->times);
-    const Row* ref = row.method.reference == Reference::WithinT ? t_row : full_default;
+    const bool within_t = row.method.reference == Reference::WithinT;
+    const Row* ref = row.method.is_cadclash && row.method.options.decision != cadclash::DecisionMode::Fast
+                         ? (within_t ? t_row : full_default)
+                         : (within_t ? mesh_t_row : mesh_row);
     if (!ref || ref == &row || row.times.empty()) continue;
-    row.reference_name = ref == t_row ? "cadclash tolerance t" : "cadclash default";
+    row.reference_name = ref == t_row        ? "cadclash tolerance t"
+                         : ref == mesh_row   ? "cadclash --fast"
+                         : ref == mesh_t_row ? "cadclash --fast, tolerance t"
+                                             : "cadclash default";
     // The reference's pairs over what this row checked (the t row may itself be on the subset).
     const cb::Subset& sub = row.method.subset.whole() ? ref->method.subset : row.method.subset;
     const cb::PairSet expect = restricted(ref->found, sub);

@@ -17,7 +17,7 @@ namespace cadclash::cli {
 namespace {
 
 // Version of the JSON report; see docs/report-schema.md. Bump on any incompatible change.
-constexpr int kReportVersion = 1;
+constexpr int kReportVersion = 2;
 // Exit code of --fail-on-collision when a penetrating or touching pair (or containment) was found.
 constexpr int kExitCollision = 3;
 // Exit code when --time-budget or --memory-budget ran out: the report was written, marked partial.
@@ -40,6 +40,7 @@ struct CheckOptions {
   bool brute_force = false;
   bool no_containment = false;
   bool exact = false;
+  bool fast = false;
   std::string parallel = "v1";
   std::string schedule = "guided";
   std::string triangle_level = "auto";
@@ -75,7 +76,7 @@ CollideOptions collide_options(const CheckOptions& o) {
                                                  : TriangleLevel::Auto;
   c.use_oaabb = !o.brute_force;
   c.detect_containment = !o.no_containment;
-  c.exact_verification = o.exact;
+  c.decision = o.exact ? DecisionMode::Exact : o.fast ? DecisionMode::Fast : DecisionMode::Certified;
   c.time_budget_seconds = o.time_budget;
   c.memory_budget_bytes = static_cast<std::size_t>(o.memory_budget_mb * 1024.0 * 1024.0);
   if (o.memory_budget_mb > 0.0 && c.memory_budget_bytes == 0) c.memory_budget_bytes = 1;  // a budget, however small
@@ -110,18 +111,25 @@ nlohmann::json side_json(const Model& m, InstanceId i, SurfaceId s) {
 }
 
 struct ClassCounts {
-  std::size_t c[4] = {0, 0, 0, 0};
+  std::size_t c[5] = {0, 0, 0, 0, 0};  // by ContactClass
   void add(const Report& r) {
     for (const SurfacePairResult& p : r.pairs) ++c[static_cast<int>(p.contact)];
   }
-  bool collision() const { return c[0] + c[1] + c[3] > 0; }
+  // An undecided pair may be a contact: an audit fails safe.
+  bool collision() const { return c[0] + c[1] + c[3] + c[4] > 0; }
 };
 
 nlohmann::json summary_json(const Report& r) {
   ClassCounts n;
   n.add(r);
-  return {{"pairs", r.pairs.size()},   {"penetrating", n.c[0]}, {"touching", n.c[1]},
-          {"clearance", n.c[2]},       {"containment", n.c[3]}};
+  nlohmann::json by = nlohmann::json::object();
+  for (DecidedBy d : {DecidedBy::Mesh, DecidedBy::MeshExact, DecidedBy::Analytic, DecidedBy::Refined,
+                      DecidedBy::Exact, DecidedBy::Undecided})
+    by[decided_by_name(d)] = 0;
+  for (const SurfacePairResult& p : r.pairs)
+    if (p.contact != ContactClass::Containment) by[decided_by_name(p.decided_by)] = by[decided_by_name(p.decided_by)].get<int>() + 1;
+  return {{"pairs", r.pairs.size()}, {"penetrating", n.c[0]}, {"touching", n.c[1]}, {"clearance", n.c[2]},
+          {"containment", n.c[3]},   {"undecided", n.c[4]},   {"decided_by", by}};
 }
 
 nlohmann::json counters_json(const CollideCounters& c) {
@@ -131,7 +139,13 @@ nlohmann::json counters_json(const CollideCounters& c) {
           {"triangles_a", c.triangles_a},         {"triangles_b", c.triangles_b},
           {"triangle_tests", c.triangle_tests},   {"exact_fallbacks", c.exact_fallbacks},
           {"distance_tests", c.distance_tests},   {"intersecting_pairs", c.intersecting_pairs},
-          {"tessellated_surfaces", c.tessellated_surfaces}};
+          {"tessellated_surfaces", c.tessellated_surfaces}, {"decided_mesh", c.decided_mesh},
+          {"decided_mesh_exact", c.decided_mesh_exact},     {"decided_analytic", c.decided_analytic},
+          {"decided_refined", c.decided_refined},           {"decided_exact", c.decided_exact},
+          {"undecided", c.undecided},                       {"ambiguous_pairs", c.ambiguous_pairs},
+          {"refined_surfaces", c.refined_surfaces},         {"exact_queries", c.exact_queries},
+          {"witness_queries", c.witness_queries},
+          {"dismissed_pairs", c.dismissed_pairs}};
 }
 
 nlohmann::json timings_json(const CollideTimings& t) {
@@ -148,6 +162,8 @@ nlohmann::json pairs_json(const Model& m, const Report& r) {
     nlohmann::json j{{"a", side_json(m, p.instance_a, p.surface_a)},
                      {"b", side_json(m, p.instance_b, p.surface_b)},
                      {"class", contact_class_name(p.contact)},
+                     {"decided_by", decided_by_name(p.decided_by)},
+                     {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
                      {"intersecting", p.intersecting},
                      {"distance", number_or_null(p.distance)},
                      {"penetration", p.penetration}};
@@ -174,17 +190,20 @@ void print_table(const Model& m, const Report& r, std::ostream& os) {
       const Instance& a = m.instances[ca];
       const Instance& b = m.instances[cb];
       os << '\n' << a.path << " (" << m.parts[a.part].name << ")  x  " << b.path << " (" << m.parts[b.part].name << ")\n";
-      os << "  " << std::left << std::setw(12) << "class" << std::setw(11) << "distance" << std::setw(34)
-         << "surface A" << "surface B\n";
+      os << "  " << std::left << std::setw(12) << "class" << std::setw(11) << "decided by" << std::setw(11)
+         << "distance" << std::setw(34) << "surface A" << "surface B\n";
     }
     auto side = [&](SurfaceId s) {
       if (s == kInvalidId) return std::string("(whole part)");
       return m.surfaces[s].name + " [" + source_label(m.surfaces[s]) + "]";
     };
     std::string dist = p.contact == ContactClass::Penetrating ? "-" + fmt(p.penetration) : fmt(p.distance);
-    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(11) << dist
-       << std::setw(34) << side(p.surface_a) << side(p.surface_b);
+    const char* by = p.contact == ContactClass::Containment ? "mesh" : decided_by_name(p.decided_by);
+    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(11) << by << std::setw(11)
+       << dist << std::setw(34) << side(p.surface_a) << side(p.surface_b);
     if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
+    if (p.contact == ContactClass::Undecided)
+      os << "  exact distance in [" << fmt(p.distance_lo) << ", " << fmt(p.distance_hi) << "]";
     os << '\n';
   }
 }
@@ -195,7 +214,11 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
   const CollideCounters& c = r.counters;
   if (n.c[0] > 0) os << "\n(distance of a penetrating pair: minus its crossing-depth estimate)\n";
   os << "\n" << r.pairs.size() << " reported pairs: " << n.c[0] << " penetrating, " << n.c[1] << " touching, "
-     << n.c[2] << " clearance, " << n.c[3] << " containment\n";
+     << n.c[2] << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided\n";
+  os << "decided by: mesh " << c.decided_mesh << ", mesh-exact " << c.decided_mesh_exact << ", analytic "
+     << c.decided_analytic << ", refined " << c.decided_refined << ", exact " << c.decided_exact << ", undecided "
+     << c.undecided << "; ambiguous " << c.ambiguous_pairs << ", faces refined " << c.refined_surfaces
+     << ", witness queries " << c.witness_queries << ", exact queries " << c.exact_queries << ", dismissed " << c.dismissed_pairs << '\n';
   os << "counters: instance pairs " << c.instance_pairs << ", AABB tests " << c.aabb_tests << ", AABB updates "
      << c.aabb_updates << ", msA " << c.surfaces_a << ", msB " << c.surfaces_b << ", surface pairs " << c.surface_pairs
      << ", mpSk " << c.triangles_a << ", mpSl " << c.triangles_b << ", triangle tests " << c.triangle_tests
@@ -287,7 +310,7 @@ int run_check(const CheckOptions& o) {
                    {"triangle_level", o.triangle_level},
                    {"oaabb", !o.brute_force},
                    {"containment", !o.no_containment},
-                   {"exact_verification", o.exact},
+                   {"decision", o.exact ? "exact" : o.fast ? "fast" : "certified"},
                    {"exclude_under", o.exclude_under},
                    {"select_a", o.select_a},
                    {"select_b", o.select_b},
@@ -308,6 +331,7 @@ int run_check(const CheckOptions& o) {
     if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
     print_table(m, r, std::cout);
     print_summary(r, !o.no_timings, std::cout);
+    if (o.fast) std::cout << "fast mode: classes from the triangles' deflection band, not certified on the exact faces\n";
     print_partial(m, r, std::cout);
     if (!r.complete) stopped_by = r.stopped_by;
     add_budget_json(m, r, j);
@@ -328,7 +352,7 @@ int run_check(const CheckOptions& o) {
       collision = collision || n.collision();
       run_diags.insert(run_diags.end(), s.report.diagnostics.begin(), s.report.diagnostics.end());
       std::cout << "step " << s.step << ": " << n.c[0] << " penetrating, " << n.c[1] << " touching, " << n.c[2]
-                << " clearance, " << n.c[3] << " containment";
+                << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided";
       if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
       if (!s.report.complete) {
         std::cout << "  PARTIAL: stopped by the " << s.report.stopped_by << ", " << s.report.unexamined_pairs.size()
@@ -410,11 +434,16 @@ void register_check(CLI::App& app) {
   cmd->add_option("--html", o->html, "Write a self-contained HTML report with a 3D view here (docs/viewer.md)");
   cmd->add_flag("--no-timings", o->no_timings, "Leave timings out (the report is then identical for any thread count)");
   cmd->add_flag("--fail-on-collision", o->fail_on_collision,
-                "Exit 3 when a penetrating, touching or containment pair is found");
+                "Exit 3 when a penetrating, touching, containment or undecided pair is found");
   cmd->add_flag("--brute-force", o->brute_force, "Test every triangle pair, no OAABB culling (for comparison)");
   cmd->add_flag("--no-containment", o->no_containment, "Skip the point-in-part containment test");
-  cmd->add_flag("--exact", o->exact,
-                "Verify touching/clearance pairs on the exact B-rep faces (OCCT distance) and show that distance");
+  CLI::Option* exact = cmd->add_flag(
+      "--exact", o->exact,
+      "Every reported class from the exact B-rep faces (OCCT distance); pairs farther than the tolerance become "
+      "clearance or leave the report");
+  cmd->add_flag("--fast", o->fast,
+                "Classes from the triangles' deflection band alone (not certified on the exact faces)")
+      ->excludes(exact);
   cmd->add_option("--parallel", o->parallel, "Parallel version: v1 (per surface pair) or v2 (flattened)")
       ->check(CLI::IsMember({"v1", "v2"}));
   cmd->add_option("--schedule", o->schedule, "OpenMP schedule")->check(CLI::IsMember({"guided", "dynamic", "static"}));

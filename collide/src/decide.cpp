@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cadclash::detail {
 namespace {
@@ -199,6 +200,93 @@ std::optional<double> analytic_pair_gap(const AnalyticSurface& a, const Analytic
     const double cos_t = std::sqrt(std::max(0.0, 1.0 - sin_t * sin_t));
     const double E = e0 + sin_t * (half + b.radius + (centre - p0).norm());
     return radial_gap(a.radius, b.radius * cos_t - E, b.radius + E);
+  }
+  return std::nullopt;
+}
+
+std::vector<std::array<Vec3, 2>> boundary_edges(const TriangleMesh& mesh) {
+  std::vector<std::array<std::uint32_t, 3>> edges;  // (lo, hi, count) after merging
+  std::vector<std::array<std::uint32_t, 2>> all;
+  all.reserve(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      all.push_back({std::min(a, b), std::max(a, b)});
+    }
+  std::sort(all.begin(), all.end());
+  std::vector<std::array<Vec3, 2>> out;
+  for (std::size_t i = 0; i < all.size();) {
+    std::size_t j = i + 1;
+    while (j < all.size() && all[j] == all[i]) ++j;
+    if (j - i == 1) out.push_back({mesh.vertices[all[i][0]], mesh.vertices[all[i][1]]});
+    i = j;
+  }
+  return out;
+}
+
+namespace {
+
+// The foot of p on the full surface (nullopt where it is not unique: on an axis or at a centre).
+std::optional<Vec3> foot_point(const AnalyticSurface& an, const Vec3& p) {
+  const Vec3 axis = an.axis.normalized();
+  switch (an.shape) {
+    case SurfaceShape::Plane: return p - axis.dot(p - an.origin) * axis;
+    case SurfaceShape::Cylinder: {
+      const Vec3 w = p - an.origin;
+      const Vec3 on_axis = an.origin + w.dot(axis) * axis;
+      const Vec3 radial = p - on_axis;
+      if (!(radial.norm() > 0.0)) return std::nullopt;
+      return on_axis + an.radius * radial.normalized();
+    }
+    case SurfaceShape::Sphere: {
+      const Vec3 radial = p - an.origin;
+      if (!(radial.norm() > 0.0)) return std::nullopt;
+      return an.origin + an.radius * radial.normalized();
+    }
+    default: return std::nullopt;
+  }
+}
+
+double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) { return triangle_distance(p, p, p, a, b, b); }
+
+}  // namespace
+
+std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
+                                       const std::vector<std::array<Vec3, 2>>& outline_b, double delta_b,
+                                       const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
+                                       double limit, double slack) {
+  if (an_b.shape != SurfaceShape::Plane && an_b.shape != SurfaceShape::Cylinder &&
+      an_b.shape != SurfaceShape::Sphere)
+    return std::nullopt;
+  struct Candidate {
+    double g;
+    Vec3 foot;
+  };
+  std::vector<Candidate> cs;
+  for (const Vec3& va : mesh_a.vertices) {
+    const Vec3 v = to_b * va;
+    if (!region.contains(v)) continue;
+    const std::optional<Vec3> f = foot_point(an_b, v);
+    if (!f) continue;
+    const double g = (v - *f).norm();
+    if (g <= limit) cs.push_back({g, *f});
+  }
+  std::stable_sort(cs.begin(), cs.end(), [](const Candidate& x, const Candidate& y) { return x.g < y.g; });
+  if (cs.size() > 16) cs.resize(16);
+  for (const Candidate& c : cs) {
+    double to_mesh = std::numeric_limits<double>::infinity();
+    for (const auto& t : mesh_b.triangles) {
+      to_mesh = std::min(to_mesh, triangle_distance(c.foot, c.foot, c.foot, mesh_b.vertices[t[0]],
+                                                    mesh_b.vertices[t[1]], mesh_b.vertices[t[2]]));
+      if (to_mesh <= delta_b + slack) break;
+    }
+    if (!(to_mesh <= delta_b + slack)) continue;
+    double to_outline = std::numeric_limits<double>::infinity();
+    for (const auto& e : outline_b) {
+      to_outline = std::min(to_outline, point_segment(c.foot, e[0], e[1]));
+      if (to_outline <= 2.0 * delta_b + slack) break;
+    }
+    if (to_outline > 2.0 * delta_b + slack) return c.g;
   }
   return std::nullopt;
 }

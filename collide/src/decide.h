@@ -74,6 +74,21 @@ std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh
 // for other combinations. Subtract both ε and the round-off to bound the exact faces' distance.
 std::optional<double> analytic_pair_gap(const AnalyticSurface& a, const AnalyticSurface& b, const Aabb& region);
 
+// The edges of a mesh that only one triangle uses: the outline of the region it covers.
+std::vector<std::array<Vec3, 2>> boundary_edges(const TriangleMesh& mesh);
+
+// Contact certificate from a surface's parameters: the smallest distance g from a vertex of
+// `mesh_a` (mapped into B's frame by `to_b`, lying in `region` given in B's frame) to the full
+// surface `an_b`, over the vertices whose foot point on that surface is provably a point of face B:
+// within delta_b + slack of B's triangles and farther than 2·delta_b + slack from their outline
+// (`outline_b`), where the exact face's outline runs within delta_b of it. Only vertices with
+// g <= limit are tried (at most 16, nearest first). nullopt when no vertex qualifies or the shape
+// has no foot point here (plane, cylinder and sphere do).
+std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
+                                       const std::vector<std::array<Vec3, 2>>& outline_b, double delta_b,
+                                       const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
+                                       double limit, double slack);
+
 // `an` (part-local of one frame) expressed in another frame by `t`.
 AnalyticSurface transform_analytic(const AnalyticSurface& an, const Pose& t);
 

@@ -272,6 +272,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
       return;
     }
     if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
+      if (!out.intersecting) out.witness = {p.la[i], p.lb[j]};
       out.intersecting = true;
       const double depth = crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]);
       out.penetration = std::max(out.penetration, depth);
@@ -282,7 +283,11 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
       const double lower = box_distance(p.box_a[i], p.box_b[j]);
       if (lower <= std::min(out.distance, p.margin) + (p.margin - std::max(p.tau, options.clearance))) {
         ++counters.distance_tests;
-        out.distance = std::min(out.distance, triangle_distance(a0, a1, a2, tb[0], tb[1], tb[2]));
+        const double d = triangle_distance(a0, a1, a2, tb[0], tb[1], tb[2]);
+        if (d < out.distance) {
+          out.distance = d;
+          out.witness = {p.la[i], p.lb[j]};
+        }
       }
     }
   };
@@ -353,6 +358,10 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
 }
 
 void merge_outcome(PairOutcome& into, PairOutcome&& later) {
+  // The earlier block's witness wins ties, as the visiting order of one run would have it.
+  if ((!into.intersecting && later.intersecting) ||
+      (!into.intersecting && !later.intersecting && later.distance < into.distance))
+    into.witness = later.witness;
   into.intersecting = into.intersecting || later.intersecting;
   into.cut = into.cut || later.cut;
   into.penetration = std::max(into.penetration, later.penetration);

@@ -27,6 +27,9 @@ struct PairOutcome {
   double penetration = 0.0;
   double distance = std::numeric_limits<double>::infinity();
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
+  // The triangle pair (indices in Sk's and Sl's meshes) that decided the outcome: the first
+  // intersecting one, else the nearest (first in visiting order on ties); kInvalidId when none.
+  std::array<std::uint32_t, 2> witness{kInvalidId, kInvalidId};
   bool cut = false;  // the deadline expired inside the run: the outcome covers only part of its range
 };
 

@@ -125,6 +125,7 @@ void add(CollideCounters& into, const CollideCounters& c) {
   into.ambiguous_pairs += c.ambiguous_pairs;
   into.refined_surfaces += c.refined_surfaces;
   into.exact_queries += c.exact_queries;
+  into.witness_queries += c.witness_queries;
   into.dismissed_pairs += c.dismissed_pairs;
 }
 

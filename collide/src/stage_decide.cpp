@@ -2,6 +2,7 @@
 // "Certified decisions"). Cheapest evidence first; only what it leaves open goes to the next step.
 #include "box_util.h"
 #include "decide.h"
+#include "triangle_predicates.h"
 
 #include <omp.h>
 
@@ -11,16 +12,22 @@
 namespace cadclash::detail {
 namespace {
 
+// Per surface: the outline of its triangles (boundary_edges), made for the surfaces that need it.
+using Outlines = std::vector<std::vector<std::array<Vec3, 2>>>;
+
 // Where one pair's decision stands between the steps.
 struct Pending {
   Interval d;
   double threshold = 0.0;  // T
-  double band = 0.0;       // δa + δb + r of the model's triangles
+  double band = 0.0;       // δa + δb + r of the triangles the interval came from
+  double mesh_band = 0.0;  // the same for the model's triangles: penetration is judged on them
   bool settled = false;
   bool dropped = false;    // settled apart and not reported
   std::optional<ContactClass> cls;
   DecidedBy by = DecidedBy::Mesh;
-  std::optional<double> exact;
+  std::optional<double> exact;  // BRepExtrema's value: realised by two points, so an upper bound only
+  bool needs_lower = false;      // the exact value is above T: "apart" still needs a lower bound
+  std::optional<PairOutcome> fine;  // the finer triangles' outcome, once refined
   bool cut = false;
 };
 
@@ -40,8 +47,8 @@ void settle(Pending& p, Verdict v, DecidedBy by, const PairOutcome* o, double cl
   p.settled = true;
   p.by = by;
   if (v == Verdict::Contact) {
-    p.cls = o != nullptr && certainly_penetrating(*o, p.threshold, p.band) ? ContactClass::Penetrating
-                                                                           : ContactClass::Touching;
+    p.cls = o != nullptr && certainly_penetrating(*o, p.threshold, p.mesh_band) ? ContactClass::Penetrating
+                                                                                : ContactClass::Touching;
   } else {
     p.cls = apart_class(p.exact ? *p.exact : o != nullptr ? o->distance : p.d.lo, clearance);
     p.dropped = !p.cls;
@@ -54,7 +61,7 @@ Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask&
   const Surface& b = m.surfaces[t.sb];
   Pending p;
   p.threshold = touch_threshold(eps[t.sa], eps[t.sb], o.tolerance);
-  p.band = a.deflection + b.deflection + t.roundoff;
+  p.band = p.mesh_band = a.deflection + b.deflection + t.roundoff;
   const double reach = p.threshold + p.band;
   if (t.outcome == nullptr) {  // no triangles on one side: only the boxes are known
     p.d = {box_distance(own_box(a), transform_box(own_box(b), t.t_ab)), std::numeric_limits<double>::infinity()};
@@ -100,7 +107,75 @@ void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, 
   settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);
 }
 
-// Step 3: the same interval on finer triangles of both faces.
+// Step 2b: a vertex of one face on the other face's plane, cylinder or sphere, its foot point
+// provably inside that face (analytic_witness): the faces are within εA + g + r.
+void analytic_contact(const Model& m, std::span<const double> eps, const Outlines& outlines, const DecideTask& t,
+                      Pending& p, const CollideOptions& o) {
+  const Surface& a = m.surfaces[t.sa];
+  const Surface& b = m.surfaces[t.sb];
+  if (!a.has_triangles || !b.has_triangles) return;
+  const double r = t.roundoff;
+  const Aabb box_a = own_box(a), box_b = own_box(b);
+  // A's vertices on B's surface, in B's frame; then B's on A's, in A's frame.
+  const Aabb region_b = box_b.intersection(pad_box(transform_box(box_a, t.t_ba), p.threshold));
+  std::optional<double> g = analytic_witness(b.analytic, b.mesh, outlines[t.sb], b.deflection, a.mesh, t.t_ba,
+                                             region_b, o.tolerance + eps[t.sb] - r, r);
+  double own = eps[t.sa];
+  if (!g) {
+    const Aabb region_a = box_a.intersection(pad_box(transform_box(box_b, t.t_ab), p.threshold));
+    g = analytic_witness(a.analytic, a.mesh, outlines[t.sa], a.deflection, b.mesh, t.t_ab, region_a,
+                         o.tolerance + eps[t.sa] - r, r);
+    own = eps[t.sb];
+  }
+  if (!g || !(own + *g + r <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, own + *g + r);
+  settle(p, Verdict::Contact, DecidedBy::Analytic, t.outcome, o.clearance);
+}
+
+// Witness vertices. A vertex of the deciding triangle pair lies on its own exact face (within that
+// face's ε: the mesher puts nodes on the surface and its edges); when its exact distance to the
+// other face is within tolerance + that face's ε (after the mapping's round-off), the faces are within
+// T. Nearest vertices first; one success settles it. `a` and `b` are the model's surfaces or finer
+// ones (same part and index); `out` their outcome, `band` its band.
+void witness_step(const Model& m, std::span<const double> eps, const DecideTask& t, const Surface& a,
+                  const Surface& b, const PairOutcome* out, double band, Pending& p, const CollideOptions& o,
+                  CollideCounters& c) {
+  if (out == nullptr || out->witness[0] == kInvalidId) return;
+  const Part& pa = m.parts[a.part];
+  const Part& pb = m.parts[b.part];
+  if (!pa.source || !pb.source) return;
+  const auto& ta = a.mesh.triangles[out->witness[0]];
+  const auto& tb = b.mesh.triangles[out->witness[1]];
+  const Vec3 va[3] = {a.mesh.vertices[ta[0]], a.mesh.vertices[ta[1]], a.mesh.vertices[ta[2]]};
+  const Vec3 vb[3] = {t.t_ab * b.mesh.vertices[tb[0]], t.t_ab * b.mesh.vertices[tb[1]], t.t_ab * b.mesh.vertices[tb[2]]};
+  struct Candidate {
+    double near;   // its distance to the other triangle (A's frame): the order of trial
+    bool of_a;     // a vertex of A's triangle, asked of B's face
+    Vec3 point;    // in the part frame of the face it is asked of
+  };
+  std::vector<Candidate> cs;
+  for (const Vec3& v : va) cs.push_back({triangle_distance(v, v, v, vb[0], vb[1], vb[2]), true, t.t_ba * v});
+  for (const Vec3& v : vb) cs.push_back({triangle_distance(v, v, v, va[0], va[1], va[2]), false, v});
+  std::stable_sort(cs.begin(), cs.end(), [](const Candidate& x, const Candidate& y) { return x.near < y.near; });
+  for (const Candidate& cand : cs) {
+    const double own_eps = cand.of_a ? eps[t.sa] : eps[t.sb];
+    const double other_eps = cand.of_a ? eps[t.sb] : eps[t.sa];
+    if (cand.near > o.tolerance + other_eps + band) break;  // farther ones cannot be within reach
+    ++c.witness_queries;
+    const std::optional<double> d =
+        cand.of_a ? pb.source->point_distance(t.sb - pb.first_surface, cand.point)
+                  : pa.source->point_distance(t.sa - pa.first_surface, cand.point);
+    if (!d) continue;
+    const double hi = own_eps + *d + t.roundoff;
+    if (hi <= p.threshold) {
+      p.d.hi = std::min(p.d.hi, hi);
+      settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+      return;
+    }
+  }
+}
+
+// Step 4: the same interval on finer triangles of both faces.
 void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p,
                   const CollideOptions& o, CollideCounters& c) {
   const RefinedSurface& ra = cache[t.sa];
@@ -108,17 +183,23 @@ void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache,
   if (!ra.ok || !rb.ok) return;
   const double band = ra.surface.deflection + rb.surface.deflection + t.roundoff;
   const double reach = p.threshold + band;
-  const PairOutcome out = pair_outcome(ra.surface, ra.bvh, rb.surface, rb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  p.fine = pair_outcome(ra.surface, ra.bvh, rb.surface, rb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  const PairOutcome& out = *p.fine;
   const Interval d = mesh_interval(out, band, reach);
   p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
   p.band = band;
+  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;  // cannot happen for sound bounds; keep the interval ordered
   settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &out, o.clearance);
   // A contact proved on finer triangles is penetrating only when they prove it.
   if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(out, p.threshold, band))
     p.cls = ContactClass::Penetrating;
 }
 
-// Step 4: the exact faces' distance. Returns false when the faces have no exact geometry.
+// The exact faces' distance by BRepExtrema (SurfaceSource::exact_distance). Its value is the
+// distance of two points it found on the faces: an upper bound on d*, and OCCT 7.6 can miss the
+// minimum of two B-spline faces (tests/collide/test_certified_truth.cpp has such a pair). So a value
+// <= T proves contact; a larger one only lowers the interval's top, and "apart" needs a lower bound
+// from finer triangles (corroborate). Returns false when the faces have no exact geometry.
 bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, Pending& p,
                 const CollideOptions& o, CollideCounters& c) {
   const Surface& a = m.surfaces[t.sa];
@@ -132,10 +213,31 @@ bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t
                                                             t.sb - pb.first_surface, poses[t.ib], search);
   if (!d) return false;
   p.exact = *d;
-  p.d = *d <= search ? Interval{*d, *d} : Interval{*d, std::numeric_limits<double>::infinity()};
-  p.band = 0.0;
-  settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
+  // p.band stays the triangles' band: the exact distance says nothing about how deep faces cross,
+  // so penetration is still judged on the triangles' crossing depth beyond T + band.
+  if (*d <= p.threshold) {
+    p.d.hi = std::min(p.d.hi, *d);
+    p.d.lo = std::min(p.d.lo, p.d.hi);
+    settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+  } else {
+    if (*d <= search) p.d.hi = std::min(p.d.hi, *d);
+    p.needs_lower = true;
+  }
   return true;
+}
+
+// Corroborates an exact value above T: the finer triangles' lower bound proves the pair apart, their
+// upper bound or a witness on them proves it in contact (BRepExtrema missed), else it stays open.
+void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t,
+                 const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o, CollideCounters& c) {
+  if (!p.fine) refined_step(t, cache, p, o, c);
+  // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
+  // its corroboration; it is reported as decided by the exact faces.
+  if (p.settled && p.exact) p.by = DecidedBy::Exact;
+  if (p.settled || !p.fine) return;
+  const RefinedSurface& ra = cache[t.sa];
+  const RefinedSurface& rb = cache[t.sb];
+  witness_step(m, eps, t, ra.surface, rb.surface, &*p.fine, p.band, p, o, c);
 }
 
 void count(CollideCounters& c, DecidedBy by) {
@@ -205,11 +307,56 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   }
   for (const Pending& p : pending) counters.ambiguous_pairs += !p.settled;
 
-  // Step 3: finer triangles for the faces of the pairs still open (certified mode; exact mode asks
+  // Step 2b: analytic contact witnesses, on the outlines of the surfaces of the open pairs.
+  if (o.decision == DecisionMode::Certified) {
+    Outlines outlines(model.surfaces.size());
+    std::vector<SurfaceId> faces;
+    std::vector<std::size_t> open;
+    for (std::size_t k = 0; k < tasks.size(); ++k) {
+      if (pending[k].settled || tasks[k].outcome == nullptr) continue;
+      open.push_back(k);
+      faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
+    }
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (nfaces >= 8)
+    for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
+      const SurfaceId f = faces[static_cast<std::size_t>(i)];
+      outlines[f] = boundary_edges(model.surfaces[f].mesh);
+    }
+    const auto nopen = static_cast<std::ptrdiff_t>(open.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nopen >= 8)
+    for (std::ptrdiff_t i = 0; i < nopen; ++i) {
+      const std::size_t k = open[static_cast<std::size_t>(i)];
+      analytic_contact(model, eps, outlines, tasks[k], pending[k], o);
+    }
+  }
+
+  // Step 3: witness vertices (a few OCCT point distances each).
+  if (o.decision == DecisionMode::Certified) {
+    std::vector<std::size_t> open;
+    for (std::size_t k = 0; k < tasks.size(); ++k)
+      if (!pending[k].settled && tasks[k].outcome != nullptr) open.push_back(k);
+    const auto nopen = static_cast<std::ptrdiff_t>(open.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nopen >= 2)
+    for (std::ptrdiff_t i = 0; i < nopen; ++i) {
+      const std::size_t k = open[static_cast<std::size_t>(i)];
+      if (deadline.expired()) pending[k].cut = true;
+      else
+        witness_step(model, eps, tasks[k], model.surfaces[tasks[k].sa], model.surfaces[tasks[k].sb], tasks[k].outcome,
+                     pending[k].band, pending[k], o, task_counters[k]);
+    }
+  }
+
+  // Step 4: finer triangles for the faces of the pairs still open (certified mode; exact mode asks
   // the exact faces directly).
   std::vector<std::size_t> open;
   for (std::size_t k = 0; k < tasks.size(); ++k)
-    if (!pending[k].settled && tasks[k].outcome != nullptr && o.decision == DecisionMode::Certified &&
+    // Finer triangles shrink the band tenfold: they can prove a gap the triangles see (apart), not a
+    // contact within T (far below any band): crossing or touching triangles go to the exact faces.
+    if (!pending[k].settled && !pending[k].cut && tasks[k].outcome != nullptr && o.decision == DecisionMode::Certified &&
+        !tasks[k].outcome->intersecting && tasks[k].outcome->distance > pending[k].threshold &&
         (can_refine(model, tasks[k].sa) || can_refine(model, tasks[k].sb)))
       open.push_back(k);
   if (!open.empty() && !deadline.expired()) {
@@ -227,7 +374,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     }
   }
 
-  // Step 4: the exact faces, for what is still open.
+  // Step 5: the exact faces, for what is still open.
   std::vector<std::size_t> rest;
   for (std::size_t k = 0; k < tasks.size(); ++k)
     if (!pending[k].settled && !pending[k].cut) rest.push_back(k);
@@ -249,10 +396,30 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
              tasks[k].outcome, o.clearance);
   }
 
+  // Step 6: exact values above T, corroborated (or contradicted) by finer triangles.
+  std::vector<std::size_t> check;
+  for (std::size_t k = 0; k < tasks.size(); ++k)
+    if (!pending[k].settled && !pending[k].cut && pending[k].needs_lower && tasks[k].outcome != nullptr) check.push_back(k);
+  if (!check.empty() && !deadline.expired()) {
+    std::vector<SurfaceId> faces;
+    for (std::size_t k : check) faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    counters.refined_surfaces += refine_surfaces(model, faces, refined, threads);
+    const auto ncheck = static_cast<std::ptrdiff_t>(check.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (ncheck >= 2)
+    for (std::ptrdiff_t i = 0; i < ncheck; ++i) {
+      const std::size_t k = check[static_cast<std::size_t>(i)];
+      if (deadline.expired()) pending[k].cut = true;
+      else corroborate(model, eps, tasks[k], refined, pending[k], o, task_counters[k]);
+    }
+  }
+
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     const DecideTask& t = tasks[k];
     Pending& p = pending[k];
     counters.exact_queries += task_counters[k].exact_queries;
+    counters.witness_queries += task_counters[k].witness_queries;
     counters.distance_tests += task_counters[k].distance_tests;
     if (p.cut) {
       results[k].cut = true;

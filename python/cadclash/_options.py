@@ -32,7 +32,8 @@ class CollideOptions:
     triangle_level: str = "auto"    # candidate triangle pairs: "auto", "flat" loops or "bvh"
     flat_limit: int = 4096          # "auto" switches to the BVH above this many candidate pairs
     containment: bool = True        # detect a closed part inside another
-    exact: bool = False             # verify touching/clearance pairs on the exact B-rep faces (slow)
+    exact: bool = False             # every reported class from the exact B-rep faces (slow); see collide.h
+    fast: bool = False              # classes from the triangles' deflection band alone, not certified
     # Deflection (mm) assumed for lazy surfaces not yet tessellated, and the one they are tessellated
     # at. None: the model's absolute load deflection (0 for a relative one), as ``cadclash check`` does.
     deflection_hint: Optional[float] = None
@@ -81,7 +82,10 @@ def _to_core(o: CollideOptions, query_deflection: float) -> "_core.CollideOption
         raise ValueError("flat_limit must be >= 0")
     c.flat_limit = int(o.flat_limit)
     c.detect_containment = bool(o.containment)
-    c.exact_verification = bool(o.exact)
+    if o.exact and o.fast:
+        raise ValueError("exact and fast exclude each other")
+    c.decision = (_core.DecisionMode.Exact if o.exact else
+                  _core.DecisionMode.Fast if o.fast else _core.DecisionMode.Certified)
     c.deflection_hint = query_deflection if o.deflection_hint is None else float(o.deflection_hint)
     c.tessellation_deflection = (query_deflection if o.tessellation_deflection is None
                                  else float(o.tessellation_deflection))

@@ -52,6 +52,10 @@ void bind_scene(pyb::module_& m) {
       .value("Guided", Schedule::Guided)
       .value("Dynamic", Schedule::Dynamic)
       .value("Static", Schedule::Static);
+  pyb::enum_<DecisionMode>(m, "DecisionMode")
+      .value("Certified", DecisionMode::Certified)
+      .value("Fast", DecisionMode::Fast)
+      .value("Exact", DecisionMode::Exact);
   pyb::enum_<TriangleLevel>(m, "TriangleLevel")
       .value("Auto", TriangleLevel::Auto)
       .value("Flat", TriangleLevel::Flat)
@@ -70,7 +74,7 @@ void bind_scene(pyb::module_& m) {
       .def_readwrite("triangle_level", &CollideOptions::triangle_level)
       .def_readwrite("flat_limit", &CollideOptions::flat_limit)
       .def_readwrite("detect_containment", &CollideOptions::detect_containment)
-      .def_readwrite("exact_verification", &CollideOptions::exact_verification)
+      .def_readwrite("decision", &CollideOptions::decision)
       .def_readwrite("tessellation_deflection", &CollideOptions::tessellation_deflection)
       .def_readwrite("time_budget_seconds", &CollideOptions::time_budget_seconds)
       .def_readwrite("memory_budget_bytes", &CollideOptions::memory_budget_bytes);

@@ -20,6 +20,7 @@ struct BrepSource::Impl {
   std::vector<TopoDS_Face> faces;           // part-local, in face-index order
   std::vector<std::int64_t> entity_ids;     // per face; -1 if unknown
   std::vector<Aabb> boxes;                  // part-local box of each exact face
+  std::vector<char> exact_faces;            // per face: planar and bounded by lines (deflection 0)
   double default_deflection = 0.1;          // absolute, mm
   double angular_deflection = 0.5;
   bool verify_deflection = true;
@@ -64,6 +65,11 @@ Aabb face_aabb(const TopoDS_Face& face);
 // BRepExtrema_DistShapeShape(a, b, Extrema_ExtFlag_MIN).Value(), but it stops as soon as the distance
 // is 0. nullopt when OCCT finds no solution. May throw Standard_Failure. Reads the shapes only.
 std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b);
+
+// What the exact face says about itself (collide.h, Surface): its model uncertainty (the largest
+// OCCT tolerance of the face, its edges and vertices, never below Precision::Confusion), its
+// elementary surface, and whether its triangles are exactly the face (a plane bounded by lines).
+void describe_face(const TopoDS_Face& face, Surface& out);
 
 gp_Trsf to_trsf(const Pose& pose);
 Pose to_pose(const gp_Trsf& trsf);

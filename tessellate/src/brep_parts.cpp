@@ -134,7 +134,10 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
         s.provenance.colour = in.tags[i].colour;
       }
       s.aabb = impl->boxes[i];
+      detail::describe_face(impl->faces[i], s);
     }
+    impl->exact_faces.resize(n);
+    for (std::size_t i = 0; i < n; ++i) impl->exact_faces[i] = surfaces[i].exact_triangles ? 1 : 0;
 
     if (!lazy && n > 0) {
       // One BRepMesh call over all faces of the part: shared edges are discretised once and BRepMesh
@@ -176,6 +179,9 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
           }
         }
         if (good[i] != 0) {
+          // A plane bounded by lines: its triangles are the face; what BRepMesh or the centroid
+          // measure reports is rounding.
+          if (surfaces[i].exact_triangles) surfaces[i].deflection = 0.0;
           surfaces[i].has_triangles = true;
           surfaces[i].aabb.extend(mesh_aabb(surfaces[i].mesh));
         }

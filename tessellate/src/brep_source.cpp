@@ -1,6 +1,12 @@
 // BrepSource: the exact faces of one part, tessellated on demand and measured exactly.
 #include "brep_internal.h"
 
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <gp_Pnt.hxx>
+
 #include <Standard_Failure.hxx>
 #include <TopLoc_Location.hxx>
 #include <TopoDS.hxx>
@@ -46,15 +52,37 @@ bool BrepSource::triangulate(std::uint32_t local_index, double deflection, Trian
   bool ok = false;
   {
     std::lock_guard<std::shared_mutex> lock(impl_->mutex);
-    ok = detail::mesh_face_to(impl_->faces[local_index], target, impl_->angular_deflection, impl_->verify_deflection,
-                              out, achieved_deflection, why);
+    // Finer than the part's own deflection is a refinement for one query: BRepMesh stores what it
+    // makes in the face, so it meshes a copy (shared geometry, own topology), and the face keeps the
+    // triangulation the model's surfaces, exporters and other readers of the shape were given.
+    const bool refinement = deflection > 0.0 && deflection < impl_->default_deflection;
+    const TopoDS_Face face =
+        refinement ? TopoDS::Face(BRepBuilderAPI_Copy(impl_->faces[local_index], Standard_False, Standard_False).Shape())
+                   : impl_->faces[local_index];
+    ok = detail::mesh_face_to(face, target, impl_->angular_deflection, impl_->verify_deflection, out,
+                              achieved_deflection, why);
   }
+  if (ok && local_index < impl_->exact_faces.size() && impl_->exact_faces[local_index]) achieved_deflection = 0.0;
   if (!ok) {
     error = Diagnostic{Severity::Error, impl_->source_file, 0, impl_->entity_ids[local_index],
                        "face " + std::to_string(local_index) + " of part '" + impl_->part_name +
                            "' could not be tessellated (" + why + ")"};
   }
   return ok;
+}
+
+std::optional<double> BrepSource::point_distance(std::uint32_t local_index, const Vec3& point) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    const TopoDS_Vertex v = BRepBuilderAPI_MakeVertex(gp_Pnt(point.x(), point.y(), point.z()));
+    BRepExtrema_DistShapeShape dist(v, a.faces[local_index], Extrema_ExtFlag_MIN);
+    if (!dist.IsDone() || dist.NbSolution() == 0) return std::nullopt;
+    return dist.Value();
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
 }
 
 std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,

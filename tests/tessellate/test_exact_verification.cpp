@@ -123,7 +123,7 @@ TEST(ExactVerification, ReportIsIdenticalFor1_2And4Threads) {
   instance("/ball", 2, placed(Vec3(35, 5, 14)));       // rests on box 3's top
   Scene scene(m);
   CollideOptions o;
-  o.exact_verification = true;
+  o.decision = DecisionMode::Exact;
   o.tolerance = 0.01;
   std::string reference;
   for (int threads : {1, 2, 4}) {
@@ -156,7 +156,7 @@ TEST(ExactVerification, As1ReportIsIdenticalFor1_2And4Threads) {
   ASSERT_FALSE(sel.set_a.empty());
   Scene scene(in.model, sel);
   CollideOptions o;
-  o.exact_verification = true;
+  o.decision = DecisionMode::Exact;
   std::string reference;
   for (int threads : {1, 2, 4}) {
     o.threads = threads;
@@ -198,9 +198,12 @@ TEST(ExactVerification, CoaxialGapIsMeasuredOnTheExactFaces) {
   ASSERT_GT(m.surfaces[rod].deflection + m.surfaces[bore].deflection, gap);  // the mesh cannot tell
   Scene scene(m);
   CollideOptions o;
+  o.decision = DecisionMode::Fast;
   const Report mesh_only = scene.check(o);
-  o.exact_verification = true;
+  o.decision = DecisionMode::Exact;
   const Report verified = scene.check(o);
+  o.decision = DecisionMode::Certified;
+  const Report certified = scene.check(o);
   auto find = [&](const Report& r) -> const SurfacePairResult* {
     for (const SurfacePairResult& p : r.pairs)
       if ((p.surface_a == rod && p.surface_b == bore) || (p.surface_a == bore && p.surface_b == rod)) return &p;
@@ -210,12 +213,22 @@ TEST(ExactVerification, CoaxialGapIsMeasuredOnTheExactFaces) {
   ASSERT_NE(p0, nullptr);
   EXPECT_EQ(p0->contact, ContactClass::Touching);
   EXPECT_FALSE(p0->exact_distance.has_value());
-  const SurfacePairResult* p1 = find(verified);
+  // Exact mode measures the gap and takes the pair out of the contacts (counted as dismissed).
+  EXPECT_EQ(find(verified), nullptr);
+  EXPECT_GE(verified.counters.dismissed_pairs, 1u);
+  o.clearance = 0.1;
+  o.decision = DecisionMode::Exact;
+  const Report with_clearance = scene.check(o);
+  const SurfacePairResult* p1 = find(with_clearance);
   ASSERT_NE(p1, nullptr);
-  EXPECT_EQ(p1->contact, ContactClass::Touching);
+  EXPECT_EQ(p1->contact, ContactClass::Clearance);
+  EXPECT_EQ(p1->decided_by, DecidedBy::Exact);
   ASSERT_TRUE(p1->exact_distance.has_value());
   EXPECT_NEAR(*p1->exact_distance, gap, 1e-7);
-  EXPECT_GT(*p1->exact_distance, o.tolerance + 1e-6);  // not in contact: what verification is for
+  // The default proves it apart without the exact faces: the two cylinders' parameters (coaxial,
+  // radii 0.05 apart) are a certificate.
+  EXPECT_EQ(find(certified), nullptr);
+  EXPECT_GE(certified.counters.decided_analytic, 1u);
 }
 
 }  // namespace

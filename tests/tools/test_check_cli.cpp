@@ -55,7 +55,7 @@ TEST(CheckCli, TableAndJsonReport) {
   EXPECT_NE(r.out.find("18 penetrating, 41 touching, 89 clearance, 0 containment"), std::string::npos) << r.out;
   const nlohmann::json j = nlohmann::json::parse(read(json));
   EXPECT_EQ(j["schema"], "cadclash-check-report");
-  EXPECT_EQ(j["version"], 1);
+  EXPECT_EQ(j["version"], 2);
   EXPECT_EQ(j["summary"]["penetrating"], 18);
   EXPECT_EQ(j["summary"]["touching"], 41);
   EXPECT_EQ(j["settings"]["clearance"], 0.6);

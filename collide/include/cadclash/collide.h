@@ -170,6 +170,15 @@ class SurfaceSource {
   // "farther than that"). Returns nullopt when either side has no exact geometry.
   // Called from several threads at once (exact verification runs pairs in parallel), also for the
   // same parts: must be thread-safe.
+  // Exact distance from `point` (this part's local frame) to surface `local_index`'s exact face, its
+  // boundary included; nullopt when there is no exact geometry. Thread-safe like exact_distance.
+  // The certified decision asks it about mesh vertices: a vertex of one face within T of the other
+  // face proves the two in contact, at a fraction of a face–face distance's cost.
+  virtual std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const {
+    (void)local_index, (void)point;
+    return std::nullopt;
+  }
+
   virtual std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a,
                                                const SurfaceSource& other, std::uint32_t local_b,
                                                const Pose& pose_b, double max_distance) const {
@@ -254,6 +263,9 @@ std::size_t triangle_count(const Model& model);
 // Ambiguous pairs are refined, cheapest first, until decided:
 //   analytic  the other face's triangles lie provably off a plane, cylinder or sphere (Surface::analytic)
 //             by more than T + its deflection: a lower bound on d* (proves "apart" only);
+//   witness   a vertex of one face's triangles (a point of that exact face, within its ε) whose exact
+//             distance to the other face (SurfaceSource::point_distance) is within tolerance + ε of
+//             that face: contact proved (decided_by Exact: it is measured on the exact face);
 //   refined   both faces re-tessellated at a tenth of their deflection by their SurfaceSource (cached
 //             in the Scene) and the interval taken again;
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces), interval [d*, d*].
@@ -361,6 +373,7 @@ struct CollideCounters {
   std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
   std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
   std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
+  std::uint64_t witness_queries = 0;    // SurfaceSource::point_distance calls (witness vertices)
   std::uint64_t dismissed_pairs = 0;    // candidate pairs the triangles' band would call touching
                                         // (fast mode's answer) that a certificate proved apart
 };

@@ -120,6 +120,9 @@ class BrepSource final : public SurfaceSource {
   bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                    double& achieved_deflection, Diagnostic& error) override;
 
+  // BRepExtrema_DistShapeShape between a vertex at `point` (part-local) and the face.
+  std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const override;
+
   // BRepExtrema_DistShapeShape on the two placed faces; `other` must be a BrepSource, else nullopt.
   // When the faces' boxes are farther apart than max_distance, returns that box distance (a lower
   // bound > max_distance) without running the exact search.
