@@ -20,7 +20,7 @@ def _report(model: Model, raw) -> Report:
     raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged = raw
     paths, part_names, surface_names, step_ids = model._names()
     pairs = []
-    for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri in raw_pairs:
+    for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri, by, lo, hi in raw_pairs:
         whole = sa < 0  # containment: whole instances
         pairs.append(PairResult(
             contact=contact, instance_a=paths[ia], instance_b=paths[ib], part_a=part_names[ia],
@@ -28,7 +28,8 @@ def _report(model: Model, raw) -> Report:
             surface_b=None if whole else surface_names[sb], step_id_a=None if whole else step_ids[sa],
             step_id_b=None if whole else step_ids[sb], intersecting=intersecting, distance=distance,
             penetration=penetration, exact_distance=exact, instance_id_a=ia, instance_id_b=ib,
-            surface_id_a=None if whole else sa, surface_id_b=None if whole else sb, triangle_pairs=tri))
+            surface_id_a=None if whole else sa, surface_id_b=None if whole else sb, triangle_pairs=tri,
+            decided_by=by, distance_lo=lo, distance_hi=hi))
     return Report(pairs, Counters(**counters), Timings(**timings), _diagnostics(diags), complete, stopped_by,
                   [(paths[a], paths[b]) for a, b in unexamined], memory_charged)
 

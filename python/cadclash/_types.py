@@ -86,7 +86,7 @@ class PairResult:
     estimate (a lower bound in early-exit mode). See ``collide.h`` for the exact class definitions.
     """
 
-    contact: str                  # "penetrating", "touching", "clearance" or "containment"
+    contact: str                  # "penetrating", "touching", "clearance", "containment" or "undecided"
     instance_a: str               # instance paths
     instance_b: str
     part_a: str
@@ -98,13 +98,18 @@ class PairResult:
     intersecting: bool
     distance: float
     penetration: float
-    exact_distance: Optional[float]   # only with exact=True, for B-rep pairs that are not penetrating
+    exact_distance: Optional[float]   # BRepExtrema's distance when the decision asked for it (an upper bound)
     instance_id_a: int
     instance_id_b: int
     surface_id_a: Optional[int]
     surface_id_b: Optional[int]
     # all_triangles=True only: intersecting (triangle of A, triangle of B) index pairs, k x 2 uint32 (a copy).
     triangle_pairs: np.ndarray = field(repr=False, compare=False)
+    # What settled the class ("mesh", "mesh-exact", "analytic", "refined", "exact", "undecided") and
+    # the bounds [distance_lo, distance_hi] on the exact faces' distance it established (collide.h).
+    decided_by: str = "mesh"
+    distance_lo: float = 0.0
+    distance_hi: float = 0.0
 
     @property
     def key(self) -> tuple:
@@ -132,6 +137,17 @@ class Counters:
     distance_tests: int = 0
     intersecting_pairs: int = 0
     tessellated_surfaces: int = 0
+    decided_mesh: int = 0
+    decided_mesh_exact: int = 0
+    decided_analytic: int = 0
+    decided_refined: int = 0
+    decided_exact: int = 0
+    undecided: int = 0
+    ambiguous_pairs: int = 0
+    refined_surfaces: int = 0
+    exact_queries: int = 0
+    witness_queries: int = 0
+    dismissed_pairs: int = 0
 
 
 @dataclass(frozen=True)
@@ -145,7 +161,8 @@ class Timings:
     total: float = 0.0
 
 
-_CLASSES = ("penetrating", "touching", "clearance", "containment")
+_CLASSES = ("penetrating", "touching", "clearance", "containment", "undecided")
+_DECIDED_BY = ("mesh", "mesh-exact", "analytic", "refined", "exact", "undecided")
 
 
 @dataclass(frozen=True)
@@ -182,14 +199,19 @@ class Report:
 
     @property
     def collision(self) -> bool:
-        """True when a penetrating, touching or containment pair was found (the CLI's
-        ``--fail-on-collision`` condition)."""
+        """True when a penetrating, touching, containment or undecided pair was found (the CLI's
+        ``--fail-on-collision`` condition: an undecided pair may be a contact)."""
         return any(p.contact != "clearance" for p in self.pairs)
 
     def summary(self) -> dict:
         """Counts per class, like the ``summary`` object of the CLI's JSON report."""
         out = {"pairs": len(self.pairs)}
         out.update({c: self.count(c) for c in _CLASSES})
+        by = {d: 0 for d in _DECIDED_BY}
+        for p in self.pairs:
+            if p.contact != "containment":
+                by[p.decided_by] += 1
+        out["decided_by"] = by
         return out
 
 

@@ -88,6 +88,17 @@ pyb::dict counters_to_dict(const CollideCounters& c) {
   d["distance_tests"] = c.distance_tests;
   d["intersecting_pairs"] = c.intersecting_pairs;
   d["tessellated_surfaces"] = c.tessellated_surfaces;
+  d["decided_mesh"] = c.decided_mesh;
+  d["decided_mesh_exact"] = c.decided_mesh_exact;
+  d["decided_analytic"] = c.decided_analytic;
+  d["decided_refined"] = c.decided_refined;
+  d["decided_exact"] = c.decided_exact;
+  d["undecided"] = c.undecided;
+  d["ambiguous_pairs"] = c.ambiguous_pairs;
+  d["refined_surfaces"] = c.refined_surfaces;
+  d["exact_queries"] = c.exact_queries;
+  d["witness_queries"] = c.witness_queries;
+  d["dismissed_pairs"] = c.dismissed_pairs;
   return d;
 }
 
@@ -114,7 +125,7 @@ pyb::tuple report_to_tuple(const Report& report) {
     pyb::object exact = p.exact_distance ? pyb::object(pyb::float_(*p.exact_distance)) : pyb::object(pyb::none());
     pairs.append(pyb::make_tuple(p.instance_a, p.instance_b, id_or_minus_one(p.surface_a), id_or_minus_one(p.surface_b),
                                  contact_class_name(p.contact), p.intersecting, p.distance, p.penetration, exact,
-                                 tri));
+                                 tri, decided_by_name(p.decided_by), p.distance_lo, p.distance_hi));
   }
   pyb::list unexamined;
   for (const auto& [a, b] : report.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));
