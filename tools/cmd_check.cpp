@@ -190,7 +190,7 @@ void print_table(const Model& m, const Report& r, std::ostream& os) {
       const Instance& a = m.instances[ca];
       const Instance& b = m.instances[cb];
       os << '\n' << a.path << " (" << m.parts[a.part].name << ")  x  " << b.path << " (" << m.parts[b.part].name << ")\n";
-      os << "  " << std::left << std::setw(12) << "class" << std::setw(11) << "decided by" << std::setw(11)
+      os << "  " << std::left << std::setw(12) << "class" << std::setw(12) << "decided by" << std::setw(11)
          << "distance" << std::setw(34) << "surface A" << "surface B\n";
     }
     auto side = [&](SurfaceId s) {
@@ -199,7 +199,7 @@ void print_table(const Model& m, const Report& r, std::ostream& os) {
     };
     std::string dist = p.contact == ContactClass::Penetrating ? "-" + fmt(p.penetration) : fmt(p.distance);
     const char* by = p.contact == ContactClass::Containment ? "mesh" : decided_by_name(p.decided_by);
-    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(11) << by << std::setw(11)
+    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(12) << by << std::setw(11)
        << dist << std::setw(34) << side(p.surface_a) << side(p.surface_b);
     if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
     if (p.contact == ContactClass::Undecided)
