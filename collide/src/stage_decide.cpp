@@ -220,8 +220,11 @@ bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t
     p.d.lo = std::min(p.d.lo, p.d.hi);
     settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
   } else {
-    if (*d <= search) p.d.hi = std::min(p.d.hi, *d);
-    p.needs_lower = true;
+    if (*d <= search) p.d.hi = std::max(p.d.lo, std::min(p.d.hi, *d));
+    // Apart needs a lower bound: one already known (the boxes of a face without triangles, say) or
+    // the finer triangles' (corroborate).
+    if (p.d.lo > p.threshold) settle(p, Verdict::Apart, DecidedBy::Exact, t.outcome, o.clearance);
+    else p.needs_lower = true;
   }
   return true;
 }

@@ -231,5 +231,57 @@ TEST(ExactVerification, CoaxialGapIsMeasuredOnTheExactFaces) {
   EXPECT_GE(certified.counters.decided_analytic, 1u);
 }
 
+// A face BRepMesh gives no triangles (data/cad/mesh_fail_degenerate.step: #132's B-spline surface
+// collapses onto a segment) still takes part: its exact box reaches the square #39 through the OAABB
+// levels and the pair is decided on the exact faces, in the default mode; fast mode cannot see it.
+TEST(ExactVerification, FaceWithoutTrianglesIsDecidedOnTheExactGeometry) {
+  ImportResult in = import_file(std::string(CADCLASH_DATA_DIR) + "/cad/mesh_fail_degenerate.step");
+  Model& m = in.model;
+  SurfaceId bad = kInvalidId, square = kInvalidId;
+  for (SurfaceId s = 0; s < m.surfaces.size(); ++s) (m.surfaces[s].has_triangles ? square : bad) = s;
+  ASSERT_NE(bad, kInvalidId);
+  ASSERT_NE(square, kInvalidId);
+  ASSERT_EQ(m.surfaces[bad].provenance.step_id, 132);
+  InstanceId ibad = kInvalidId, isquare = kInvalidId;
+  for (InstanceId i = 0; i < m.instances.size(); ++i)
+    (m.instances[i].part == m.surfaces[bad].part ? ibad : isquare) = i;
+  // The segment's midpoint onto the square's centre: it crosses the square there.
+  const Aabb sq = m.surfaces[square].aabb.transformed(m.instances[isquare].pose);
+  const Aabb seg = m.surfaces[bad].aabb;
+  m.instances[ibad].pose = Pose::Identity();
+  m.instances[ibad].pose.translation() = sq.center() - seg.center();
+  auto find = [&](const Report& r) -> const SurfacePairResult* {
+    for (const SurfacePairResult& p : r.pairs)
+      if ((p.surface_a == bad && p.surface_b == square) || (p.surface_a == square && p.surface_b == bad)) return &p;
+    return nullptr;
+  };
+  Scene scene(m);
+  const SurfacePairResult* p = nullptr;
+  const Report r = scene.check();
+  p = find(r);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->contact, ContactClass::Touching);
+  EXPECT_EQ(p->decided_by, DecidedBy::Exact);
+  ASSERT_TRUE(p->exact_distance.has_value());
+  EXPECT_EQ(*p->exact_distance, 0.0);
+  CollideOptions fast;
+  fast.decision = DecisionMode::Fast;
+  EXPECT_EQ(find(scene.check(fast)), nullptr);  // no triangles, nothing the band can say
+  // Lifted 1 mm off the square's plane (its thin box axis), it is proved apart: a clearance within 2.
+  int thin = 0;
+  sq.sizes().minCoeff(&thin);
+  Pose lifted = m.instances[ibad].pose;
+  lifted.translation()[thin] += 1.0;
+  scene.set_pose(ibad, lifted);
+  EXPECT_EQ(find(scene.check()), nullptr);
+  CollideOptions near;
+  near.clearance = 2.0;
+  const Report rc = scene.check(near);
+  p = find(rc);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->contact, ContactClass::Clearance);
+  EXPECT_NEAR(p->distance_hi, 1.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace cadclash
