@@ -18,6 +18,7 @@ void add_counts(SurfaceRepairStats& into, const SurfaceRepairStats& s) {
   into.merged_points += s.merged_points;
   into.unused_points += s.unused_points;
   into.degenerate_faces += s.degenerate_faces;
+  into.collinear_faces += s.collinear_faces;
   into.duplicate_faces += s.duplicate_faces;
   into.flipped_faces += s.flipped_faces;
   into.stitched_edges += s.stitched_edges;
@@ -70,6 +71,10 @@ void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, Mes
       const Tri g{to_part[t[0]], to_part[t[1]], to_part[t[2]]};
       if (g[0] == ~0u || g[1] == ~0u || g[2] == ~0u || g[0] == g[1] || g[1] == g[2] || g[0] == g[2]) {
         ++st.degenerate_faces;
+        continue;
+      }
+      if (detail::collinear_exact(soup.points[g[0]], soup.points[g[1]], soup.points[g[2]])) {
+        ++st.collinear_faces;
         continue;
       }
       if (!seen_triangles.insert(detail::TriKey(g)).second) {

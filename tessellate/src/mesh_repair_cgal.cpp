@@ -29,6 +29,11 @@
 #include <set>
 
 namespace cadclash::detail {
+
+bool collinear_exact(const Vec3& a, const Vec3& b, const Vec3& c) {
+  using P = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  return CGAL::collinear(P(a.x(), a.y(), a.z()), P(b.x(), b.y(), b.z()), P(c.x(), c.y(), c.z()));
+}
 namespace {
 
 namespace PMP = CGAL::Polygon_mesh_processing;

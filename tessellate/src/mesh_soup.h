@@ -47,6 +47,9 @@ MeshStageResult repair_soup_cgal(const TaggedSoup& soup, std::uint32_t tag_count
 // Patch id per triangle of a cleaned soup (ids are 0..n-1 in no particular order), from
 // sharp_edges_segmentation on the oriented mesh, optionally split further by planar region growing.
 // Returns false with `error` when the soup cannot become a mesh.
+// True when the three points lie on one line, decided exactly (CGAL's filtered predicate).
+bool collinear_exact(const Vec3& a, const Vec3& b, const Vec3& c);
+
 bool segment_soup_cgal(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
                        const SegmentOptions& options, std::vector<std::uint32_t>& patch, std::string& error);
 

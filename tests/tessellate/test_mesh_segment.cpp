@@ -184,3 +184,49 @@ TEST(MeshSegment, PlanarRegionGrowingSplitsAShallowFold) {
 
 }  // namespace
 }  // namespace cadclash
+
+namespace cadclash {
+namespace {
+
+using namespace cadclash::test;
+
+std::size_t total_triangles(const Model& m) {
+  std::size_t n = 0;
+  for (const Surface& s : m.surfaces) n += s.mesh.triangles.size();
+  return n;
+}
+
+// A triangle-soup cube with one zero-area triangle (three distinct corners on one edge): repair
+// removes it, decided exactly, so segmentation finds the cube's 6 faces and nothing more; left in,
+// it would be a patch of its own.
+TEST(MeshRepairSegment, CollinearTriangleNeverBecomesASurface) {
+  TriangleMesh box = box_soup(Vec3(0, 0, 0), Vec3(2, 3, 4));
+  add_soup_triangle(box, Vec3(0, 0, 0), Vec3(0.5, 0, 0), Vec3(2, 0, 0));
+  Model model = one_part_model({box});
+  const MeshRepairReport rep = repair_meshes(model);
+  EXPECT_EQ(rep.total.collinear_faces, 1u);
+  EXPECT_EQ(rep.total.degenerate_faces, 0u);
+  segment_surfaces(model);
+  EXPECT_EQ(model.surfaces.size(), 6u);
+  EXPECT_EQ(total_triangles(model), 12u);
+}
+
+// A needle is not flat: 1e-12 off the line it covers area, and repair keeps it (no epsilon decides).
+TEST(MeshRepairSegment, NeedleIsKept) {
+  TriangleMesh box = box_soup(Vec3(0, 0, 0), Vec3(2, 3, 4));
+  TriangleMesh needle;
+  add_soup_triangle(needle, Vec3(0, 0, 10), Vec3(0.5, 1e-12, 10), Vec3(2, 0, 10));
+  Model model = one_part_model({box, needle});
+  const MeshRepairReport rep = repair_meshes(model);
+  EXPECT_EQ(rep.total.collinear_faces, 0u);
+  EXPECT_EQ(model.surfaces[1].mesh.triangles.size(), 1u);
+  // Exactly collinear with coordinates far from the origin too (1e6 mm): still removed.
+  TriangleMesh far;
+  add_soup_triangle(far, Vec3(1e6, 1e6, 1e6), Vec3(1e6 + 0.5, 1e6, 1e6), Vec3(1e6 + 1, 1e6, 1e6));
+  Model m2 = one_part_model({box, far});
+  EXPECT_EQ(repair_meshes(m2).total.collinear_faces, 1u);
+  EXPECT_TRUE(m2.surfaces[1].mesh.triangles.empty());
+}
+
+}  // namespace
+}  // namespace cadclash

@@ -166,8 +166,11 @@ struct SurfaceRepairStats {
   std::uint32_t merged_points = 0;
   std::uint32_t unused_points = 0;         // vertices no triangle referenced, dropped
   std::uint32_t degenerate_faces = 0;      // triangles removed: two corners at the same point (or a
-                                           // non-finite coordinate). Zero-area triangles with three
-                                           // distinct collinear corners are kept.
+                                           // non-finite coordinate)
+  std::uint32_t collinear_faces = 0;       // triangles removed: three distinct corners on one line, as
+                                           // exact arithmetic on the coordinates decides (CGAL's
+                                           // collinear predicate); zero area, so the geometry is the
+                                           // same without them. A needle that is not exactly flat stays.
   std::uint32_t duplicate_faces = 0;       // triangles removed: same three points as an earlier triangle of
                                            // the part (either orientation); "earlier" = lower surface id,
                                            // then lower triangle index
@@ -195,7 +198,9 @@ struct MeshRepairReport {
 // Repairs the triangles of every mesh surface, one part at a time, keeping every triangle on the
 // surface it came from. Per part:
 //  1. Points equal bit-for-bit are merged (within and across the part's surfaces); unused points go.
-//  2. Triangles with two corners at one point are removed; so are repeats of an earlier triangle.
+//  2. Triangles with two corners at one point or three exactly collinear corners are removed (they
+//     cover no area; left in, segmentation would make a patch of them); so are repeats of an
+//     earlier triangle.
 //  3. The rest is oriented with orient_polygon_soup and turned into a halfedge mesh; points at
 //     non-manifold spots are duplicated (orient_polygon_soup, then duplicate_non_manifold_vertices).
 //  4. stitch_borders; then each connected component gets one orientation. A closed component faces
