@@ -21,6 +21,10 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_option("--import-time-limit", in.import_time_limit,
                  "Seconds the isolated reader of one STEP/IGES/BREP file may take, and again its tessellation; what is not done by then is reported as not read or not tessellated (0: no limit)")
       ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--model-tolerance", in.model_tolerance,
+                 "Uncertainty of mesh coordinates, mm: faces within tolerance + both uncertainties touch "
+                 "(default: 2^-24 x the largest coordinate, the single-precision bound)")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
   cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
@@ -46,6 +50,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.lazy = in.lazy;
   options.isolate_cad_readers = !in.no_isolation;
   options.reader_time_limit_seconds = in.import_time_limit;
+  options.model_tolerance = in.model_tolerance;
   options.tessellation.time_limit_seconds = in.import_time_limit;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);

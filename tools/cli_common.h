@@ -24,6 +24,7 @@ struct InputOptions {
   std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
   bool lazy = false;
   bool no_isolation = false;
+  double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   // Mesh post-processing (mesh parts only; see tessellate.h).
   bool repair = false;

@@ -2,6 +2,7 @@
 #include "readers.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cctype>
 #include <filesystem>
 #include <system_error>
@@ -28,7 +29,24 @@ std::string lower_extension(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+ImportResult read_any(const std::string& path, const ImportOptions& options);
+
+}  // namespace
+
 ImportResult import_file(const std::string& path, const ImportOptions& options) {
+  assert(options.model_tolerance >= 0.0);
+  ImportResult r = read_any(path, options);
+  if (options.model_tolerance > 0.0)
+    for (Surface& s : r.model.surfaces)
+      if (!r.model.parts[s.part].source) s.uncertainty = options.model_tolerance;
+  return r;
+}
+
+namespace {
+
+ImportResult read_any(const std::string& path, const ImportOptions& options) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) return detail::failed_import(path, "no such file");
@@ -43,6 +61,8 @@ ImportResult import_file(const std::string& path, const ImportOptions& options) 
   if (ext == ".glb" && detail::is_cadclash_glb(path)) return detail::read_cadclash_glb(path, options);
   return detail::read_assimp_mesh(path, options);
 }
+
+}  // namespace
 
 ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options) {
   if (paths.size() == 1) return import_file(paths.front(), options);

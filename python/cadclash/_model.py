@@ -240,7 +240,8 @@ def _path_under(path: str, prefix: str) -> bool:
 def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1, angular: float = 0.5,
          relative: bool = False, preset: Optional[str] = None, lazy: bool = False, repair: bool = False,
          fill_holes: bool = False, segment: bool = False, sharp_angle: float = 60.0, planar: bool = False,
-         isolate: bool = True, time_limit: float = 0.0, strict: bool = False) -> Model:
+         isolate: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
+         strict: bool = False) -> Model:
     """Reads one or more files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF) into one ``Model``.
 
     The arguments mirror ``cadclash check``'s input switches: ``deflection`` (mm, or a fraction of
@@ -251,7 +252,9 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     process, so a file that crashes OCCT gives an error diagnostic (and the faces that could still be
     read) instead of ending Python; ``isolate=False`` is the CLI's ``--no-isolation``. ``time_limit``
     (seconds, 0 = none; the CLI's ``--import-time-limit``) stops an isolated reader that takes longer
-    on one file, and then the file's tessellation, with error diagnostics naming what was not done. Several files form one scene;
+    on one file, and then the file's tessellation, with error diagnostics naming what was not done.
+    ``model_tolerance`` (mm; the CLI's ``--model-tolerance``) is the uncertainty of mesh coordinates
+    (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch. Several files form one scene;
     each file's instance paths are then prefixed with "/<file name>".
 
     Returns the model with ``diagnostics`` and ``complete`` set: a partly bad file keeps its good
@@ -265,7 +268,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     model = Model()
     raw, complete = model._load(files, float(deflection), bool(relative), float(angular), preset or "",
                                 bool(lazy), bool(repair), bool(fill_holes), bool(segment), float(sharp_angle),
-                                bool(planar), bool(isolate), float(time_limit))
+                                bool(planar), bool(isolate), float(time_limit), float(model_tolerance))
     model.files = files
     model.diagnostics = _diagnostics(raw)
     model.complete = complete

@@ -34,6 +34,7 @@ struct LoadArgs {
   bool planar = false;
   bool isolate = true;
   double time_limit = 0.0;
+  double model_tolerance = 0.0;
 };
 
 // Same steps and defaults as the CLI's import_inputs(), without printing: (diagnostics, complete).
@@ -59,6 +60,8 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   if (!(a.time_limit >= 0.0)) throw pyb::value_error("time_limit must be >= 0 seconds (0: no limit)");
   options.reader_time_limit_seconds = a.time_limit;
   options.tessellation.time_limit_seconds = a.time_limit;
+  if (!(a.model_tolerance >= 0.0)) throw pyb::value_error("model_tolerance must be >= 0 mm (0: from the coordinates)");
+  options.model_tolerance = a.model_tolerance;
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;
@@ -143,13 +146,13 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate, double time_limit) {
+             bool planar, bool isolate, double time_limit, double model_tolerance) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
-                               fill_holes, segment, sharp_angle, planar, isolate, time_limit});
+                               fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
-          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"))
+          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"))
       .def_property_readonly("_query_deflection", [](const ModelCore& c) { return c.state->query_deflection; })
       .def("_counts",
            [](const ModelCore& c) {

@@ -143,6 +143,8 @@ SegmentReport segment_surfaces(Model& model, const SegmentOptions& options) {
         patch.provenance.kind = SourceKind::Segment;
         patch.provenance.parent = sid;
         patch.deflection = parent.deflection;
+        patch.uncertainty = parent.uncertainty;
+        patch.exact_triangles = parent.exact_triangles;
         patch.has_triangles = true;
         patch.mesh = extract_patch(parent.mesh, label, j);
         patch.aabb = mesh_aabb(patch.mesh);

@@ -283,5 +283,60 @@ TEST(ExactVerification, FaceWithoutTrianglesIsDecidedOnTheExactGeometry) {
   EXPECT_NEAR(p->distance_hi, 1.0, 1e-6);
 }
 
+// A face's model uncertainty comes from the model: OCCT's tolerances of the face, its edges and
+// vertices (at least 1e-7 mm), and at least what the STEP file declares as its length uncertainty.
+TEST(ModelUncertainty, FromTolerancesAndTheFilesDeclaredUncertainty) {
+  const std::string path = std::string(CADCLASH_DATA_DIR) + "/cad/valid_two_solids.step";
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream text;
+  text << f.rdbuf();
+  const std::string declared = "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07)";
+  ASSERT_NE(text.str().find(declared), std::string::npos);
+  ImportResult plain = import_file(path);
+  ASSERT_FALSE(plain.model.surfaces.empty());
+  for (const Surface& s : plain.model.surfaces) {
+    EXPECT_GE(s.uncertainty, 1e-7);
+    EXPECT_LT(s.uncertainty, 1e-3);
+  }
+  // The same file declaring 0.01 mm.
+  std::string coarse = text.str();
+  coarse.replace(coarse.find(declared), declared.size(), "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.01)");
+  const std::string tmp = ::testing::TempDir() + "/declared_uncertainty.step";
+  std::ofstream(tmp, std::ios::binary) << coarse;
+  ImportResult declared_in = import_file(tmp);
+  ASSERT_EQ(declared_in.model.surfaces.size(), plain.model.surfaces.size());
+  for (const Surface& s : declared_in.model.surfaces) EXPECT_GE(s.uncertainty, 0.01 - 1e-12) << s.name;
+}
+
+// The elementary surfaces are recognised in the part's frame: every vertex of a cylinder face's
+// triangles lies on the recorded cylinder, of a plane face on the recorded plane.
+TEST(ModelUncertainty, AnalyticSurfacesMatchTheirTriangles) {
+  const std::vector<TopoDS_Shape> shapes{BRepPrimAPI_MakeCylinder(3, 8).Shape(), BRepPrimAPI_MakeBox(10, 10, 10).Shape()};
+  Model m = build(shapes, 0.2);
+  int cylinders = 0, planes = 0;
+  for (const Surface& s : m.surfaces) {
+    const AnalyticSurface& a = s.analytic;
+    for (const Vec3& v : s.mesh.vertices) {
+      if (a.shape == SurfaceShape::Cylinder) {
+        const Vec3 w = v - a.origin;
+        EXPECT_NEAR((w - w.dot(a.axis) * a.axis).norm(), a.radius, 1e-9);
+      } else if (a.shape == SurfaceShape::Plane) {
+        EXPECT_NEAR(a.axis.dot(v - a.origin), 0.0, 1e-9);
+      }
+    }
+    cylinders += a.shape == SurfaceShape::Cylinder;
+    planes += a.shape == SurfaceShape::Plane;
+    if (s.exact_triangles) {
+      EXPECT_EQ(a.shape, SurfaceShape::Plane);
+      EXPECT_EQ(s.deflection, 0.0);
+    }
+  }
+  EXPECT_EQ(cylinders, 1);
+  EXPECT_EQ(planes, 2 + 6);  // the cylinder's caps and the box's sides
+  std::size_t exact = 0;
+  for (const Surface& s : m.surfaces) exact += s.exact_triangles;
+  EXPECT_EQ(exact, 6u);  // the box's sides; the caps are bounded by circles
+}
+
 }  // namespace
 }  // namespace cadclash

@@ -70,8 +70,44 @@ TEST(CheckCli, TableAndJsonReport) {
       EXPECT_EQ(p["class"], "touching");
       EXPECT_EQ(p["distance"], 0.0);
       EXPECT_EQ(p["a"]["kind"], "obj-group");
+      // Mesh triangles are the surfaces: the contact is proved on them alone.
+      EXPECT_EQ(p["decided_by"], "mesh-exact");
+      EXPECT_EQ(p["distance_interval"][0], 0.0);
+      EXPECT_LE(p["distance_interval"][1].get<double>(), 1e-12);
     }
   EXPECT_TRUE(found);
+  EXPECT_EQ(j["settings"]["decision"], "certified");
+  EXPECT_EQ(j["summary"]["undecided"], 0);
+  EXPECT_EQ(j["summary"]["decided_by"]["mesh-exact"].get<int>() + j["summary"]["decided_by"]["mesh"].get<int>(),
+            j["pairs"].size());
+}
+
+// --fast and --exact exclude each other; the modes are recorded; on meshes all three agree.
+TEST(CheckCli, DecisionModes) {
+  EXPECT_EQ(run("check " + boxes() + " --fast --exact").code, 2);
+  nlohmann::json summary;
+  for (const char* mode : {"--fast", "--exact", ""}) {
+    const std::string json = tmp(std::string("mode") + mode + ".json");
+    const Proc r = run("check " + boxes() + " " + mode + " --clearance 0.6 --no-timings --json " + json);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(read(json));
+    EXPECT_EQ(j["settings"]["decision"], *mode == 0 ? "certified" : std::string(mode + 2));
+    nlohmann::json counts = j["summary"];
+    counts.erase("decided_by");
+    if (summary.is_null()) summary = counts;
+    else EXPECT_EQ(counts, summary) << mode;
+  }
+}
+
+// box_near is 0.5 mm from box_a: apart by default; a mesh model tolerance of 0.3 mm on each side
+// makes them touch (0.5 <= 0 + 0.3 + 0.3).
+TEST(CheckCli, ModelToleranceWidensTouching) {
+  const std::string pair = data("box_a.obj") + " " + data("box_near.obj");
+  EXPECT_EQ(run("check " + pair + " --fail-on-collision").code, 0);
+  EXPECT_EQ(run("check " + pair + " --model-tolerance 0.2 --fail-on-collision").code, 0);
+  const Proc r = run("check " + pair + " --model-tolerance 0.3 --fail-on-collision");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("touching    mesh-exact"), std::string::npos) << r.out;
 }
 
 TEST(CheckCli, ReportIsByteIdenticalForAnyThreadCount) {

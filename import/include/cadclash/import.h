@@ -68,6 +68,10 @@ struct ImportOptions {
   // Tessellation runs in this process afterwards and is not covered. Without isolation it cannot be
   // applied (a warning says so).
   double reader_time_limit_seconds = 0.0;
+  // Meshes (OBJ/OFF/STL/...): how far their coordinates may be from the intended geometry, mm, set as
+  // every mesh surface's Surface::uncertainty. 0 = derived by collide from the coordinates (2^-24 x the
+  // part's largest coordinate: the single-precision bound, as STL, glTF and PLY store float32).
+  double model_tolerance = 0.0;
 };
 
 struct ImportResult {
