@@ -288,6 +288,42 @@ std::optional<SurfacePairResult> fast(const Model& m, const DecideTask& t, const
 
 }  // namespace
 
+namespace {
+
+// The tasks whose pending state satisfies `keep`, in task order.
+template <class Keep>
+std::vector<std::size_t> select(const std::vector<Pending>& pending, Keep keep) {
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < pending.size(); ++k)
+    if (!pending[k].settled && !pending[k].cut && keep(k)) out.push_back(k);
+  return out;
+}
+
+// The surfaces of the listed tasks, each once, ascending.
+std::vector<SurfaceId> faces_of(std::span<const DecideTask> tasks, const std::vector<std::size_t>& ks) {
+  std::vector<SurfaceId> faces;
+  for (std::size_t k : ks) faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+// Runs step(k) for the listed tasks on the threads, one task at a time (a step may cost OCCT work);
+// each answer depends on its task alone. Past the deadline the rest are marked cut.
+template <class Step>
+void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending, int threads,
+              const Deadline& deadline, Step step) {
+  const auto n = static_cast<std::ptrdiff_t>(ks.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (n >= 2)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const std::size_t k = ks[static_cast<std::size_t>(i)];
+    if (deadline.expired()) pending[k].cut = true;
+    else step(k);
+  }
+}
+
+}  // namespace
+
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
@@ -297,126 +333,66 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
     return results;
   }
+  const bool certified = o.decision == DecisionMode::Certified;
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
   std::vector<Pending> pending(tasks.size());
   std::vector<CollideCounters> task_counters(tasks.size());
-  // Steps 1 and 2: microseconds per pair.
+  auto meshed = [&](std::size_t k) { return tasks[k].outcome != nullptr; };
+  // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
 #pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     pending[ku] = from_mesh(model, eps, tasks[ku], o);
-    if (!pending[ku].settled && o.decision == DecisionMode::Certified && tasks[ku].outcome != nullptr)
-      analytic(model, eps, tasks[ku], pending[ku], o);
+    if (!pending[ku].settled && certified && meshed(ku)) analytic(model, eps, tasks[ku], pending[ku], o);
   }
   for (const Pending& p : pending) counters.ambiguous_pairs += !p.settled;
 
-  // Step 2b: analytic contact witnesses, on the outlines of the surfaces of the open pairs.
-  if (o.decision == DecisionMode::Certified) {
+  if (certified) {
+    // Step 2b: analytic contact witnesses, on the outlines of the open pairs' surfaces.
+    const std::vector<std::size_t> open = select(pending, meshed);
+    const std::vector<SurfaceId> faces = faces_of(tasks, open);
     Outlines outlines(model.surfaces.size());
-    std::vector<SurfaceId> faces;
-    std::vector<std::size_t> open;
-    for (std::size_t k = 0; k < tasks.size(); ++k) {
-      if (pending[k].settled || tasks[k].outcome == nullptr) continue;
-      open.push_back(k);
-      faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
-    }
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
     const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (nfaces >= 8)
     for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
       const SurfaceId f = faces[static_cast<std::size_t>(i)];
       outlines[f] = boundary_edges(model.surfaces[f].mesh);
     }
-    const auto nopen = static_cast<std::ptrdiff_t>(open.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nopen >= 8)
-    for (std::ptrdiff_t i = 0; i < nopen; ++i) {
-      const std::size_t k = open[static_cast<std::size_t>(i)];
-      analytic_contact(model, eps, outlines, tasks[k], pending[k], o);
-    }
-  }
-
-  // Step 3: witness vertices (a few OCCT point distances each).
-  if (o.decision == DecisionMode::Certified) {
-    std::vector<std::size_t> open;
-    for (std::size_t k = 0; k < tasks.size(); ++k)
-      if (!pending[k].settled && tasks[k].outcome != nullptr) open.push_back(k);
-    const auto nopen = static_cast<std::ptrdiff_t>(open.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nopen >= 2)
-    for (std::ptrdiff_t i = 0; i < nopen; ++i) {
-      const std::size_t k = open[static_cast<std::size_t>(i)];
-      if (deadline.expired()) pending[k].cut = true;
-      else
-        witness_step(model, eps, tasks[k], model.surfaces[tasks[k].sa], model.surfaces[tasks[k].sb], tasks[k].outcome,
-                     pending[k].band, pending[k], o, task_counters[k]);
-    }
-  }
-
-  // Step 4: finer triangles for the faces of the pairs still open (certified mode; exact mode asks
-  // the exact faces directly).
-  std::vector<std::size_t> open;
-  for (std::size_t k = 0; k < tasks.size(); ++k)
-    // Finer triangles shrink the band tenfold: they can prove a gap the triangles see (apart), not a
-    // contact within T (far below any band): crossing or touching triangles go to the exact faces.
-    if (!pending[k].settled && !pending[k].cut && tasks[k].outcome != nullptr && o.decision == DecisionMode::Certified &&
-        !tasks[k].outcome->intersecting && tasks[k].outcome->distance > pending[k].threshold &&
-        (can_refine(model, tasks[k].sa) || can_refine(model, tasks[k].sb)))
-      open.push_back(k);
-  if (!open.empty() && !deadline.expired()) {
-    std::vector<SurfaceId> faces;
-    for (std::size_t k : open) faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-    counters.refined_surfaces += refine_surfaces(model, faces, refined, threads);
-    const auto nopen = static_cast<std::ptrdiff_t>(open.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nopen >= 2)
-    for (std::ptrdiff_t i = 0; i < nopen; ++i) {
-      const std::size_t k = open[static_cast<std::size_t>(i)];
-      if (deadline.expired()) pending[k].cut = true;
-      else refined_step(tasks[k], refined, pending[k], o, task_counters[k]);
-    }
+    run_step(open, pending, threads, deadline,
+             [&](std::size_t k) { analytic_contact(model, eps, outlines, tasks[k], pending[k], o); });
+    // Step 3: witness vertices of the deciding triangle pair (a few OCCT point distances each).
+    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
+      witness_step(model, eps, tasks[k], model.surfaces[tasks[k].sa], model.surfaces[tasks[k].sb], tasks[k].outcome,
+                   pending[k].band, pending[k], o, task_counters[k]);
+    });
+    // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see
+    // (apart), not a contact within T (far below any band): crossing or touching triangles go on.
+    const std::vector<std::size_t> gaps = select(pending, [&](std::size_t k) {
+      return meshed(k) && !tasks[k].outcome->intersecting && tasks[k].outcome->distance > pending[k].threshold &&
+             (can_refine(model, tasks[k].sa) || can_refine(model, tasks[k].sb));
+    });
+    if (!gaps.empty() && !deadline.expired())
+      counters.refined_surfaces += refine_surfaces(model, faces_of(tasks, gaps), refined, threads);
+    run_step(gaps, pending, threads, deadline,
+             [&](std::size_t k) { refined_step(tasks[k], refined, pending[k], o, task_counters[k]); });
   }
 
   // Step 5: the exact faces, for what is still open.
-  std::vector<std::size_t> rest;
-  for (std::size_t k = 0; k < tasks.size(); ++k)
-    if (!pending[k].settled && !pending[k].cut) rest.push_back(k);
-  const auto nrest = static_cast<std::ptrdiff_t>(rest.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nrest >= 2)
-  for (std::ptrdiff_t i = 0; i < nrest; ++i) {
-    const std::size_t k = rest[static_cast<std::size_t>(i)];
+  run_step(select(pending, [](std::size_t) { return true; }), pending, threads, deadline, [&](std::size_t k) {
     Pending& p = pending[k];
-    if (deadline.expired()) {
-      p.cut = true;
-      continue;
-    }
-    if (exact_step(model, poses, tasks[k], p, o, task_counters[k])) continue;
+    if (exact_step(model, poses, tasks[k], p, o, task_counters[k]) || !meshed(k)) return;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
-    if (tasks[k].outcome != nullptr)
-      settle(p, verdict(p.d, p.threshold),
-             triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb) ? DecidedBy::MeshExact
-                                                                                               : DecidedBy::Mesh,
-             tasks[k].outcome, o.clearance);
-  }
+    const bool exact = triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb);
+    settle(p, verdict(p.d, p.threshold), exact ? DecidedBy::MeshExact : DecidedBy::Mesh, tasks[k].outcome, o.clearance);
+  });
 
   // Step 6: exact values above T, corroborated (or contradicted) by finer triangles.
-  std::vector<std::size_t> check;
-  for (std::size_t k = 0; k < tasks.size(); ++k)
-    if (!pending[k].settled && !pending[k].cut && pending[k].needs_lower && tasks[k].outcome != nullptr) check.push_back(k);
-  if (!check.empty() && !deadline.expired()) {
-    std::vector<SurfaceId> faces;
-    for (std::size_t k : check) faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-    counters.refined_surfaces += refine_surfaces(model, faces, refined, threads);
-    const auto ncheck = static_cast<std::ptrdiff_t>(check.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (ncheck >= 2)
-    for (std::ptrdiff_t i = 0; i < ncheck; ++i) {
-      const std::size_t k = check[static_cast<std::size_t>(i)];
-      if (deadline.expired()) pending[k].cut = true;
-      else corroborate(model, eps, tasks[k], refined, pending[k], o, task_counters[k]);
-    }
-  }
+  const std::vector<std::size_t> check =
+      select(pending, [&](std::size_t k) { return pending[k].needs_lower && meshed(k); });
+  if (!check.empty() && !deadline.expired())
+    counters.refined_surfaces += refine_surfaces(model, faces_of(tasks, check), refined, threads);
+  run_step(check, pending, threads, deadline,
+           [&](std::size_t k) { corroborate(model, eps, tasks[k], refined, pending[k], o, task_counters[k]); });
 
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     const DecideTask& t = tasks[k];
