@@ -58,14 +58,15 @@ TEST_P(RealStl, RepairsAndSegmentsKeepingEveryTriangle) {
   ASSERT_EQ(repair.per_surface.size(), surfaces_in);
   ASSERT_EQ(model.surfaces.size(), surfaces_in);
   for (const SurfaceRepairStats& s : repair.per_surface) {
-    // Without hole filling and component removal, triangles only go as degenerate or repeated.
-    EXPECT_EQ(s.triangles_after, s.triangles_before - s.degenerate_faces - s.duplicate_faces);
+    // Without hole filling and component removal, triangles only go as degenerate, collinear or repeated.
+    EXPECT_EQ(s.triangles_after, s.triangles_before - s.degenerate_faces - s.collinear_faces - s.duplicate_faces);
     EXPECT_EQ(s.hole_faces + s.filled_holes + s.removed_component_faces, 0u);
     EXPECT_EQ(model.surfaces[s.surface].mesh.triangles.size(), s.triangles_after);
     EXPECT_LE(s.vertices_after, s.vertices_before - s.merged_points - s.unused_points + s.duplicated_vertices);
   }
   const std::size_t triangles_repaired = triangle_count(model);
-  EXPECT_EQ(triangles_repaired, triangles_in - repair.total.degenerate_faces - repair.total.duplicate_faces);
+  EXPECT_EQ(triangles_repaired, triangles_in - repair.total.degenerate_faces - repair.total.collinear_faces -
+                                    repair.total.duplicate_faces);
 
   const SegmentReport seg = segment_surfaces(model);
   EXPECT_TRUE(seg.diagnostics.empty()) << format_diagnostic(seg.diagnostics.front());

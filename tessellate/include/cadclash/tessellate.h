@@ -115,7 +115,9 @@ class BrepSource final : public SurfaceSource {
   double default_deflection() const;
 
   // Meshes the face with BRepMesh_IncrementalMesh when it has no triangulation or a coarser one than
-  // `deflection` (refinement); otherwise reads the existing one. Triangles are part-local and
+  // `deflection`; otherwise reads the existing one. A deflection finer than default_deflection() is a
+  // refinement: it is meshed on a copy of the face, which keeps the triangulation it had (the one the
+  // model's surfaces, exporters and other readers of the shape were given). Triangles are part-local and
   // counter-clockwise seen from outside (winding flipped for reversed faces).
   bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                    double& achieved_deflection, Diagnostic& error) override;
