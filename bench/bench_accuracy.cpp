@@ -3,14 +3,18 @@
 //   bench_accuracy [--file F.stp]... [--out DIR] [--cache DIR|--no-cache] [--deflections 1,0.3,...]
 //                  [--tolerances 0,0.01,0.1] [--jitters 0,0.05] [--repeats N] [--threads N] [--no-plots]
 //
-// For each file, as read and with every instance moved by each --jitters distance: the ground truth (ground_truth.h) per tolerance, read from DIR/cache when a run on
-// the same file bytes made it; then per deflection one eager import, and per tolerance the three
-// cadclash modes and OCCT's BRepExtrema_ShapeProximity, each scored (recall, precision, missed and
-// false pairs by STEP #id) and timed (best of --repeats; import and tessellation timed apart).
+// For each file, as read and with every instance moved by each --jitters distance: the ground truth
+// (cadclash/testing/truth.h: exact face distance <= tolerance + εa + εb) per tolerance, read from
+// DIR/cache when a run on the same file bytes made it; then per deflection one eager import, and per
+// tolerance cadclash's own three decision modes (fast, certified = the default, exact) and OCCT's
+// BRepExtrema_ShapeProximity as a peer, each scored as reported by the product (recall, precision,
+// missed and false pairs by STEP #id), timed (best of --repeats; import and tessellation timed
+// apart), and for cadclash split by what decided each pair (CollideCounters::decided_*).
 // Writes DIR/accuracy.json, DIR/accuracy.md, the plot data DIR/accuracy_*.dat and, when gnuplot is
 // installed, DIR/accuracy_trade.svg and DIR/accuracy_time.svg (scripts in bench/plots/).
 #include "bench_accuracy_run.h"
-#include "ground_truth.h"
+#include "cadclash/testing/scenes.h"
+#include "cadclash/testing/truth.h"
 
 #include "cadclash/import.h"
 
@@ -31,6 +35,15 @@
 
 namespace cadclash::bench {
 namespace {
+
+using truth::cache_path;
+using truth::compute_ground_truth;
+using truth::exact_face_distance;
+using truth::file_hash;
+using truth::load_ground_truth;
+using truth::MeasuredPair;
+using truth::save_ground_truth;
+using truth::within;
 
 // The CLI's defaults (tools/cli_common.h): the "default setting" of the report.
 constexpr double kDefaultDeflection = 0.1;
@@ -114,25 +127,19 @@ std::string fmt(double v, int precision = 4) {
   return buf;
 }
 
-// Moves instance i by `jitter` mm along a direction fixed by i (splitmix64), the same in every run.
-void move_instances(Model& m, double jitter) {
-  if (jitter == 0.0) return;
-  for (InstanceId i = 0; i < m.instances.size(); ++i) {
-    std::uint64_t state = 0x5EED0000ull + i;
-    auto uniform = [&state] {
-      std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-      return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1p-52 - 1.0;  // [-1, 1)
-    };
-    Vec3 d;
-    do {
-      const double x = uniform(), y = uniform(), z = uniform();
-      d = Vec3(x, y, z);
-    } while (d.norm() < 0.1 || d.norm() > 1.0);
-    m.instances[i].pose.pretranslate(jitter * d.normalized());
-  }
+// "97.5 / 2.5 / 0 / 0 / 0" (+ " / undecided x" when any): decided_shares in percent; "-" when the
+// mode counts no decisions (fast).
+std::string shares_text(const CollideCounters& c) {
+  const std::vector<double> sh = decided_shares(c);
+  if (std::all_of(sh.begin(), sh.end(), [](double v) { return v == 0.0; })) return "-";
+  std::string out;
+  for (std::size_t i = 0; i < 5; ++i) out += (i ? " / " : "") + fmt(100.0 * sh[i], 3);
+  if (c.undecided) out += " / undecided " + fmt(100.0 * sh[5], 3);
+  return out;
 }
+
+// Moves instance i by `jitter` mm along a direction fixed by i (splitmix64), the same in every run.
+void move_instances(Model& m, double jitter) { truth::jitter_instances(m, jitter); }
 
 std::string label(const Model& m, InstanceId i, SurfaceId s) {
   const Surface& surf = m.surfaces[s];
@@ -179,16 +186,19 @@ int run(const Args& args) {
   std::vector<TessTime> tess_times;
 
   md << "Setting: cadclash on " << args.threads << " thread(s) (OCCT's proximity tool is serial); times are the best of "
-     << args.repeats << " runs (exact-verified: one run) of scene build + check (cadclash) or load + perform (OCCT), "
+     << args.repeats << " runs (exact: one run) of scene build + check (cadclash) or load + perform (OCCT), "
      << "import and tessellation excluded. Angular deflection 0.5 rad (the CLI default).\n\n";
-  md << "Modes: **mesh-only** τ = tolerance; **error-aware** τ = tolerance + both faces' achieved deflections "
-        "(cadclash's default); **exact-verified** error-aware, then `CollideOptions::exact_verification` and a "
-        "pair that is not penetrating is kept only if its exact B-rep distance is ≤ tolerance (+" << fmt(kContactSlack)
-     << " mm); **occt-proximity** `BRepExtrema_ShapeProximity(tolerance)` on the same face triangulations, given the "
-        "instance pairs whose boxes are within tolerance + 2 × deflection.\n\n";
-  md << "Truth: `BRepExtrema_DistShapeShape` on the placed B-rep faces ≤ tolerance + " << fmt(kContactSlack)
-     << " mm, for every face pair whose exact face boxes (enlarged by the tolerance) overlap — a box prefilter "
-        "that never drops a true pair, since faces within the tolerance have boxes within it.\n\n";
+  md << "Modes are the product's own, scored on what `Scene::check` reports (Penetrating and Touching rows; "
+        "nothing filtered by the benchmark): **fast** `DecisionMode::Fast` (the triangles alone, τ = tolerance + both "
+        "faces' achieved deflections); **certified** `DecisionMode::Certified`, the default (the triangles' "
+        "interval, then analytic, refined and exact certificates for the ambiguous pairs); **exact** "
+        "`DecisionMode::Exact` (every reported pair's exact B-rep distance); **occt-proximity** "
+        "`BRepExtrema_ShapeProximity(tolerance)` on the same face triangulations, given the instance pairs whose "
+        "boxes are within tolerance + 2 × deflection. \"decided by\" is the share of decided surface pairs per "
+        "certificate (`CollideCounters::decided_*`: mesh / mesh-exact / analytic / refined / exact).\n\n";
+  md << "Truth: `BRepExtrema_DistShapeShape` on the placed B-rep faces ≤ tolerance + εa + εb (each face's model "
+        "uncertainty, `Surface::uncertainty`: the library's own contact definition), for every face pair whose "
+        "exact face boxes (enlarged by that threshold) overlap — a box prefilter that never drops a true pair.\n\n";
 
   for (const std::string& file : args.files) for (double jitter : args.jitters) {
     std::string hash = file_hash(file);
@@ -220,7 +230,7 @@ int run(const Args& args) {
       if (!cached && !args.no_cache && !save_ground_truth(cpath, exact_in.model, truth))
         std::cerr << cpath << ": warning: cannot write the ground-truth cache\n";
       std::size_t n_true = 0;
-      for (const MeasuredPair& p : truth.measured) n_true += within(p, t);
+      for (const MeasuredPair& p : truth.measured) n_true += within(p);
       std::cout << "  truth t=" << t << ": " << truth.measured.size() << " candidates, " << n_true << " true"
                 << (truth.from_cache ? " (cache)" : " (" + fmt(truth.seconds, 3) + " s)") << '\n';
       truths.emplace(t, std::move(truth));
@@ -239,7 +249,7 @@ int run(const Args& args) {
     md << "| tolerance (mm) | candidate face pairs | true pairs | truth time |\n|---|---|---|---|\n";
     for (const auto& [t, truth] : truths) {
       std::size_t n_true = 0;
-      for (const MeasuredPair& p : truth.measured) n_true += within(p, t);
+      for (const MeasuredPair& p : truth.measured) n_true += within(p);
       md << "| " << fmt(t) << " | " << truth.measured.size() << " | " << n_true << " | "
          << (truth.from_cache ? "cached" : fmt(truth.seconds, 3) + " s") << " |\n";
       jf["truth"].push_back({{"tolerance", t}, {"candidates", truth.measured.size()}, {"true_pairs", n_true},
@@ -272,19 +282,22 @@ int run(const Args& args) {
         std::map<PairKey, double> measured;
         for (const MeasuredPair& p : truth.measured)
           measured[{p.instance_a, p.instance_b, p.surface_a, p.surface_b}] = p.distance;
-        for (Mode mode : {Mode::MeshOnly, Mode::ErrorAware, Mode::ExactVerified, Mode::OcctProximity}) {
+        for (Mode mode : kModes) {
           Row r;
           r.file = name;
           r.deflection = d;
           r.achieved = achieved;
           r.tolerance = t;
           r.triangles = tris;
-          // Exact verification is dominated by OCCT distance calls (seconds): one run is timing enough.
-          r.run = run_mode(m, mode, t, d, args.threads, mode == Mode::ExactVerified ? 1 : args.repeats);
+          // Exact mode is dominated by OCCT distance calls (seconds): one run is timing enough.
+          r.run = run_mode(m, mode, t, d, args.threads, mode == Mode::Exact ? 1 : args.repeats);
           r.score = score(truth, r.run.reported);
           std::cout << "    t=" << t << " " << mode_name(mode) << ": recall " << fmt(r.score.recall()) << ", precision "
                     << fmt(r.score.precision()) << ", missed " << r.score.missed.size() << ", false "
-                    << r.score.false_pairs.size() << ", " << fmt(r.run.seconds * 1e3, 3) << " ms\n";
+                    << r.score.false_pairs.size() << ", undecided " << r.run.undecided.size() << ", "
+                    << fmt(r.run.seconds * 1e3, 3) << " ms";
+          if (mode != Mode::OcctProximity) std::cout << ", decided by " << shares_text(r.run.counters);
+          std::cout << '\n';
           nlohmann::json jr{{"deflection", d},
                             {"achieved_deflection", achieved},
                             {"tolerance", t},
@@ -299,10 +312,19 @@ int run(const Args& args) {
                             {"missed", nlohmann::json::array()},
                             {"false", nlohmann::json::array()}};
           if (mode != Mode::OcctProximity) {
-            jr["triangle_tests"] = r.run.triangle_tests;
-            jr["exact_fallbacks"] = r.run.exact_fallbacks;
+            const CollideCounters& c = r.run.counters;
+            jr["triangle_tests"] = c.triangle_tests;
+            jr["exact_fallbacks"] = c.exact_fallbacks;
+            jr["decided"] = {{"mesh", c.decided_mesh},       {"mesh_exact", c.decided_mesh_exact},
+                             {"analytic", c.decided_analytic}, {"refined", c.decided_refined},
+                             {"exact", c.decided_exact},     {"undecided", c.undecided}};
+            jr["ambiguous_pairs"] = c.ambiguous_pairs;
+            jr["refined_surfaces"] = c.refined_surfaces;
+            jr["exact_queries"] = c.exact_queries;
+            jr["dismissed_pairs"] = c.dismissed_pairs;
+            jr["undecided"] = nlohmann::json::array();
+            for (const PairKey& k : r.run.undecided) jr["undecided"].push_back(pair_json(m, k, measured));
           }
-          if (mode == Mode::ExactVerified) jr["exact_queries"] = r.run.exact_queries;
           if (mode == Mode::OcctProximity) jr["instance_pairs"] = r.run.instance_pairs;
           for (const PairKey& k : r.score.missed) jr["missed"].push_back(pair_json(m, k, measured));
           for (const PairKey& k : r.score.false_pairs) jr["false"].push_back(pair_json(m, k, measured));
@@ -312,25 +334,26 @@ int run(const Args& args) {
       }
     }
 
-    md << "\n| deflection | tolerance | mode | true | reported | missed | false | recall | precision | time (ms) | "
-          "exact fallbacks |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md << "\n| deflection | tolerance | mode | true | reported | missed | false | undecided | recall | precision | "
+          "time (ms) | decided by (%) mesh / mesh-exact / analytic / refined / exact | exact queries |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row& r : rows) {
       const bool is_default = r.deflection == kDefaultDeflection && r.tolerance == kDefaultTolerance &&
-                              r.run.mode == Mode::ErrorAware;
+                              r.run.mode == Mode::Certified;
       const std::string b = is_default ? "**" : "";
       md << "| " << b << fmt(r.deflection) << b << " | " << fmt(r.tolerance) << " | " << mode_name(r.run.mode) << " | "
          << r.score.truth << " | " << r.score.reported << " | " << r.score.missed.size() << " | "
-         << r.score.false_pairs.size() << " | " << fmt(r.score.recall(), 4) << " | " << fmt(r.score.precision(), 4)
-         << " | " << fmt(r.run.seconds * 1e3, 3) << " | ";
-      if (r.run.mode == Mode::OcctProximity) md << "- |\n";
-      else
-        md << r.run.exact_fallbacks << " / " << r.run.triangle_tests << " ("
-           << fmt(r.run.triangle_tests ? 100.0 * double(r.run.exact_fallbacks) / double(r.run.triangle_tests) : 0.0, 3)
-           << "%) |\n";
+         << r.score.false_pairs.size() << " | ";
+      if (r.run.mode == Mode::OcctProximity) md << "- | ";
+      else md << r.run.undecided.size() << " | ";
+      md << fmt(r.score.recall(), 4) << " | " << fmt(r.score.precision(), 4) << " | " << fmt(r.run.seconds * 1e3, 3)
+         << " | ";
+      if (r.run.mode == Mode::OcctProximity) md << "- | - |\n";
+      else md << shares_text(r.run.counters) << " | " << r.run.counters.exact_queries << " |\n";
     }
     md << "\nBold: the default setting (deflection " << fmt(kDefaultDeflection) << " mm, tolerance "
-       << fmt(kDefaultTolerance) << ", error-aware). Missed and false pairs are listed by STEP #id, with their exact "
-          "distances, in `accuracy.json`.\n\n";
+       << fmt(kDefaultTolerance) << ", certified). Missed, false and undecided pairs are listed by STEP #id, with "
+          "their exact distances, in `accuracy.json`.\n\n";
     jfiles.push_back(std::move(jf));
     all_rows.insert(all_rows.end(), rows.begin(), rows.end());
   }
@@ -339,7 +362,7 @@ int run(const Args& args) {
   {
     std::ofstream dat(args.out + "/accuracy_trade.dat");
     dat << "# time_ms recall precision deflection tolerance\n";
-    for (Mode mode : {Mode::MeshOnly, Mode::ErrorAware, Mode::ExactVerified, Mode::OcctProximity}) {
+    for (Mode mode : kModes) {
       dat << "# " << mode_name(mode) << '\n';
       for (const Row& r : all_rows)
         if (r.run.mode == mode)
@@ -348,12 +371,12 @@ int run(const Args& args) {
       dat << "\n\n";
     }
     std::ofstream tdat(args.out + "/accuracy_time.dat");
-    tdat << "# deflection tessellation_ms mesh_only_ms error_aware_ms exact_verified_ms occt_ms (tolerance "
+    tdat << "# deflection tessellation_ms fast_ms certified_ms exact_ms occt_ms (tolerance "
          << fmt(args.tolerances.front()) << ", first scene)\n";
     for (const TessTime& tt : tess_times) {
       if (&tt - tess_times.data() >= static_cast<std::ptrdiff_t>(args.deflections.size())) break;  // first scene
       tdat << tt.deflection << ' ' << tt.seconds * 1e3;
-      for (Mode mode : {Mode::MeshOnly, Mode::ErrorAware, Mode::ExactVerified, Mode::OcctProximity})
+      for (Mode mode : kModes)
         for (const Row& r : all_rows)
           if (r.file == all_rows.front().file && r.deflection == tt.deflection &&
               r.tolerance == args.tolerances.front() && r.run.mode == mode) {
@@ -382,11 +405,11 @@ int run(const Args& args) {
 
   std::ofstream(args.out + "/accuracy.md") << md.str();
   const nlohmann::json j{{"schema", "cadclash-accuracy"},
-                         {"contact_slack", kContactSlack},
+                         {"contact", "exact face distance <= tolerance + eps_a + eps_b (Surface::uncertainty)"},
                          {"threads", args.threads},
                          {"repeats", args.repeats},
                          {"default", {{"deflection", kDefaultDeflection}, {"tolerance", kDefaultTolerance},
-                                      {"mode", "error-aware"}}},
+                                      {"mode", "certified"}}},
                          {"files", jfiles}};
   std::ofstream(args.out + "/accuracy.json") << j.dump(1) << '\n';
   std::cout << "wrote " << args.out << "/accuracy.md, accuracy.json" << (plotted ? ", accuracy_*.svg" : "") << '\n';

@@ -42,6 +42,14 @@ SceneSelection selection_of(const Model& m, const std::function<bool(InstanceId,
   return sel;
 }
 
+DecisionMode decision_of(Mode m) {
+  switch (m) {
+    case Mode::Fast: return DecisionMode::Fast;
+    case Mode::Exact: return DecisionMode::Exact;
+    default: return DecisionMode::Certified;
+  }
+}
+
 RunResult run_cadclash(Model& model, Mode mode, double tolerance, double deflection, int threads, int repeats,
                        const std::function<bool(InstanceId, InstanceId)>& keep) {
   RunResult out;
@@ -52,14 +60,8 @@ RunResult run_cadclash(Model& model, Mode mode, double tolerance, double deflect
   o.threads = threads;
   o.deflection_hint = deflection;
   o.tessellation_deflection = deflection;
-  o.exact_verification = mode == Mode::ExactVerified;
+  o.decision = decision_of(mode);
   o.detect_containment = false;  // whole-instance rows have no surface pair to score
-  // Mesh-only: τ = tolerance. The model's achieved deflections are what error-aware τ adds; they are
-  // zeroed for the query and restored after.
-  std::vector<double> saved(model.surfaces.size());
-  for (std::size_t s = 0; s < model.surfaces.size(); ++s) saved[s] = model.surfaces[s].deflection;
-  if (mode == Mode::MeshOnly)
-    for (Surface& s : model.surfaces) s.deflection = 0.0;
   const SceneSelection sel = selection_of(model, keep);
   Report best;
   out.seconds = std::numeric_limits<double>::infinity();
@@ -68,21 +70,16 @@ RunResult run_cadclash(Model& model, Mode mode, double tolerance, double deflect
     Scene scene(model, sel);
     Report rep = scene.check(o);
     const double t = seconds_since(t0);
-    if (t < out.seconds) out.seconds = t;
-    best = std::move(rep);
-  }
-  for (std::size_t s = 0; s < model.surfaces.size(); ++s) model.surfaces[s].deflection = saved[s];
-  out.triangle_tests = best.counters.triangle_tests;
-  out.exact_fallbacks = best.counters.exact_fallbacks;
-  for (const SurfacePairResult& p : best.pairs) {
-    if (p.contact == ContactClass::Containment || p.contact == ContactClass::Clearance) continue;
-    // Whatever pairs the library verified (today: the non-intersecting ones) are judged by their
-    // exact distance; the others are kept as reported.
-    if (mode == Mode::ExactVerified && p.exact_distance) {
-      ++out.exact_queries;
-      if (*p.exact_distance > tolerance + kContactSlack) continue;
+    if (t < out.seconds) {
+      out.seconds = t;
+      best = std::move(rep);
     }
-    out.reported.push_back({p.instance_a, p.instance_b, p.surface_a, p.surface_b});
+  }
+  out.counters = best.counters;
+  for (const SurfacePairResult& p : best.pairs) {
+    const PairKey k{p.instance_a, p.instance_b, p.surface_a, p.surface_b};
+    if (p.contact == ContactClass::Penetrating || p.contact == ContactClass::Touching) out.reported.push_back(k);
+    if (p.contact == ContactClass::Undecided) out.undecided.push_back(k);
   }
   return out;
 }
@@ -131,8 +128,8 @@ RunResult run_occt(Model& model, double tolerance, double deflection, int repeat
       const Instance& ib = model.instances[b];
       try {
         BRepExtrema_ShapeProximity prox(tolerance);
-        prox.LoadShape1(compounds[ia.part].Moved(TopLoc_Location(to_trsf(ia.pose))));
-        prox.LoadShape2(compounds[ib.part].Moved(TopLoc_Location(to_trsf(ib.pose))));
+        prox.LoadShape1(compounds[ia.part].Moved(TopLoc_Location(truth::to_trsf(ia.pose))));
+        prox.LoadShape2(compounds[ib.part].Moved(TopLoc_Location(truth::to_trsf(ib.pose))));
         prox.Perform();
         if (!prox.IsDone()) continue;
         const SurfaceId fa = model.parts[ia.part].first_surface, fb = model.parts[ib.part].first_surface;
@@ -154,12 +151,22 @@ RunResult run_occt(Model& model, double tolerance, double deflection, int repeat
 
 const char* mode_name(Mode m) {
   switch (m) {
-    case Mode::MeshOnly: return "mesh-only";
-    case Mode::ErrorAware: return "error-aware";
-    case Mode::ExactVerified: return "exact-verified";
+    case Mode::Fast: return "fast";
+    case Mode::Certified: return "certified";
+    case Mode::Exact: return "exact";
     case Mode::OcctProximity: return "occt-proximity";
   }
   return "?";
+}
+
+std::vector<double> decided_shares(const CollideCounters& c) {
+  const double n[] = {double(c.decided_mesh),    double(c.decided_mesh_exact), double(c.decided_analytic),
+                      double(c.decided_refined), double(c.decided_exact),      double(c.undecided)};
+  double total = 0.0;
+  for (double v : n) total += v;
+  std::vector<double> out;
+  for (double v : n) out.push_back(total > 0.0 ? v / total : 0.0);
+  return out;
 }
 
 RunResult run_mode(Model& model, Mode mode, double tolerance, double deflection, int threads, int repeats,

@@ -1,39 +1,52 @@
-// One setting of the accuracy benchmark: cadclash (three modes) or OCCT's BRepExtrema_ShapeProximity
-// on an imported model, scored against the ground truth. Used by bench_accuracy and its test.
+// One setting of the accuracy benchmark: cadclash in one of its own decision modes, or OCCT's
+// BRepExtrema_ShapeProximity, on an imported model, scored against the exact ground truth
+// (cadclash::truth). Used by bench_accuracy and its test.
 #pragma once
 
-#include "ground_truth.h"
+#include "cadclash/testing/truth.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace cadclash::bench {
 
+using truth::GroundTruth;
+using truth::PairKey;
+using truth::Score;
+
 enum class Mode : std::uint8_t {
-  MeshOnly,       // τ = tolerance alone: every surface's deflection is set to 0 for the query
-  ErrorAware,     // cadclash's default τ = tolerance + both surfaces' achieved deflections
-  ExactVerified,  // error-aware, then CollideOptions::exact_verification; pairs kept below
+  Fast,           // CollideOptions::decision = DecisionMode::Fast: the triangles alone
+  Certified,      // the library's default, DecisionMode::Certified
+  Exact,          // DecisionMode::Exact: every reported pair's exact B-rep distance
   OcctProximity,  // BRepExtrema_ShapeProximity(tolerance) on the same face triangulations
 };
 
-// "mesh-only", "error-aware", "exact-verified", "occt-proximity".
+inline constexpr Mode kModes[] = {Mode::Fast, Mode::Certified, Mode::Exact, Mode::OcctProximity};
+
+// "fast", "certified", "exact", "occt-proximity".
 const char* mode_name(Mode m);
 
 struct RunResult {
-  Mode mode = Mode::ErrorAware;
+  Mode mode = Mode::Certified;
   double tolerance = 0.0;
-  std::vector<PairKey> reported;  // the surface pairs this mode calls "within the tolerance"
-  double seconds = 0.0;           // best of the repeats: scene build + check (cadclash), load + perform (OCCT)
-  std::uint64_t triangle_tests = 0, exact_fallbacks = 0;  // cadclash only
-  std::uint64_t exact_queries = 0;                         // exact-verified: pairs sent to the B-rep
-  std::uint64_t instance_pairs = 0;                        // OCCT: instance pairs given to it
+  // The surface pairs this mode reports in contact: cadclash's Penetrating and Touching rows (not
+  // Clearance, Containment or Undecided), OCCT's overlapping face pairs. Nothing is filtered here.
+  std::vector<PairKey> reported;
+  std::vector<PairKey> undecided;  // cadclash rows of class Undecided (not counted as reported)
+  double seconds = 0.0;            // best of the repeats: scene build + check (cadclash), load + perform (OCCT)
+  CollideCounters counters;        // cadclash only: the best run's counters (decided_* and the work)
+  std::uint64_t instance_pairs = 0;  // OCCT: instance pairs given to it
 };
 
-// Runs one mode on `model` (eagerly tessellated B-rep parts). `keep`, when given, restricts the
-// instance pairs as in compute_ground_truth. Exact-verified drops a reported pair whose
-// SurfacePairResult::exact_distance is > tolerance + kContactSlack and keeps the rest (pairs the
-// library did not verify — today those whose triangles intersect — and pairs without exact geometry).
+// The share of decided pairs per certificate, from the counters: mesh, mesh-exact, analytic,
+// refined, exact, undecided (sums to 1 when any pair was decided; all 0 otherwise).
+std::vector<double> decided_shares(const CollideCounters& c);
+
+// Runs one mode on `model` (eagerly tessellated B-rep parts) at `tolerance` with the library's
+// default options otherwise (containment off: whole-instance rows have no surface pair to score).
+// `keep`, when given, restricts the instance pairs as in truth::compute_ground_truth.
 // threads: cadclash's OpenMP threads (OCCT's tool is serial).
 RunResult run_mode(Model& model, Mode mode, double tolerance, double deflection, int threads, int repeats,
                    const std::function<bool(InstanceId, InstanceId)>& keep = {});

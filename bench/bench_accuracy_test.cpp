@@ -1,7 +1,7 @@
 // bench_accuracy computes its numbers right: the scorer on hand-made sets, and one instance pair of
-// as1-tu-203.stp whose true face pairs are known. No timing is checked.
+// as1-tu-203.stp whose true face pairs are known, in every mode. No timing is checked.
 #include "bench_accuracy_run.h"
-#include "ground_truth.h"
+#include "cadclash/testing/truth.h"
 
 #include "cadclash/import.h"
 
@@ -17,15 +17,21 @@
 namespace cadclash::bench {
 namespace {
 
+using truth::compute_ground_truth;
+using truth::MeasuredPair;
+using truth::within;
+
+// Tolerance 0.01 and both faces' uncertainty 1e-7: threshold 0.0100002.
 GroundTruth hand_truth() {
   GroundTruth t;
   t.tolerance = 0.01;
-  t.measured = {{0, 1, 0, 5, 0.0},     // touching
-                {0, 1, 1, 5, 0.01},    // exactly at the tolerance: true
-                {0, 1, 2, 5, 0.0100005},  // within the slack: true
-                {0, 1, 3, 5, 0.011},   // beyond: false
-                {0, 2, 0, 7, 0.5},     // far: false
-                {1, 2, 5, 7, std::numeric_limits<double>::infinity()}};  // not measurable: false
+  const double th = 0.01 + 2e-7;
+  t.measured = {{0, 1, 0, 5, 0.0, th},        // touching
+                {0, 1, 1, 5, 0.01, th},       // exactly at the tolerance: true
+                {0, 1, 2, 5, 0.0100001, th},  // within the two uncertainties: true
+                {0, 1, 3, 5, 0.0100003, th},  // beyond them: false
+                {0, 2, 0, 7, 0.5, th},        // far: false
+                {1, 2, 5, 7, std::numeric_limits<double>::infinity(), th}};  // not measurable: false
   return t;
 }
 
@@ -100,7 +106,7 @@ TEST_F(AccuracyAs1, GroundTruthOfTheRodAndNut) {
   std::set<std::pair<int, int>> real;
   for (const MeasuredPair& p : t.measured) {
     const auto f = faces({p.instance_a, p.instance_b, p.surface_a, p.surface_b});
-    if (within(p, 0.0)) {
+    if (within(p)) {
       real.insert(f);
     } else {
       EXPECT_NEAR(p.distance, 2.5, 1e-6) << f.first << " " << f.second;
@@ -113,7 +119,7 @@ TEST_F(AccuracyAs1, GroundTruthOfTheRodAndNut) {
 // Every mode's recall and precision equal the counts recomputed here from the raw reported pairs.
 TEST_F(AccuracyAs1, ScoresMatchARecountOfTheReportedPairs) {
   const GroundTruth t = compute_ground_truth(in_.model, 0.0, 1, keep_);
-  for (Mode mode : {Mode::MeshOnly, Mode::ErrorAware, Mode::ExactVerified, Mode::OcctProximity}) {
+  for (Mode mode : kModes) {
     const RunResult r = run_mode(in_.model, mode, 0.0, 0.1, 1, 1, keep_);
     std::set<std::pair<int, int>> got;
     for (const PairKey& k : r.reported) {
@@ -132,9 +138,15 @@ TEST_F(AccuracyAs1, ScoresMatchARecountOfTheReportedPairs) {
     if (!got.empty()) {
       EXPECT_DOUBLE_EQ(s.precision(), double(hits) / double(got.size())) << mode_name(mode);
     }
-    // cadclash's contract: τ includes the achieved deflections, so exact contact is never missed.
-    if (mode == Mode::ErrorAware || mode == Mode::ExactVerified) {
+    // cadclash's contract: τ includes the achieved deflections, so exact contact is never missed;
+    // the certified and exact decisions report exactly the pairs in contact, none undecided.
+    if (mode != Mode::OcctProximity) {
       EXPECT_EQ(s.recall(), 1.0) << mode_name(mode);
+    }
+    if (mode == Mode::Certified || mode == Mode::Exact) {
+      EXPECT_EQ(s.precision(), 1.0) << mode_name(mode);
+      EXPECT_TRUE(r.undecided.empty()) << mode_name(mode);
+      EXPECT_EQ(r.counters.undecided, 0u) << mode_name(mode);
     }
   }
 }

@@ -11,7 +11,7 @@ set yrange [*:1.005]
 set offsets 0, 0, 0.01, 0.01
 set grid
 set key bottom right opaque
-modes = "mesh-only error-aware exact-verified occt-proximity"
+modes = "fast certified exact occt-proximity"
 set ylabel "recall"
 plot for [i=0:3] dir."/accuracy_trade.dat" index i using 1:2 with points pt (i*2+5) ps 1.2 title word(modes, i+1)
 set ylabel "precision"

@@ -54,6 +54,26 @@ std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfa
   return total;
 }
 
+RefinedSurface refine_to(const Model& model, SurfaceId s, double deflection) {
+  const Surface& surf = model.surfaces[s];
+  RefinedSurface r;
+  r.attempted = true;
+  r.surface = surf;
+  if (can_refine(model, s) && deflection < surf.deflection) {
+    const Part& part = model.parts[surf.part];
+    TriangleMesh mesh;
+    double achieved = 0.0;
+    if (part.source->triangulate(s - part.first_surface, deflection, mesh, achieved, r.error) &&
+        achieved < surf.deflection) {
+      r.surface.mesh = std::move(mesh);
+      r.surface.deflection = achieved;
+    }
+  }
+  r.ok = !r.surface.mesh.triangles.empty();
+  if (r.ok) r.bvh = build_surface_bvh(r.surface.mesh);
+  return r;
+}
+
 PairOutcome pair_outcome(const Surface& a, const SurfaceBvh& bvh_a, const Surface& b, const SurfaceBvh& bvh_b,
                          const Pose& t_ab, const Pose& t_ba, double reach, double clearance,
                          CollideCounters& counters) {

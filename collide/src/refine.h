@@ -34,6 +34,10 @@ double refinement_deflection(const Surface& s);
 std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfaces,
                             std::vector<RefinedSurface>& cache, int threads);
 
+// Surface `s` meshed at `deflection` by its source when it can be refined (not cached; for a pair
+// that needs a finer level than the cache holds), else the model's own triangles.
+RefinedSurface refine_to(const Model& model, SurfaceId s, double deflection);
+
 // The triangle level of surfaces a (A's frame) and b (mapped by t_ab) searching up to `reach` (and
 // `clearance`), early exit: intersecting, crossing depth past `reach`, or the minimum distance.
 PairOutcome pair_outcome(const Surface& a, const SurfaceBvh& bvh_a, const Surface& b, const SurfaceBvh& bvh_b,

@@ -233,7 +233,9 @@ bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t
 // upper bound or a witness on them proves it in contact (BRepExtrema missed), else it stays open.
 void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t,
                  const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o, CollideCounters& c) {
-  if (!p.fine) refined_step(t, cache, p, o, c);
+  // The surfaces' parameters first (exact mode has not asked them yet): a lower bound for free.
+  if (t.outcome != nullptr) analytic(m, eps, t, p, o);
+  if (!p.settled && !p.fine) refined_step(t, cache, p, o, c);
   // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
   // its corroboration; it is reported as decided by the exact faces.
   if (p.settled && p.exact) p.by = DecidedBy::Exact;
@@ -241,6 +243,25 @@ void corroborate(const Model& m, std::span<const double> eps, const DecideTask& 
   const RefinedSurface& ra = cache[t.sa];
   const RefinedSurface& rb = cache[t.sb];
   witness_step(m, eps, t, ra.surface, rb.surface, &*p.fine, p.band, p, o, c);
+  if (p.settled || !p.exact) return;
+  // Deeper, for this pair alone: a band below half the exact value's margin over T proves it apart
+  // if OCCT's value is right (and shows the contact if OCCT missed it). Not below a hundredth of the
+  // model's deflection: the triangles grow with the inverse deflection, and past that a pair would
+  // cost seconds; such knife-edge pairs are reported undecided with their interval.
+  const double margin = *p.exact - p.threshold - t.roundoff;
+  const double target = 0.25 * margin;
+  const double floor = 1e-2 * std::max(m.surfaces[t.sa].deflection, m.surfaces[t.sb].deflection);
+  if (!(target > floor) || !(target < std::max(ra.surface.deflection, rb.surface.deflection))) return;
+  const RefinedSurface fa = refine_to(m, t.sa, target), fb = refine_to(m, t.sb, target);
+  if (!fa.ok || !fb.ok) return;
+  const double band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
+  const double reach = p.threshold + band;
+  const PairOutcome out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  const Interval d = mesh_interval(out, band, reach);
+  p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
+  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;
+  settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
+  if (!p.settled) witness_step(m, eps, t, fa.surface, fb.surface, &out, band, p, o, c);
 }
 
 void count(CollideCounters& c, DecidedBy by) {

@@ -1,4 +1,4 @@
-#include "ground_truth.h"
+#include "cadclash/testing/truth.h"
 
 #include "cadclash/tessellate.h"
 
@@ -24,7 +24,7 @@
 #include <tuple>
 #include <utility>
 
-namespace cadclash::bench {
+namespace cadclash::truth {
 
 gp_Trsf to_trsf(const Pose& pose) {
   const Eigen::Matrix3d& r = pose.linear();
@@ -38,7 +38,7 @@ gp_Trsf to_trsf(const Pose& pose) {
 namespace {
 
 // Bump when the meaning of a cached file changes.
-constexpr int kCacheVersion = 1;
+constexpr int kCacheVersion = 2;  // 2: contact is distance <= tolerance + εa + εb
 
 Aabb world_box(const Aabb& local, const Pose& pose) {
   Aabb world;
@@ -90,7 +90,22 @@ std::string tolerance_text(double t) {
 
 }  // namespace
 
-bool within(const MeasuredPair& p, double tolerance) { return p.distance <= tolerance + kContactSlack; }
+double effective_uncertainty(const Model& model, SurfaceId s) {
+  const Surface& surf = model.surfaces[s];
+  if (surf.uncertainty > 0.0) return surf.uncertainty;
+  const Part& part = model.parts[surf.part];
+  Aabb box;
+  for (SurfaceId k = part.first_surface; k < part.first_surface + part.surface_count; ++k)
+    box.extend(model.surfaces[k].aabb);
+  if (box.isEmpty()) return 0.0;
+  return 0x1p-24 * box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
+}
+
+double contact_threshold(const Model& model, SurfaceId a, SurfaceId b, double tolerance) {
+  return tolerance + effective_uncertainty(model, a) + effective_uncertainty(model, b);
+}
+
+bool within(const MeasuredPair& p) { return p.distance <= p.threshold; }
 
 GroundTruth compute_ground_truth(const Model& model, double tolerance, int threads,
                                  const std::function<bool(InstanceId, InstanceId)>& keep) {
@@ -98,6 +113,11 @@ GroundTruth compute_ground_truth(const Model& model, double tolerance, int threa
   GroundTruth truth;
   truth.tolerance = tolerance;
   const std::size_t n = model.instances.size();
+  // The largest threshold of any pair: the instance-level prefilter's gap.
+  std::vector<double> eps(model.surfaces.size());
+  double max_eps = 0.0;
+  for (SurfaceId s = 0; s < model.surfaces.size(); ++s) max_eps = std::max(max_eps, eps[s] = effective_uncertainty(model, s));
+  const double max_gap = tolerance + 2.0 * max_eps;
   std::vector<Aabb> instance_box(n);
   for (InstanceId i = 0; i < n; ++i) {
     const Instance& inst = model.instances[i];
@@ -110,7 +130,7 @@ GroundTruth compute_ground_truth(const Model& model, double tolerance, int threa
   for (InstanceId a = 0; a < n; ++a) {
     for (InstanceId b = a + 1; b < n; ++b) {
       if (keep && !keep(a, b)) continue;
-      if (!boxes_within(instance_box[a], instance_box[b], tolerance)) continue;
+      if (!boxes_within(instance_box[a], instance_box[b], max_gap)) continue;
       const Instance& ia = model.instances[a];
       const Instance& ib = model.instances[b];
       const Part& pa = model.parts[ia.part];
@@ -122,8 +142,10 @@ GroundTruth compute_ground_truth(const Model& model, double tolerance, int threa
       for (std::uint32_t j = 0; j < pa.surface_count; ++j) {
         const Aabb box_a = world_box(model.surfaces[pa.first_surface + j].aabb, ia.pose);
         for (std::uint32_t k = 0; k < pb.surface_count; ++k) {
-          if (!boxes_within(box_a, boxes_b[k], tolerance)) continue;
-          truth.measured.push_back({a, b, pa.first_surface + j, pb.first_surface + k, 0.0});
+          const SurfaceId sa = pa.first_surface + j, sb = pb.first_surface + k;
+          const double threshold = tolerance + eps[sa] + eps[sb];
+          if (!boxes_within(box_a, boxes_b[k], threshold)) continue;
+          truth.measured.push_back({a, b, sa, sb, 0.0, threshold});
           any = true;
         }
       }
@@ -141,6 +163,28 @@ GroundTruth compute_ground_truth(const Model& model, double tolerance, int threa
   for (const MeasuredPair& p : truth.measured) truth.failed += !std::isfinite(p.distance);
   truth.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return truth;
+}
+
+GroundTruth with_tolerance(const GroundTruth& truth, const Model& model, double tolerance) {
+  GroundTruth out = truth;
+  out.tolerance = tolerance;
+  for (MeasuredPair& p : out.measured) p.threshold = contact_threshold(model, p.surface_a, p.surface_b, tolerance);
+  return out;
+}
+
+double instance_distance(const Model& model, InstanceId a, InstanceId b, double search) {
+  const Instance& ia = model.instances[a];
+  const Instance& ib = model.instances[b];
+  const Part& pa = model.parts[ia.part];
+  const Part& pb = model.parts[ib.part];
+  double best = std::numeric_limits<double>::infinity();
+  for (SurfaceId sa = pa.first_surface; sa < pa.first_surface + pa.surface_count; ++sa) {
+    const Aabb box_a = world_box(model.surfaces[sa].aabb, ia.pose);
+    for (SurfaceId sb = pb.first_surface; sb < pb.first_surface + pb.surface_count; ++sb)
+      if (boxes_within(box_a, world_box(model.surfaces[sb].aabb, ib.pose), search))
+        best = std::min(best, exact_face_distance(model, a, sa, b, sb));
+  }
+  return best;
 }
 
 std::string file_hash(const std::string& path) {
@@ -190,8 +234,9 @@ std::optional<GroundTruth> load_ground_truth(const std::string& path, const Mode
       if (a == by_path.end() || b == by_path.end()) return std::nullopt;
       MeasuredPair p{a->second, b->second, surface(a->second, e.at(1).get<std::int64_t>()),
                      surface(b->second, e.at(3).get<std::int64_t>()),
-                     e.at(4).is_null() ? std::numeric_limits<double>::infinity() : e.at(4).get<double>()};
+                     e.at(4).is_null() ? std::numeric_limits<double>::infinity() : e.at(4).get<double>(), 0.0};
       if (p.surface_a == kInvalidId || p.surface_b == kInvalidId || p.instance_a >= p.instance_b) return std::nullopt;
+      p.threshold = contact_threshold(model, p.surface_a, p.surface_b, tolerance);
       truth.failed += !std::isfinite(p.distance);
       truth.measured.push_back(p);
     }
@@ -234,7 +279,7 @@ Score score(const GroundTruth& truth, std::vector<PairKey> reported) {
   reported.erase(std::unique(reported.begin(), reported.end()), reported.end());
   std::vector<PairKey> real;
   for (const MeasuredPair& p : truth.measured)
-    if (within(p, truth.tolerance)) real.push_back({p.instance_a, p.instance_b, p.surface_a, p.surface_b});
+    if (within(p)) real.push_back({p.instance_a, p.instance_b, p.surface_a, p.surface_b});
   std::sort(real.begin(), real.end());
   Score s;
   s.truth = real.size();
@@ -245,4 +290,4 @@ Score score(const GroundTruth& truth, std::vector<PairKey> reported) {
   return s;
 }
 
-}  // namespace cadclash::bench
+}  // namespace cadclash::truth

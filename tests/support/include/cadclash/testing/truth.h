@@ -1,12 +1,18 @@
-// Ground truth for the accuracy benchmark: which B-rep face pairs of which instance pairs are within
-// a tolerance of each other, measured on the exact faces (BRepExtrema_DistShapeShape on the placed
-// faces), and how a set of reported surface pairs scores against it.
+// cadclash/testing/truth.h — exact ground truth for tests and benchmarks: which B-rep face pairs of
+// which instance pairs are in contact, measured on the exact faces (BRepExtrema_DistShapeShape on the
+// placed faces), and how a set of reported surface pairs scores against it. Library cadclash::truth
+// (tests/support); not part of the product.
+//
+// Contact is the library's own definition (collide.h, "Certified decisions"): two faces are in
+// contact when their exact distance d* <= T = tolerance + εa + εb, ε being each surface's model
+// uncertainty (Surface::uncertainty, or when that is 0 the single-precision bound 2^-24 of its part's
+// largest coordinate magnitude, as collide derives it). No extra slack.
 //
 // Candidates: every instance pair (a < b) and every face pair whose world boxes, enlarged by the
-// tolerance, overlap. The boxes are the surfaces' Surface::aabb (which encloses the exact face, not
-// its triangles) mapped to world by the pose, so they enclose the placed faces: two faces within the
-// tolerance always have boxes within the tolerance, and the prefilter never drops a true pair. Every
-// candidate's exact distance is measured and kept (true or not), so a false pair can be looked up.
+// pair's threshold T, overlap. The boxes are the surfaces' Surface::aabb (which encloses the exact
+// face, not its triangles) mapped to world by the pose, so they enclose the placed faces: two faces
+// within T always have boxes within T, and the prefilter never drops a true pair. Every candidate's
+// exact distance is measured and kept (true or not), so a false pair can be looked up.
 #pragma once
 
 #include "cadclash/collide.h"
@@ -19,35 +25,37 @@
 
 class gp_Trsf;
 
-namespace cadclash::bench {
+namespace cadclash::truth {
 
 // The OCCT transformation of a pose (part-local -> world), to place B-rep shapes like instances.
 gp_Trsf to_trsf(const Pose& pose);
 
-// Exact contact is "distance <= tolerance + kContactSlack": touching faces do not measure exactly 0
-// (on as1-tu-203.stp they measure 0 or 1e-15..1e-11 mm; the next face pair is 1 mm away), and
-// BRepExtrema works to Precision::Confusion() = 1e-7 mm. 1e-6 mm is far below any deliberate gap
-// in a mechanical assembly.
-inline constexpr double kContactSlack = 1e-6;
+// ε of surface `s` as collide uses it: Surface::uncertainty when > 0, else 2^-24 times the largest
+// Euclidean norm of a corner of its part's box (the union of the part's surface boxes).
+double effective_uncertainty(const Model& model, SurfaceId s);
+
+// The contact threshold of two surfaces: tolerance + ε(a) + ε(b).
+double contact_threshold(const Model& model, SurfaceId a, SurfaceId b, double tolerance);
 
 // One measured candidate face pair. Model ids (instance_a < instance_b).
 struct MeasuredPair {
   InstanceId instance_a = kInvalidId, instance_b = kInvalidId;
   SurfaceId surface_a = kInvalidId, surface_b = kInvalidId;
-  double distance = 0.0;  // exact face distance; +infinity when OCCT could not measure it
+  double distance = 0.0;   // exact face distance; +infinity when OCCT could not measure it
+  double threshold = 0.0;  // contact_threshold of the two surfaces at the truth's tolerance
 };
 
 struct GroundTruth {
   double tolerance = 0.0;
   std::vector<MeasuredPair> measured;   // every candidate, sorted by ids
   std::uint64_t instance_pairs = 0;     // instance pairs with at least one candidate
-  std::uint64_t failed = 0;             // candidates OCCT could not measure (counted as not within)
+  std::uint64_t failed = 0;             // candidates OCCT could not measure (counted as not in contact)
   double seconds = 0.0;                 // time to measure (0 when read from the cache)
   bool from_cache = false;
 };
 
-// True when the measured pair is within the truth's tolerance.
-bool within(const MeasuredPair& p, double tolerance);
+// True when the measured pair is in contact: distance <= threshold.
+bool within(const MeasuredPair& p);
 
 // Measures every candidate of `model` (a model whose parts are B-rep parts with BrepSource sources;
 // other parts are skipped) for `tolerance`. Deterministic; runs on `threads` threads (<= 0: OpenMP's
@@ -55,9 +63,18 @@ bool within(const MeasuredPair& p, double tolerance);
 GroundTruth compute_ground_truth(const Model& model, double tolerance, int threads,
                                  const std::function<bool(InstanceId, InstanceId)>& keep = {});
 
+// The same measurements judged at a smaller tolerance (thresholds recomputed; candidates that the
+// smaller tolerance's box prefilter would drop stay, measured, and are not in contact).
+// Precondition: tolerance <= truth.tolerance.
+GroundTruth with_tolerance(const GroundTruth& truth, const Model& model, double tolerance);
+
 // The exact distance of two placed faces (BRepExtrema_DistShapeShape); +infinity when either
 // surface is not a B-rep face or OCCT fails.
 double exact_face_distance(const Model& model, InstanceId a, SurfaceId sa, InstanceId b, SurfaceId sb);
+
+// The smallest exact face distance between instances a and b over the face pairs whose world boxes
+// come within `search` mm of each other; +infinity when none do.
+double instance_distance(const Model& model, InstanceId a, InstanceId b, double search);
 
 // FNV-1a 64 of the file's bytes, as 16 hex digits; empty when the file cannot be read.
 std::string file_hash(const std::string& path);
@@ -66,7 +83,8 @@ std::string file_hash(const std::string& path);
 std::string cache_path(const std::string& dir, const std::string& hash, double tolerance);
 
 // Reads a cache written by save_ground_truth for the same model (pairs are stored by instance path
-// and face index, so ids are re-derived); nullopt when absent, unreadable or not matching.
+// and face index, so ids are re-derived; thresholds are recomputed from the model); nullopt when
+// absent, unreadable or not matching.
 std::optional<GroundTruth> load_ground_truth(const std::string& path, const Model& model, double tolerance);
 
 // Writes the truth; returns false when the file cannot be written.
@@ -91,7 +109,7 @@ struct Score {
   double precision() const;
 };
 
-// Scores `reported` (any order, duplicates ignored) against the pairs of `truth` within its tolerance.
+// Scores `reported` (any order, duplicates ignored) against the pairs of `truth` in contact.
 Score score(const GroundTruth& truth, std::vector<PairKey> reported);
 
-}  // namespace cadclash::bench
+}  // namespace cadclash::truth
