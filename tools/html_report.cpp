@@ -22,7 +22,9 @@ extern const char* const kHtmlViewerScript;
 
 namespace {
 
-// Version of the data the page reads (viewer/src); bump with any incompatible change.
+// Version of the data the page reads (viewer/src); bump with any incompatible change. Fields added
+// to a record (the pairs' decided_by and distance_interval) are compatible: the page and its data
+// are always written together, and a reader of version 1 ignores them.
 constexpr int kHtmlDataVersion = 1;
 
 constexpr std::string_view kTitleMarker = "<!--cadclash:title-->";
@@ -140,6 +142,8 @@ nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Repo
                       {"surface_a", signed_id(p.surface_a)},
                       {"surface_b", signed_id(p.surface_b)},
                       {"class", contact_class_name(p.contact)},
+                      {"decided_by", decided_by_name(p.decided_by)},
+                      {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
                       {"intersecting", p.intersecting},
                       {"distance", number_or_null(p.distance)},
                       {"penetration", p.penetration}};

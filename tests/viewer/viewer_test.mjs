@@ -3,11 +3,19 @@
 // the selection panel against the JSON report of the same run, that the canvas shows the model and
 // that clicking frames the pair; then filters the table (text and class toggles) and walks it with
 // the keys, checking rows and panel against the JSON report. Saves a screenshot next to the report.
+// The panel and the table's "decided by" column show the certified decision (decided_by and the
+// proven distance interval) of the JSON report.
 //
 // Usage: node viewer_test.mjs --cadclash EXE --viewer-dir DIR --out DIR
-//                             --case NAME INPUT... [--option CHECK_OPTION]... [--case ...]
+//                             --case NAME INPUT... [--option CHECK_OPTION]... [--tessellate]
+//                             [--expect-class CLASS] [--case ...]
 // Each case is one report (its inputs form one scene, --option is passed to `cadclash check`),
 // checked in one browser. A case whose input is missing is skipped with a message.
+// --tessellate: the inputs are first written to one .glb by `cadclash tessellate`, and the check
+// reads that: its surfaces keep their deflection bands but have no exact geometry, so contacts
+// within the bands cannot be proved (undecided pairs).
+// --expect-class CLASS: the report must hold a pair of that class; one is clicked and checked too
+// (row, chip colour, panel, its class toggle, and the 3D view's colouring).
 // Exit codes: 0 pass, 1 fail, 77 every case skipped.
 import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
@@ -29,6 +37,8 @@ function parseArgs(argv) {
     const a = argv[i];
     if (a === '--case') args.cases.push({ name: argv[++i], inputs: [], options: [] });
     else if (a === '--option' && args.cases.length) args.cases.at(-1).options.push(argv[++i]);
+    else if (a === '--tessellate' && args.cases.length) args.cases.at(-1).tessellate = true;
+    else if (a === '--expect-class' && args.cases.length) args.cases.at(-1).expectClass = argv[++i];
     else if (a.startsWith('--')) args[a.slice(2)] = argv[++i];
     else if (args.cases.length) args.cases.at(-1).inputs.push(a);
     else throw new Error(`${a}: an input must follow --case NAME`);
@@ -73,17 +83,27 @@ async function main() {
   return 0;
 }
 
-async function checkCase(browser, args, { name, inputs, options }) {
+async function checkCase(browser, args, { name, inputs, options, tessellate, expectClass }) {
   const out = resolve(args.out, name);
   rmSync(out, { recursive: true, force: true });
   mkdirSync(out, { recursive: true });
   const json = join(out, 'report.json'), html = join(out, 'report.html');
+  if (tessellate) {
+    const glb = join(out, 'model.glb');
+    const run = spawnSync(args.cadclash, ['tessellate', ...inputs, '-o', glb], { encoding: 'utf8', timeout: 120000 });
+    check(run.status === 0, `cadclash tessellate exited ${run.status}:\n${run.stderr}`);
+    inputs = [glb];
+  }
   const run = spawnSync(args.cadclash, ['check', ...inputs, ...options, '--no-timings', '--json', json, '--html', html],
                         { encoding: 'utf8', timeout: 120000 });
   check(run.status === 0, `cadclash check exited ${run.status}:\n${run.stderr}`);
   const report = JSON.parse(readFileSync(json, 'utf8'));
   const pairs = report.pairs;
   check(pairs.length > 0, 'the input gives no pairs; the test needs at least one');
+  const byClass = {};
+  for (const p of pairs) byClass[p.class] = (byClass[p.class] || 0) + 1;
+  console.log(`pairs by class: ${JSON.stringify(byClass)}; decided by: ${JSON.stringify(report.summary.decided_by)}`);
+  if (expectClass) check(byClass[expectClass] > 0, `the report has no ${expectClass} pair`);
 
   const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
   try {
@@ -114,6 +134,13 @@ async function checkCase(browser, args, { name, inputs, options }) {
       row: document.querySelector('#pairs tbody tr[data-index]').getBoundingClientRect().height,
     }));
     check(heights.scroll >= pairs.length * heights.row - 1, `the table is ${heights.scroll} px high, for ${pairs.length} rows of ${heights.row} px`);
+    // The header names every column a row has (the "decided by" column included).
+    const columns = await page.$$eval('#pairs thead th', (ths) => ths.map((th) => th.textContent));
+    const cells = await page.$eval('#pairs tbody tr[data-index]', (tr) => tr.cells.length);
+    check(columns.includes('decided by') && columns.length === cells, `header ${columns}, rows of ${cells} cells`);
+    // Every class has its toggle (whether or not the report has pairs of it).
+    for (const c of CLASSES)
+      check(await page.locator(`#class-toggles input[data-class="${c}"]`).count() === 1, `no class toggle for ${c}`);
     await page.evaluate((i) => window.cadclashViewer.scrollToPair(i), pairs.length - 1);
     check((await rowsDrawn()).includes(pairs.length - 1), 'scrolling to the last pair does not draw its row');
 
@@ -122,6 +149,8 @@ async function checkCase(browser, args, { name, inputs, options }) {
     console.log(`whole assembly covers ${all.covered} of ${all.total} pixels`);
     check(all.covered > all.total * 0.01, 'the canvas is blank (is WebGL working?)');
 
+    if (expectClass) await checkClass(page, pairs, expectClass);
+
     // A pair in the middle of the table (so the click needs scrolling), with both surfaces named.
     let index = pairs.length >> 1;
     while (index < pairs.length - 1 && (pairs[index].a.surface === undefined || pairs[index].b.surface === undefined)) ++index;
@@ -129,6 +158,7 @@ async function checkCase(browser, args, { name, inputs, options }) {
     check(await page.evaluate((i) => window.cadclashViewer.scrollToPair(i), index), `row ${index} is not listed`);
     await page.locator(`#pairs tbody tr[data-index="${index}"]`).click();
     await checkSelected(page, pairs, index, 'the click');
+    await checkRow(page, pairs, index, 'the click');
 
     // Both selected surfaces are drawn, and clicking framed them: they cover more of the canvas
     // than when the whole assembly is in view.
@@ -155,6 +185,21 @@ async function checkCase(browser, args, { name, inputs, options }) {
 const count = (n) => n.toLocaleString('en');
 const stepText = (side) => (side.step_id === undefined ? '–' : `#${side.step_id}`);
 
+// The classes of docs/report-schema.md, their colours in the page (viewer/src/classes.js) and the
+// order in which a surface in several pairs takes a class: an undecided pair may be a contact, so
+// it wins over touching.
+const CLASSES = ['penetrating', 'touching', 'clearance', 'containment', 'undecided'];
+const CLASS_RGB = {
+  penetrating: 'rgb(224, 32, 42)', touching: 'rgb(255, 140, 26)', clearance: 'rgb(242, 210, 27)',
+  containment: 'rgb(155, 77, 202)', undecided: 'rgb(240, 50, 230)',
+};
+const SEVERITY = ['clearance', 'touching', 'undecided', 'containment', 'penetrating'];
+
+// The JSON report's distance interval as the page writes it: 4 significant digits, null (an
+// infinite bound) as ∞.
+const numberText = (v) => (v === null ? '∞' : v === 0 ? '0' : Number(v.toPrecision(4)).toString());
+const intervalText = (pair) => `[${numberText(pair.distance_interval[0])}, ${numberText(pair.distance_interval[1])}] mm`;
+
 // The selected pair is `index`, and the panel shows that pair of the JSON report.
 async function checkSelected(page, pairs, index, what) {
   const selected = await page.getAttribute('html', 'data-cadclash-selected');
@@ -168,7 +213,51 @@ async function checkSelected(page, pairs, index, what) {
     check(await field(`${key}-part`) === side.part, `${key}: part ${await field(`${key}-part`)}, expected ${side.part}`);
   }
   check((await field('class')).trim() === pair.class, `class ${await field('class')}, expected ${pair.class}`);
-  console.log(`${what}: row ${index + 1}: ${pair.class} ${pair.a.instance} ${stepText(pair.a)} x ${pair.b.instance} ${stepText(pair.b)}`);
+  check(await field('decided-by') === pair.decided_by, `decided by ${await field('decided-by')}, expected ${pair.decided_by}`);
+  check(await field('interval') === intervalText(pair),
+        `exact distance in ${await field('interval')}, expected ${intervalText(pair)} (${JSON.stringify(pair.distance_interval)})`);
+  console.log(`${what}: row ${index + 1}: ${pair.class} (${pair.decided_by}, ${intervalText(pair)}) ` +
+              `${pair.a.instance} ${stepText(pair.a)} x ${pair.b.instance} ${stepText(pair.b)}`);
+}
+
+// The pair's drawn row shows its class, in the class's colour, and what decided it.
+async function checkRow(page, pairs, index, what) {
+  const pair = pairs[index];
+  const row = await page.$eval(`#pairs tbody tr[data-index="${index}"]`, (tr) => ({
+    cls: tr.querySelector('td.cls').textContent,
+    by: tr.querySelector('td.by').textContent,
+    chip: getComputedStyle(tr.querySelector('td.cls .chip')).backgroundColor,
+  }));
+  check(row.cls === pair.class, `${what}: row ${index + 1} shows class ${row.cls}, expected ${pair.class}`);
+  check(row.by === pair.decided_by, `${what}: row ${index + 1} shows decided by ${row.by}, expected ${pair.decided_by}`);
+  check(row.chip === CLASS_RGB[pair.class], `${what}: row ${index + 1}'s ${pair.class} chip is ${row.chip}, expected ${CLASS_RGB[pair.class]}`);
+}
+
+// A pair of class `cls` is listed, clicked and shown like any other; the toggle counts the class;
+// the 3D view colours with it exactly the surfaces whose most severe pair is of that class.
+async function checkClass(page, pairs, cls) {
+  const of = pairs.map((p, i) => i).filter((i) => pairs[i].class === cls);
+  const index = of[of.length >> 1];
+  check(await page.evaluate((i) => window.cadclashViewer.scrollToPair(i), index), `${cls} row ${index} is not listed`);
+  await page.locator(`#pairs tbody tr[data-index="${index}"]`).click();
+  await checkSelected(page, pairs, index, `the click on a ${cls} pair`);
+  await checkRow(page, pairs, index, `the ${cls} pair`);
+  const chip = await page.$eval(`#selection [data-field="class"] .chip`, (e) => getComputedStyle(e).backgroundColor);
+  check(chip === CLASS_RGB[cls], `the panel's ${cls} chip is ${chip}, expected ${CLASS_RGB[cls]}`);
+  const shown = await page.innerText(`#class-toggles [data-count="${cls}"]`);
+  check(shown === count(of.length), `the ${cls} toggle says ${shown}, expected ${of.length}`);
+  if (pairs.some((p) => p.class === 'containment')) return;  // a containment colours whole instances
+  const worst = new Map();
+  for (const p of pairs)
+    for (const side of [p.a, p.b]) {
+      const key = `${side.instance}\n${side.surface}\n${side.face_index}`;
+      const was = worst.get(key);
+      if (was === undefined || SEVERITY.indexOf(p.class) > SEVERITY.indexOf(was)) worst.set(key, p.class);
+    }
+  const expected = [...worst.values()].filter((c) => c === cls).length;
+  const drawn = (await page.evaluate(() => window.cadclashViewer.highlightCounts()))[cls] || 0;
+  check(drawn === expected, `the 3D view colours ${drawn} surfaces ${cls}, expected ${expected}`);
+  console.log(`${cls}: ${of.length} pairs, ${drawn} surfaces coloured ${cls}`);
 }
 
 // The filter rules of docs/viewer.md, written again here from the JSON report: whitespace-separated

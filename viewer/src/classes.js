@@ -1,12 +1,15 @@
 // Contact classes: their colours and which one wins when a surface is in several pairs.
 
-export const CLASSES = ['penetrating', 'touching', 'clearance', 'containment'];
+// undecided: nothing could prove the exact faces in contact or apart (see collide.h, "Certified
+// decisions"); it may be a contact, so it is drawn in a loud magenta of its own.
+export const CLASSES = ['penetrating', 'touching', 'clearance', 'containment', 'undecided'];
 
 export const CLASS_COLOURS = {
   penetrating: 0xe0202a,
   touching: 0xff8c1a,
   clearance: 0xf2d21b,
   containment: 0x9b4dca,
+  undecided: 0xf032e6,
 };
 
 // Selection colours of side A and side B (unlit, drawn on top of everything).
@@ -15,12 +18,15 @@ export const SELECTION_COLOURS = [0x1e90ff, 0x00d084];
 // Colour of the surfaces in no reported pair (drawn translucent as context).
 export const CONTEXT_COLOUR = 0xa9adb3;
 
-// A surface in several pairs shows its most severe class.
-const SEVERITY = { penetrating: 3, containment: 2, touching: 1, clearance: 0 };
+// A surface in several pairs shows its most severe class. An undecided pair may be a contact the
+// triangles could not prove: it must stay visible over touching (a class this viewer does not know
+// counts as undecided).
+const SEVERITY = { penetrating: 4, containment: 3, undecided: 2, touching: 1, clearance: 0 };
+const severity = (c) => SEVERITY[c] ?? SEVERITY.undecided;
 
 export function moreSevere(a, b) {
   if (a === undefined) return b;
-  return SEVERITY[b] > SEVERITY[a] ? b : a;
+  return severity(b) > severity(a) ? b : a;
 }
 
 // What the distance column shows: a penetrating pair shows minus its crossing-depth estimate,
@@ -28,6 +34,15 @@ export function moreSevere(a, b) {
 export function distanceText(pair) {
   if (pair.class === 'penetrating') return '-' + formatNumber(pair.penetration);
   return pair.distance === null ? '–' : formatNumber(pair.distance);
+}
+
+// The proven interval of the exact face distance, "[lo, hi] mm"; an unbounded end (null in the
+// data: infinity) shows ∞, a missing interval '–'.
+export function intervalText(pair) {
+  const iv = pair.distance_interval;
+  if (!Array.isArray(iv) || iv.length !== 2) return '–';
+  const end = (v) => (v === null ? '∞' : formatNumber(v));
+  return `[${end(iv[0])}, ${end(iv[1])}] mm`;
 }
 
 export function formatNumber(v) {

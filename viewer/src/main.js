@@ -249,6 +249,8 @@ function start() {
       readyMs: tReady,  // since navigation start: includes reading and parsing the HTML file
     },
     selectPair,
+    // Per class, how many (instance, surface) the 3D view colours with it (unfiltered).
+    highlightCounts: () => clash.highlightCounts(),
     // Scrolls the table to a listed pair's row (false when the filter hides it).
     scrollToPair: (index) => table.scrollToPair(index),
     // Fits the whole assembly in view (the selection stays).

@@ -2,7 +2,7 @@
 // as DOM nodes, between two spacer rows that give the table its full height. Rows have one fixed
 // height (every cell is one or two lines that never wrap), so a row's position is its place in the
 // listed pairs times that height: 60 000 rows scroll and filter as fast as 60.
-import { distanceText } from './classes.js';
+import { distanceText, intervalText } from './classes.js';
 import { escapeHtml, surfaceLabel } from './panel.js';
 
 const OVERSCAN = 12;  // rows drawn above and below the visible ones, so a quick scroll shows no gap
@@ -22,14 +22,14 @@ function sideCell(data, instanceId, surfaceId) {
 
 function rowHtml(data, i, selected) {
   const p = data.pairs[i];
-  return `<tr class="${p.class}${i === selected ? ' selected' : ''}" data-index="${i}">` +
-         `<td class="num">${i + 1}</td><td class="cls"><span class="chip"></span>${p.class}</td>` +
-         `<td class="num">${distanceText(p)}</td>` +
+  return `<tr class="${escapeHtml(p.class)}${i === selected ? ' selected' : ''}" data-index="${i}">` +
+         `<td class="num">${i + 1}</td><td class="cls"><span class="chip"></span>${escapeHtml(p.class)}</td>` +
+         `<td class="num">${distanceText(p)}</td><td class="by" title="exact distance in ${intervalText(p)}">${escapeHtml(p.decided_by ?? '–')}</td>` +
          `${sideCell(data, p.instance_a, p.surface_a)}${sideCell(data, p.instance_b, p.surface_b)}</tr>`;
 }
 
 function spacer(height) {
-  return height > 0 ? `<tr class="spacer"><td colspan="5" style="height:${height}px"></td></tr>` : '';
+  return height > 0 ? `<tr class="spacer"><td colspan="6" style="height:${height}px"></td></tr>` : '';
 }
 
 export class PairTable {

@@ -1,5 +1,5 @@
 // The legend, the class toggles above the table and the selection panel (plain DOM).
-import { CLASSES, formatNumber } from './classes.js';
+import { CLASSES, formatNumber, intervalText } from './classes.js';
 
 export function escapeHtml(text) {
   return String(text).replace(/[&<>"']/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;' })[c]);
@@ -56,7 +56,8 @@ function sideRows(data, label, instanceId, surfaceId) {
     `<tr><td>${k.startsWith('<') ? k : escapeHtml(k)}</td><td data-field="${label.toLowerCase()}-${field}">${escapeHtml(v)}</td></tr>`).join('');
 }
 
-// Shows what a CAD user needs to find the two faces: STEP ids, part names, instance paths.
+// Shows what a CAD user needs to find the two faces: STEP ids, part names, instance paths; and
+// what decided the class, with the proven interval of the exact face distance.
 export function showSelection(panel, data, index) {
   const p = data.pairs[index];
   const extra = [];
@@ -64,8 +65,10 @@ export function showSelection(panel, data, index) {
   if (p.intersecting) extra.push('triangles intersect');
   panel.innerHTML =
     `<table><tr><td>pair</td><td data-field="index">${index + 1}</td></tr>` +
-    `<tr><td>class</td><td data-field="class"><span class="chip ${p.class}"></span>${p.class}</td></tr>` +
+    `<tr><td>class</td><td data-field="class"><span class="chip ${escapeHtml(p.class)}"></span>${escapeHtml(p.class)}</td></tr>` +
+    `<tr><td>decided by</td><td data-field="decided-by">${escapeHtml(p.decided_by ?? '–')}</td></tr>` +
     `<tr><td>distance</td><td data-field="distance">${p.distance === null ? '–' : formatNumber(p.distance) + ' mm'}` +
     `${extra.length ? ' <span class="muted">(' + extra.join(', ') + ')</span>' : ''}</td></tr>` +
+    `<tr><td>exact distance in</td><td data-field="interval">${intervalText(p)}</td></tr>` +
     sideRows(data, 'A', p.instance_a, p.surface_a) + sideRows(data, 'B', p.instance_b, p.surface_b) + '</table>';
 }

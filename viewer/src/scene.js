@@ -139,14 +139,24 @@ export class ClashScene {
     for (const { surface, cls, instances } of groups.values()) {
       const g = this.surfaceGeometry(surface);
       if (!g) continue;
-      const mesh = new THREE.InstancedMesh(g, this.classMaterials[cls], instances.length);
+      // A class this viewer does not know is drawn like undecided (moreSevere ranks it so too).
+      const material = this.classMaterials[cls] ?? this.classMaterials.undecided;
+      const mesh = new THREE.InstancedMesh(g, material, instances.length);
       instances.sort((x, y) => x - y).forEach((inst, k) => mesh.setMatrixAt(k, this.matrices[inst]));
       mesh.computeBoundingSphere();
-      mesh.userData = { surface, instances };
+      mesh.userData = { surface, instances, cls };
       this.highlights.add(mesh);
       ++this.drawCalls;
     }
     this.root.add(this.highlights);
+  }
+
+  // How many (instance, surface) are coloured in each class (tests/viewer compares it to the report).
+  highlightCounts() {
+    const counts = {};
+    for (const mesh of this.highlights.children)
+      counts[mesh.userData.cls] = (counts[mesh.userData.cls] || 0) + mesh.userData.instances.length;
+    return counts;
   }
 
   // Colours only the surfaces of the listed pairs (null: all); the others are drawn as context.
