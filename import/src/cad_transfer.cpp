@@ -13,6 +13,8 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 
+#include <algorithm>
+#include <bit>
 #include <cstring>
 #include <mutex>
 #include <sstream>
@@ -41,6 +43,7 @@ struct Writer {
   std::string out;
   void u64(std::uint64_t v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); }
   void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
   void str(const std::string& s) {
     u64(s.size());
     out += s;
@@ -62,6 +65,7 @@ struct Reader {
     return v;
   }
   std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+  double f64() { return std::bit_cast<double>(u64()); }
   std::string str() {
     const std::uint64_t n = u64();
     if (!ok || in.size() - at < n) {
@@ -119,6 +123,7 @@ std::string pack_transfer(const Transfer& t) {
   }
   w.u64(t.complete ? 1 : 0);
   w.u64(static_cast<std::uint64_t>(t.kind));
+  w.f64(t.declared_uncertainty);
   if (!t.doc.IsNull()) {
     w.u64(1);
     const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
@@ -162,6 +167,7 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   }
   t.complete = r.u64() == 1;
   t.kind = static_cast<SourceKind>(r.u64());
+  t.declared_uncertainty = r.f64();
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
@@ -246,6 +252,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
       result.complete = false;
     }
   }
+  for (Surface& s : result.model.surfaces) s.uncertainty = std::max(s.uncertainty, t.declared_uncertainty);
   return result;
 }
 

@@ -656,6 +656,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
       if (d.severity == Severity::Error) result.complete = false;
       result.diagnostics.push_back(std::move(d));
     }
+    result.declared_uncertainty = declared_length_uncertainty(text, path, result.diagnostics);
     if (model.IsNull() || model->NbEntities() == 0) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP file has an empty DATA section"});
       result.complete = false;
@@ -718,16 +719,6 @@ void set_step_hang_injection_for_testing(std::int64_t face_id) { hang_injected_a
 // on a LINE whose point was cut off), so each attempt runs in a child process, which sends back the
 // transferred document (cad_transfer.h): a crash there costs the attempt, not the caller's process,
 // and this process never runs OCCT's STEP code on the file.
-// The file's declared length uncertainty as the floor of its faces' model uncertainty.
-static void apply_declared_uncertainty(const std::string& path, ImportResult& result) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  const double declared = declared_length_uncertainty(text.str(), path, result.diagnostics);
-  if (declared <= 0.0) return;
-  for (Surface& s : result.model.surfaces) s.uncertainty = std::max(s.uncertainty, declared);
-}
-
 ImportResult read_step(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
   std::vector<Diagnostic> notes;  // how the attempts went, first in the result
@@ -741,7 +732,6 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
         if (!said.count(format_diagnostic(d))) notes.push_back(d);
     }
     ImportResult result = finish_transfer(std::move(transfer), path, options);
-    apply_declared_uncertainty(path, result);
     for (const Diagnostic& d : notes) result.complete = result.complete && d.severity != Severity::Error;
     result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
     return result;
