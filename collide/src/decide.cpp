@@ -247,12 +247,21 @@ std::optional<Vec3> foot_point(const AnalyticSurface& an, const Vec3& p) {
   }
 }
 
-double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) { return triangle_distance(p, p, p, a, b, b); }
+// Distance from p to the segment [a, b] by projection in plain doubles: a few roundings of the
+// coordinates' magnitude, well within the slack its caller adds (the pair's round-off bound, which
+// allows 64 of them for triangle_distance alone).
+double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double s = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + s * ab - p).norm();
+}
 
 }  // namespace
 
 std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
-                                       const std::vector<std::array<Vec3, 2>>& outline_b, double delta_b,
+                                       const SurfaceBvh& bvh_b, const std::vector<std::array<Vec3, 2>>& outline_b,
+                                       double delta_b,
                                        const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
                                        double limit, double slack) {
   if (an_b.shape != SurfaceShape::Plane && an_b.shape != SurfaceShape::Cylinder &&
@@ -274,13 +283,7 @@ std::optional<double> analytic_witness(const AnalyticSurface& an_b, const Triang
   std::stable_sort(cs.begin(), cs.end(), [](const Candidate& x, const Candidate& y) { return x.g < y.g; });
   if (cs.size() > 16) cs.resize(16);
   for (const Candidate& c : cs) {
-    double to_mesh = std::numeric_limits<double>::infinity();
-    for (const auto& t : mesh_b.triangles) {
-      to_mesh = std::min(to_mesh, triangle_distance(c.foot, c.foot, c.foot, mesh_b.vertices[t[0]],
-                                                    mesh_b.vertices[t[1]], mesh_b.vertices[t[2]]));
-      if (to_mesh <= delta_b + slack) break;
-    }
-    if (!(to_mesh <= delta_b + slack)) continue;
+    if (!(point_mesh_distance(bvh_b, mesh_b, c.foot, delta_b + slack) <= delta_b + slack)) continue;
     double to_outline = std::numeric_limits<double>::infinity();
     for (const auto& e : outline_b) {
       to_outline = std::min(to_outline, point_segment(c.foot, e[0], e[1]));

@@ -4,6 +4,7 @@
 
 #include "cadclash/collide.h"
 #include "narrow_phase.h"
+#include "surface_bvh.h"
 
 #include <limits>
 #include <optional>
@@ -85,7 +86,8 @@ std::vector<std::array<Vec3, 2>> boundary_edges(const TriangleMesh& mesh);
 // g <= limit are tried (at most 16, nearest first). nullopt when no vertex qualifies or the shape
 // has no foot point here (plane, cylinder and sphere do).
 std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
-                                       const std::vector<std::array<Vec3, 2>>& outline_b, double delta_b,
+                                       const SurfaceBvh& bvh_b, const std::vector<std::array<Vec3, 2>>& outline_b,
+                                       double delta_b,
                                        const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
                                        double limit, double slack);
 
@@ -120,9 +122,10 @@ struct DecideResult {
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
 // is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`.
-// `eps` holds every surface's effective_uncertainty.
+// `eps` holds every surface's effective_uncertainty, `bvh` the tree of every surface with triangles.
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
-                                       std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
+                                       std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
+                                       std::vector<RefinedSurface>& refined,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
                                        CollideCounters& counters);
 

@@ -59,13 +59,16 @@ Aabb SceneData::surface_box(SurfaceId s) const {
   return mesh_aabb(surf.mesh);
 }
 
-double SceneData::deflection(SurfaceId s, const CollideOptions& o) const {
+double SceneData::deflection(SurfaceId s) const {
   const Surface& surf = model.surfaces[s];
-  return surf.has_triangles ? surf.deflection : std::max(surf.deflection, o.deflection_hint);
+  if (surf.has_triangles) return surf.deflection;
+  // Not tessellated yet (lazy): it will be meshed at its source's load deflection.
+  const SurfaceSource* source = model.parts[surf.part].source.get();
+  return std::max(surf.deflection, source != nullptr ? source->default_deflection() : 0.0);
 }
 
 double SceneData::reach_share(SurfaceId s, const CollideOptions& o) const {
-  return deflection(s, o) + (o.decision == DecisionMode::Fast ? 0.0 : eps[s]);
+  return deflection(s) + (o.decision == DecisionMode::Fast ? 0.0 : eps[s]);
 }
 
 double SceneData::part_reach_share(PartId p, const CollideOptions& o) const {

@@ -41,7 +41,7 @@ struct SceneData {
   SurfaceId end(PartId p) const { return model.parts[p].first_surface + model.parts[p].surface_count; }
   Aabb surface_box(SurfaceId s) const;
   // Deflection a surface's triangles have, or will have when tessellated on demand.
-  double deflection(SurfaceId s, const CollideOptions& o) const;
+  double deflection(SurfaceId s) const;
   // What a surface adds to the search reach: its deflection, plus its uncertainty unless fast.
   double reach_share(SurfaceId s, const CollideOptions& o) const;
   double part_reach_share(PartId p, const CollideOptions& o) const;

@@ -36,7 +36,7 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
       before.push_back(model.surfaces[sid].deflection);
     }
   if (missing.empty()) return;
-  std::vector<Diagnostic> ds = require_triangles(model, missing, q.o.tessellation_deflection, q.deadline);
+  std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.deadline);
   q.report.diagnostics.insert(q.report.diagnostics.end(), ds.begin(), ds.end());
   q.asked.insert(q.asked.end(), missing.begin(), missing.end());
   for (std::size_t i = 0; i < missing.size(); ++i) {

@@ -1,8 +1,11 @@
 #include "surface_bvh.h"
 
+#include "triangle_predicates.h"
+
 #include "box_util.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace cadclash::detail {
 namespace {
@@ -87,6 +90,30 @@ void query_surface_bvh(const SurfaceBvh& bvh, const Aabb& query, std::vector<std
     }
   }
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(start), out.end());
+}
+
+double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
+  double best = std::numeric_limits<double>::infinity();
+  if (bvh.nodes.empty()) return best;
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SurfaceBvh::Node& node = bvh.nodes[stack[--top]];
+    if (node.box.exteriorDistance(p) > std::min(best, reach)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const std::uint32_t t = bvh.order[i];
+        if (bvh.triangle_boxes[t].exteriorDistance(p) > std::min(best, reach)) continue;
+        const auto& tri = mesh.triangles[t];
+        best = std::min(best, triangle_distance(p, p, p, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]));
+      }
+    } else {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+    }
+  }
+  return best;
 }
 
 }  // namespace cadclash::detail

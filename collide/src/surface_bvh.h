@@ -28,4 +28,9 @@ SurfaceBvh build_surface_bvh(const TriangleMesh& mesh);
 void query_surface_bvh(const SurfaceBvh& bvh, const Aabb& query, std::vector<std::uint32_t>& out,
                        std::uint64_t& box_tests);
 
+// The smallest distance from `p` to a triangle of `mesh` (the mesh `bvh` was built on) whose box
+// comes within `reach` of p, by triangle_distance; +inf when none does. Nearer triangles are never
+// pruned, so a result <= reach is the distance to the whole mesh.
+double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach);
+
 }  // namespace cadclash::detail

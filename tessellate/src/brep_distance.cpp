@@ -50,6 +50,7 @@ struct SubShapes {
 
 // The running minimum with DistShapeShape's rule for near-ties (within eps: kept as a solution).
 struct Minimum {
+  double enough = 0.0;  // a distance this small ends the search
   double eps = Precision::Confusion();
   double value = 1e30;  // DistShapeShape's start when a shape has no vertex
   bool found = false;   // some solution recorded (DistShapeShape's IsDone)
@@ -63,13 +64,13 @@ struct Minimum {
       value = std::min(value, d);
     }
   }
-  bool zero() const { return found && value == 0.0; }
+  bool done() const { return found && value <= enough; }
 };
 
 void vertex_vertex(const SubShapes& a, const SubShapes& b, Minimum& m) {
-  for (int i = 1; i <= a.maps[0].Extent() && !m.zero(); ++i) {
+  for (int i = 1; i <= a.maps[0].Extent() && !m.done(); ++i) {
     const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(a.maps[0](i)));
-    for (int j = 1; j <= b.maps[0].Extent() && !m.zero(); ++j) m.offer(p.Distance(BRep_Tool::Pnt(TopoDS::Vertex(b.maps[0](j)))));
+    for (int j = 1; j <= b.maps[0].Extent() && !m.done(); ++j) m.offer(p.Distance(BRep_Tool::Pnt(TopoDS::Vertex(b.maps[0](j)))));
   }
 }
 
@@ -91,7 +92,7 @@ void level(const SubShapes& a, int ka, const SubShapes& b, int kb, Minimum& m) {
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& x, const Candidate& y) { return x.box_distance < y.box_distance; });
   for (const Candidate& c : candidates) {
-    if (c.box_distance > m.value + m.eps || m.zero()) break;
+    if (c.box_distance > m.value + m.eps || m.done()) break;
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     BRepExtrema_DistanceSS tool(a.maps[static_cast<std::size_t>(ka)](c.i + 1), b.maps[static_cast<std::size_t>(kb)](c.j + 1),
                                 ba[i], bb[j], m.value, m.eps);
@@ -101,18 +102,24 @@ void level(const SubShapes& a, int ka, const SubShapes& b, int kb, Minimum& m) {
 
 }  // namespace
 
-std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b) {
+std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b, double enough) {
   const SubShapes sa(a), sb(b);
   Minimum m;
+  m.enough = std::max(enough, 0.0);
   if (sa.maps[0].Extent() > 0 && sb.maps[0].Extent() > 0)
     m.value = BRep_Tool::Pnt(TopoDS::Vertex(sa.maps[0](1))).Distance(BRep_Tool::Pnt(TopoDS::Vertex(sb.maps[0](1))));
   vertex_vertex(sa, sb, m);
   constexpr std::array<std::array<int, 2>, 7> kLevels{{{0, 1}, {1, 0}, {0, 2}, {2, 0}, {1, 1}, {1, 2}, {2, 1}}};
-  for (const auto& [ka, kb] : kLevels) {
-    if (m.zero()) break;
+  // Looking for any two points within `enough` (a contact), edge–face comes before edge–edge: a curved
+  // edge tangent to the other face is found there in closed form for elementary curves and surfaces,
+  // while edge–edge runs OCCT's global curve–curve optimiser on every pair first. The order changes
+  // which pairs are computed before the search stops, never the minimum when it does not.
+  constexpr std::array<std::array<int, 2>, 7> kContactLevels{{{0, 1}, {1, 0}, {0, 2}, {2, 0}, {1, 2}, {2, 1}, {1, 1}}};
+  for (const auto& [ka, kb] : m.enough > 0.0 ? kContactLevels : kLevels) {
+    if (m.done()) break;
     level(sa, ka, sb, kb, m);
   }
-  if (!m.zero() && std::abs(m.value) > m.eps) level(sa, 2, sb, 2, m);
+  if (!m.done() && std::abs(m.value) > m.eps) level(sa, 2, sb, 2, m);
   if (!m.found) return std::nullopt;
   return m.value;
 }

@@ -4,15 +4,37 @@
 #include "cadclash/tessellate.h"
 
 #include <TopoDS_Face.hxx>
+#include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
+#include <TopoDS_Edge.hxx>
+
 #include <chrono>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <shared_mutex>
 #include <string>
 #include <vector>
 
+class BRepTopAdaptor_FClass2d;
+
 namespace cadclash {
+
+namespace detail {
+// What a point query needs of one face, made once per face on first use: OCCT's classifier of its
+// parameter domain (a polygon of the boundary's pcurves, points nearer than the polygon's measured
+// deviation counting as on it) and its edges with their boxes.
+struct FaceLocator {
+  // Perform() is const but not thread-safe: the classifier keeps its wires in NCollection_Sequence,
+  // whose Value() moves a cached cursor. Every call holds domain_mutex.
+  std::unique_ptr<BRepTopAdaptor_FClass2d> domain;
+  mutable std::mutex domain_mutex;
+  std::vector<std::pair<TopoDS_Edge, Aabb>> edges;  // edges with a 3D curve, each with its box
+  explicit FaceLocator(const TopoDS_Face& face);
+  ~FaceLocator();
+};
+}  // namespace detail
 
 struct BrepSource::Impl {
   std::string part_name;
@@ -27,6 +49,10 @@ struct BrepSource::Impl {
   // BRepMesh writes triangulations into the shared TShapes: meshing holds it exclusively; exact
   // distances only read the faces (OCCT's own parallel BRepExtrema does the same) and share it.
   mutable std::shared_mutex mutex;
+  // Per face, made by point_distance on first use (under locator_mutex); read-only afterwards.
+  mutable std::vector<std::unique_ptr<const detail::FaceLocator>> locators;
+  mutable std::mutex locator_mutex;
+  const detail::FaceLocator& locator(std::uint32_t local_index) const;
 };
 
 namespace detail {
@@ -63,13 +89,23 @@ Aabb face_aabb(const TopoDS_Face& face);
 
 // Minimum distance between two shapes (here: placed faces), equal bit for bit to
 // BRepExtrema_DistShapeShape(a, b, Extrema_ExtFlag_MIN).Value(), but it stops as soon as the distance
-// is 0. nullopt when OCCT finds no solution. May throw Standard_Failure. Reads the shapes only.
-std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b);
+// is at most `enough` (0: once it is 0), returning that distance. nullopt when OCCT finds no
+// solution. May throw Standard_Failure. Reads the shapes only.
+std::optional<double> min_distance(const TopoDS_Shape& a, const TopoDS_Shape& b, double enough = 0.0);
 
 // What the exact face says about itself (collide.h, Surface): its model uncertainty (the largest
 // OCCT tolerance of the face, its edges and vertices, never below Precision::Confusion), its
 // elementary surface, and whether its triangles are exactly the face (a plane bounded by lines).
 void describe_face(const TopoDS_Face& face, Surface& out);
+
+// An upper bound on the distance from `p` (the face's part frame) to the exact face, realised by a
+// point of the face: Newton from the nearest node of the face's triangulation to a foot point on the
+// surface, kept when the face's classifier (`where`) puts its parameters inside the face, farther
+// than the boundary polygon's measured deviation from it; otherwise the nearest point found on the
+// face's edge curves. The evaluation's rounding is added. nullopt when the face has no triangulation
+// with parameters or Newton fails. Reads the face only. May throw Standard_Failure.
+std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
+                                         const gp_Pnt& p);
 
 gp_Trsf to_trsf(const Pose& pose);
 Pose to_pose(const gp_Trsf& trsf);

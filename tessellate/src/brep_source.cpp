@@ -32,6 +32,13 @@ double box_distance(const Aabb& a, const Aabb& b) {
 
 }  // namespace
 
+const detail::FaceLocator& BrepSource::Impl::locator(std::uint32_t local_index) const {
+  std::lock_guard<std::mutex> lock(locator_mutex);
+  if (locators.size() != faces.size()) locators.resize(faces.size());
+  if (!locators[local_index]) locators[local_index] = std::make_unique<const detail::FaceLocator>(faces[local_index]);
+  return *locators[local_index];
+}
+
 BrepSource::BrepSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) { assert(impl_); }
 BrepSource::~BrepSource() = default;
 
@@ -76,7 +83,10 @@ std::optional<double> BrepSource::point_distance(std::uint32_t local_index, cons
   assert(local_index < a.faces.size());
   std::shared_lock<std::shared_mutex> lock(a.mutex);
   try {
-    const TopoDS_Vertex v = BRepBuilderAPI_MakeVertex(gp_Pnt(point.x(), point.y(), point.z()));
+    const gp_Pnt p(point.x(), point.y(), point.z());
+    if (auto near = detail::face_point_witness(a.faces[local_index], a.locator(local_index), a.boxes[local_index], p))
+      return near;
+    const TopoDS_Vertex v = BRepBuilderAPI_MakeVertex(p);
     BRepExtrema_DistShapeShape dist(v, a.faces[local_index], Extrema_ExtFlag_MIN);
     if (!dist.IsDone() || dist.NbSolution() == 0) return std::nullopt;
     return dist.Value();
@@ -86,8 +96,8 @@ std::optional<double> BrepSource::point_distance(std::uint32_t local_index, cons
 }
 
 std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
-                                                 std::uint32_t local_b, const Pose& pose_b,
-                                                 double max_distance) const {
+                                                 std::uint32_t local_b, const Pose& pose_b, double max_distance,
+                                                 double enough) const {
   const auto* other_brep = dynamic_cast<const BrepSource*>(&other);
   if (other_brep == nullptr) return std::nullopt;
   const Impl& a = *impl_;
@@ -107,7 +117,7 @@ std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Po
     // Moved() shares the face's geometry and only composes the location: nothing is copied.
     const TopoDS_Shape fa = a.faces[local_a].Moved(TopLoc_Location(detail::to_trsf(pose_a)));
     const TopoDS_Shape fb = b.faces[local_b].Moved(TopLoc_Location(detail::to_trsf(pose_b)));
-    return detail::min_distance(fa, fb);
+    return detail::min_distance(fa, fb, enough);
   } catch (const Standard_Failure&) {
     return std::nullopt;
   }

@@ -16,6 +16,14 @@ TessellationOptions tessellation_preset(TessellationPreset preset) {
   return o;
 }
 
+TessellationOptions apply_preset(TessellationOptions base, TessellationPreset preset) {
+  const TessellationOptions p = tessellation_preset(preset);
+  base.linear_deflection = p.linear_deflection;
+  base.angular_deflection = p.angular_deflection;
+  base.relative = false;
+  return base;
+}
+
 std::optional<TessellationPreset> parse_tessellation_preset(std::string_view name) {
   if (name == "coarse") return TessellationPreset::Coarse;
   if (name == "normal") return TessellationPreset::Normal;

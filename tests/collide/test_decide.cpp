@@ -1,11 +1,13 @@
 // The certified decision's pieces: the round-off bound against a long-double reference under large
 // rigid motions, the triangles' interval and verdict, and the analytic lower bounds.
 #include "decide.h"
+#include "surface_bvh.h"
 #include "triangle_predicates.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace cadclash {
@@ -18,6 +20,10 @@ using detail::pair_roundoff;
 using detail::PairOutcome;
 using detail::Verdict;
 using detail::verdict;
+using detail::build_surface_bvh;
+using detail::point_mesh_distance;
+using detail::SurfaceBvh;
+using detail::triangle_distance;
 
 using Mat4L = Eigen::Matrix<long double, 4, 4>;
 
@@ -205,6 +211,42 @@ TEST(AnalyticPairGap, CoaxialCylindersParallelPlanesAndTilts) {
   // Unsupported combinations give no certificate.
   EXPECT_FALSE(analytic_pair_gap(rod, ball, region));
   EXPECT_FALSE(analytic_pair_gap(shape(SurfaceShape::Torus, Vec3::Zero(), Vec3::UnitZ(), 3), p1, region));
+}
+
+// The witness step orders and filters vertices by their distance to the other face's triangles
+// through its tree: the tree must give the brute-force minimum whenever that is within the reach,
+// and +inf (never a smaller value) when no triangle comes within it.
+TEST(PointMeshDistance, EqualsBruteForceWithinTheReach) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  TriangleMesh mesh;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 c(u(rng), u(rng), 0.1 * u(rng));
+    const auto v = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {c, c + Vec3(0.7, 0.1, 0.2), c + Vec3(0.2, 0.8, -0.1)});
+    mesh.triangles.push_back({v, v + 1, v + 2});
+  }
+  const SurfaceBvh bvh = build_surface_bvh(mesh);
+  int within = 0, beyond = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Vec3 p(u(rng), u(rng), 0.5 * u(rng));
+    double brute = std::numeric_limits<double>::infinity();
+    for (const auto& t : mesh.triangles)
+      brute = std::min(brute, triangle_distance(p, p, p, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]));
+    for (double reach : {0.05, 0.5, 3.0}) {
+      const double d = point_mesh_distance(bvh, mesh, p, reach);
+      if (brute <= reach) {
+        EXPECT_EQ(d, brute) << k << ' ' << reach;
+        ++within;
+      } else {
+        EXPECT_GT(d, reach) << k << ' ' << reach;
+        ++beyond;
+      }
+    }
+  }
+  EXPECT_GT(within, 100);
+  EXPECT_GT(beyond, 100);
+  EXPECT_EQ(point_mesh_distance(SurfaceBvh{}, TriangleMesh{}, Vec3::Zero(), 1.0), std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

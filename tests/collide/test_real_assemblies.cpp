@@ -95,9 +95,6 @@ TEST_P(RealAssembly, OaabbEqualsBruteForceForAnyThreadCount) {
   CollideOptions o;
   o.mode = CollideMode::AllTrianglePairs;
   o.tolerance = 0.01;
-  o.deflection_hint = c.deflection;
-  o.tessellation_deflection = c.deflection;
-
   o.threads = 1;
   const Report fast1 = check(o);
   o.threads = 2;

@@ -7,6 +7,7 @@
 #include "cadclash/import.h"
 #include "cadclash/tessellate.h"
 
+#include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
@@ -19,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -102,6 +104,70 @@ TEST(ExactDistance, EqualsBRepExtremaDistShapeShapeBitForBit) {
   }
   EXPECT_GT(compared, 100);
   EXPECT_GT(zero, 0);  // the early exit was taken
+}
+
+// With `enough`, the search may stop at the first two points within it: touching faces give a value
+// <= enough (here the vertex or edge levels find it before the face–face level), apart faces the
+// same minimum as without it.
+TEST(ExactDistance, StopsAtTheFirstPointsWithinEnough) {
+  const Model m = build({BRepPrimAPI_MakeBox(10, 10, 10).Shape(), BRepPrimAPI_MakeCylinder(3, 8).Shape()}, 0.5);
+  const auto* box = dynamic_cast<const BrepSource*>(m.parts[0].source.get());
+  const auto* cyl = dynamic_cast<const BrepSource*>(m.parts[1].source.get());
+  ASSERT_TRUE(box && cyl);
+  int touching = 0, apart = 0;
+  for (const Pose& pose : {placed(Vec3(13, 5, 2)), placed(Vec3(10, 2, 1)), placed(Vec3(5, 5, 10)), placed(Vec3(16, 5, 2))})
+    for (std::uint32_t fa = 0; fa < box->face_count(); ++fa)
+      for (std::uint32_t fb = 0; fb < cyl->face_count(); ++fb) {
+        const auto full = box->exact_distance(fa, Pose::Identity(), *cyl, fb, pose, 1e9);
+        const auto early = box->exact_distance(fa, Pose::Identity(), *cyl, fb, pose, 1e9, 1e-3);
+        ASSERT_EQ(full.has_value(), early.has_value());
+        if (!full) continue;
+        if (*full <= 1e-3) {
+          EXPECT_LE(*early, 1e-3) << fa << ' ' << fb;
+          ++touching;
+        } else {
+          EXPECT_EQ(bits(*early), bits(*full)) << fa << ' ' << fb;
+          ++apart;
+        }
+      }
+  EXPECT_GT(touching, 0);
+  EXPECT_GT(apart, 10);
+}
+
+// point_distance answers the witness step: its value must never be below the exact distance to the
+// face (a point of the face realises it), and it should be the distance itself wherever the
+// nearest point is inside the face or on an edge. Points near as1's faces (B-spline cylinders and
+// planes bounded by circles): the triangles' vertices moved along and off the face.
+TEST(PointDistance, IsAnUpperBoundRealisedOnTheFace) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!std::ifstream(step)) GTEST_SKIP() << "run scripts/setup.sh for " << step;
+  ImportResult in = import_file(step);
+  ASSERT_TRUE(in.complete);
+  int asked = 0, tight = 0;
+  for (const Part& part : in.model.parts) {
+    const auto* src = dynamic_cast<const BrepSource*>(part.source.get());
+    ASSERT_NE(src, nullptr);
+    for (std::uint32_t f = 0; f < part.surface_count; ++f) {
+      const Surface& s = in.model.surfaces[part.first_surface + f];
+      for (std::size_t v = 0; v < s.mesh.vertices.size(); v += 3) {
+        const Vec3 base = s.mesh.vertices[v];
+        for (const Vec3& offset : {Vec3(0, 0, 0), Vec3(0.3, -0.2, 0.1), Vec3(-1.5, 0.4, 0.9)}) {
+          const Vec3 p = base + offset;
+          const auto ours = src->point_distance(f, p);
+          BRepExtrema_DistShapeShape occt(BRepBuilderAPI_MakeVertex(gp_Pnt(p.x(), p.y(), p.z())).Vertex(),
+                                          src->face(f), Extrema_ExtFlag_MIN);
+          ASSERT_TRUE(occt.IsDone());
+          ASSERT_TRUE(ours.has_value()) << part.name << " face " << f;
+          EXPECT_GE(*ours, occt.Value() - 1e-9) << part.name << " face " << f << " point " << p.transpose();
+          ++asked;
+          tight += *ours <= occt.Value() + 1e-9;
+        }
+      }
+    }
+  }
+  std::printf("[ witness  ] %d of %d point queries equal to OCCT's point-face distance (within 1e-9 mm)\n", tight, asked);
+  EXPECT_GT(asked, 500);
+  EXPECT_GE(tight, asked * 9 / 10) << tight << " of " << asked;
 }
 
 // A row of boxes touching face to face, cylinders standing on them, a sphere resting on one: many

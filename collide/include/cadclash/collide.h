@@ -165,24 +165,32 @@ class SurfaceSource {
   virtual bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                            double& achieved_deflection, Diagnostic& error) = 0;
 
-  // Exact distance between this part's surface `local_a` placed by `pose_a` and `other`'s surface
-  // `local_b` placed by `pose_b`, searching only up to `max_distance` (a value > max_distance means
-  // "farther than that"). Returns nullopt when either side has no exact geometry.
-  // Called from several threads at once (exact verification runs pairs in parallel), also for the
-  // same parts: must be thread-safe.
-  // Exact distance from `point` (this part's local frame) to surface `local_index`'s exact face, its
-  // boundary included; nullopt when there is no exact geometry. Thread-safe like exact_distance.
-  // The certified decision asks it about mesh vertices: a vertex of one face within T of the other
-  // face proves the two in contact, at a fraction of a face–face distance's cost.
+  // The deflection the part was loaded with (absolute, mm): what triangulate() meshes at when given
+  // deflection <= 0, so what a query assumes for a lazy surface not tessellated yet. 0 when unknown.
+  virtual double default_deflection() const { return 0.0; }
+
+  // An upper bound on the distance from `point` (this part's local frame) to surface `local_index`'s
+  // exact face, realised by a point of that face (its distance to `point`, rounding included): the
+  // exact distance is the tightest such bound. nullopt when there is no exact geometry or no point
+  // was found. Thread-safe like exact_distance. The certified decision asks it about mesh vertices:
+  // a vertex of one face within T of the other face proves the two in contact, at a fraction of a
+  // face–face distance's cost.
   virtual std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const {
     (void)local_index, (void)point;
     return std::nullopt;
   }
 
+  // Exact distance between this part's surface `local_a` placed by `pose_a` and `other`'s surface
+  // `local_b` placed by `pose_b`, searching only up to `max_distance` (a value > max_distance means
+  // "farther than that"). With `enough` > 0 the search may stop at the first two points of the faces
+  // within `enough` of each other: the value is then their distance, an upper bound <= enough (the
+  // certified decision needs no more to prove contact). Returns nullopt when either side has no
+  // exact geometry. Called from several threads at once, also for the same parts: thread-safe.
   virtual std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a,
                                                const SurfaceSource& other, std::uint32_t local_b,
-                                               const Pose& pose_b, double max_distance) const {
-    (void)local_a, (void)pose_a, (void)other, (void)local_b, (void)pose_b, (void)max_distance;
+                                               const Pose& pose_b, double max_distance,
+                                               double enough = 0.0) const {
+    (void)local_a, (void)pose_a, (void)other, (void)local_b, (void)pose_b, (void)max_distance, (void)enough;
     return std::nullopt;
   }
 };
@@ -262,13 +270,19 @@ std::size_t triangle_count(const Model& model);
 // exact faces cross); a contact whose crossing depth is only within the bands is touching.
 // Ambiguous pairs are refined, cheapest first, until decided:
 //   analytic  the other face's triangles lie provably off a plane, cylinder or sphere (Surface::analytic)
-//             by more than T + its deflection: a lower bound on d* (proves "apart" only);
-//   witness   a vertex of one face's triangles (a point of that exact face, within its ε) whose exact
-//             distance to the other face (SurfaceSource::point_distance) is within tolerance + ε of
-//             that face: contact proved (decided_by Exact: it is measured on the exact face);
+//             by more than T + its deflection: a lower bound on d* (proves "apart"); or a vertex of
+//             one face whose foot point on the other's plane, cylinder or sphere is provably inside
+//             that face, within T (proves contact);
+//   witness   a vertex of one face's triangles (a point of that exact face, within its ε) near the
+//             other face's triangles, whose distance to the other exact face is within tolerance + ε
+//             of that face: SurfaceSource::point_distance gives an upper bound realised by a point of
+//             that face (B-rep: a Newton foot point inside the face, or a point of its edges), so
+//             contact is proved (decided_by Exact: measured on the exact face); nearest vertices
+//             first, at most 8 per pair;
 //   refined   both faces re-tessellated at a tenth of their deflection by their SurfaceSource (cached
 //             in the Scene) and the interval taken again;
-//   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces), interval [d*, d*].
+//   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
+//             the first two points within T), interval [d*, d*].
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
 // class Undecided and its interval, never as touching. Clearance (T < d* <= clearance) is judged on
 // the mesh distance (or d* when it was computed). Results do not depend on the thread count.
@@ -321,7 +335,6 @@ enum class TriangleLevel : std::uint8_t {
 struct CollideOptions {
   double tolerance = 0.0;         // contact tolerance t, mm (>= 0)
   double clearance = 0.0;         // report non-touching pairs closer than this, mm (0 = never)
-  double deflection_hint = 0.0;   // deflection assumed for surfaces not yet tessellated (lazy), mm
   CollideMode mode = CollideMode::EarlyExit;
   int threads = 0;                // <= 0: OpenMP's default
   ParallelVersion version = ParallelVersion::V1;
@@ -331,7 +344,6 @@ struct CollideOptions {
   std::size_t flat_limit = 4096;  // Auto switches to the BVH above this many candidate pairs
   bool detect_containment = true;
   DecisionMode decision = DecisionMode::Certified;  // see "Certified decisions"
-  double tessellation_deflection = 0.0;  // passed to require_triangles (<= 0: each source's default)
   // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
   // results of the instance pairs it finished, with Report::complete false (see Report).
   // - time_budget_seconds: wall clock from the start of check(). Checked cooperatively between work
@@ -397,7 +409,9 @@ struct SurfacePairResult {
   // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].
   double distance_lo = 0.0, distance_hi = 0.0;
   // SurfaceSource::exact_distance when the decision asked for it (exact step; DecisionMode::Exact asks
-  // for every pair with exact geometry); a value > max(T, clearance) means "farther than that".
+  // for every pair with exact geometry); a value > max(T, clearance) means "farther than that". In
+  // the certified mode the search stops at the first two points within T: a value <= T there is an
+  // upper bound (contact either way), not necessarily the minimum.
   std::optional<double> exact_distance;
   // AllTrianglePairs only: intersecting (triangle index in Sk, triangle index in Sl), sorted.
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;

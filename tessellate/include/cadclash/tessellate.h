@@ -57,6 +57,10 @@ enum class TessellationPreset : std::uint8_t { Coarse, Normal, Fine, VeryFine };
 // Returns the options of a preset (parallel and verify_deflection keep their defaults).
 TessellationOptions tessellation_preset(TessellationPreset preset);
 
+// `base` with the preset's absolute linear and angular deflections (the rest of `base` kept): what
+// choosing a preset means wherever it is chosen (the CLI's --preset, Python's load(preset=)).
+TessellationOptions apply_preset(TessellationOptions base, TessellationPreset preset);
+
 // Parses "coarse", "normal", "fine", "very-fine" (also "very_fine", "veryfine"); nullopt otherwise.
 std::optional<TessellationPreset> parse_tessellation_preset(std::string_view name);
 
@@ -98,7 +102,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
 // The SurfaceSource of a B-rep part. Thread-safe: each part has a shared mutex; triangulate() calls
 // on one part serialise, exact_distance() calls only read the faces and run concurrently.
 // exact_distance is BRepExtrema_DistShapeShape's value on the two placed faces, bit for bit (the
-// same sub-shape search, stopping once the distance is 0).
+// same sub-shape search, stopping once the distance is 0, or within `enough` when one is given).
 class BrepSource final : public SurfaceSource {
  public:
   struct Impl;
@@ -112,7 +116,7 @@ class BrepSource final : public SurfaceSource {
   // Precondition: local_index < face_count(). Do not mesh it while other threads use this part.
   const TopoDS_Face& face(std::uint32_t local_index) const;
   // The deflection used when triangulate() is given deflection <= 0 (absolute, millimetres).
-  double default_deflection() const;
+  double default_deflection() const override;
 
   // Meshes the face with BRepMesh_IncrementalMesh when it has no triangulation or a coarser one than
   // `deflection`; otherwise reads the existing one. A deflection finer than default_deflection() is a
@@ -122,15 +126,19 @@ class BrepSource final : public SurfaceSource {
   bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                    double& achieved_deflection, Diagnostic& error) override;
 
-  // BRepExtrema_DistShapeShape between a vertex at `point` (part-local) and the face.
+  // An upper bound on the distance from `point` (part-local) to the face, realised by a point of the
+  // face: the foot point of a Newton projection started at the nearest node of the face's triangles,
+  // when the face classifier puts it inside the face (microseconds); else BRepExtrema_DistShapeShape
+  // between a vertex at `point` and the face.
   std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const override;
 
   // BRepExtrema_DistShapeShape on the two placed faces; `other` must be a BrepSource, else nullopt.
   // When the faces' boxes are farther apart than max_distance, returns that box distance (a lower
-  // bound > max_distance) without running the exact search.
+  // bound > max_distance) without running the exact search. With `enough` > 0 the sub-shape search
+  // stops at the first distance <= enough (vertex and edge levels come before the face–face one).
   std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
-                                       std::uint32_t local_b, const Pose& pose_b,
-                                       double max_distance) const override;
+                                       std::uint32_t local_b, const Pose& pose_b, double max_distance,
+                                       double enough = 0.0) const override;
 
  private:
   std::unique_ptr<Impl> impl_;

@@ -1,0 +1,340 @@
+// The steps of the certified decision (decide_steps.h): cheapest evidence first; each proves a
+// bound on the exact faces' distance, and only what it leaves open goes to the next.
+#include "decide_steps.h"
+
+#include "box_util.h"
+#include "triangle_predicates.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cadclash::detail {
+namespace {
+
+// A box enclosing the exact face: Surface::aabb does for B-rep faces, but for a mesh it encloses the
+// triangles, which may lie up to the deflection inside the surface they stand for.
+Aabb own_box(const Surface& s) { return pad_box(s.aabb.isEmpty() ? mesh_aabb(s.mesh) : s.aabb, s.deflection); }
+
+// The class of a pair proved apart: clearance when its distance (the exact one when known, else the
+// mesh's) is within the clearance, else not reported.
+std::optional<ContactClass> apart_class(double distance, double clearance) {
+  if (clearance > 0.0 && distance <= clearance) return ContactClass::Clearance;
+  return std::nullopt;
+}
+
+}  // namespace
+
+void settle(Pending& p, Verdict v, DecidedBy by, const PairOutcome* o, double clearance) {
+  if (v == Verdict::Ambiguous) return;
+  p.settled = true;
+  p.by = by;
+  if (v == Verdict::Contact) {
+    p.cls = o != nullptr && certainly_penetrating(*o, p.threshold, p.mesh_band) ? ContactClass::Penetrating
+                                                                                : ContactClass::Touching;
+  } else {
+    p.cls = apart_class(p.exact ? *p.exact : o != nullptr ? o->distance : p.d.lo, clearance);
+    p.dropped = !p.cls;
+  }
+}
+
+Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask& t, const CollideOptions& o) {
+  const Surface& a = m.surfaces[t.sa];
+  const Surface& b = m.surfaces[t.sb];
+  Pending p;
+  p.threshold = touch_threshold(eps[t.sa], eps[t.sb], o.tolerance);
+  p.band = p.mesh_band = a.deflection + b.deflection + t.roundoff;
+  const double reach = p.threshold + p.band;
+  if (t.outcome == nullptr) {  // no triangles on one side: only the boxes are known
+    p.d = {box_distance(own_box(a), transform_box(own_box(b), t.t_ab)), std::numeric_limits<double>::infinity()};
+    return p;
+  }
+  p.d = mesh_interval(*t.outcome, p.band, reach);
+  const DecidedBy by =
+      triangles_are_exact(m, t.sa) && triangles_are_exact(m, t.sb) ? DecidedBy::MeshExact : DecidedBy::Mesh;
+  const Verdict v = verdict(p.d, p.threshold);
+  if (o.decision == DecisionMode::Exact && !(v == Verdict::Apart && p.d.lo > std::max(p.threshold, o.clearance)))
+    return p;  // the exact step decides (faces without exact geometry fall back to this verdict there)
+  settle(p, v, by, t.outcome, o.clearance);
+  return p;
+}
+
+// Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
+void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
+  const Surface& a = m.surfaces[t.sa];
+  const Surface& b = m.surfaces[t.sb];
+  const double r = t.roundoff;
+  double lb = 0.0;
+  // The two surfaces' parameters: where the faces can come within T of each other, both lie in A's
+  // face box and in B's grown by T.
+  const Aabb box_b = transform_box(own_box(b), t.t_ab);
+  const Aabb region = own_box(a).intersection(pad_box(box_b, p.threshold));
+  if (region.isEmpty()) {
+    lb = box_distance(own_box(a), box_b);  // the boxes enclose the exact faces
+  } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab), region)) {
+    lb = std::max(lb, *g - eps[t.sa] - eps[t.sb] - r);
+  }
+  if (b.has_triangles) {
+    const double reach = p.threshold + b.deflection + r;
+    if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab, own_box(a), reach))
+      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps[t.sa]);
+  }
+  if (a.has_triangles) {
+    const double reach = p.threshold + a.deflection + r;
+    if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba, own_box(b), reach))
+      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps[t.sb]);
+  }
+  if (!(lb > p.threshold)) return;
+  p.d.lo = std::max(p.d.lo, lb);
+  settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);
+}
+
+// A vertex's foot point on the other face's plane, cylinder or sphere proves contact when it lies
+// inside that face: the witness is checked against B's triangles through their tree.
+void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+                      const CollideOptions& o) {
+  const Surface& a = fa.surface;
+  const Surface& b = fb.surface;
+  if (!a.has_triangles || !b.has_triangles) return;
+  const double r = t.roundoff;
+  const Aabb box_a = own_box(a), box_b = own_box(b);
+  // A's vertices on B's surface, in B's frame; then B's on A's, in A's frame.
+  const Aabb region_b = box_b.intersection(pad_box(transform_box(box_a, t.t_ba), p.threshold));
+  std::optional<double> g = analytic_witness(b.analytic, b.mesh, fb.bvh, *fb.outline, b.deflection, a.mesh, t.t_ba,
+                                             region_b, o.tolerance + eps[t.sb] - r, r);
+  double own = eps[t.sa];
+  if (!g) {
+    const Aabb region_a = box_a.intersection(pad_box(transform_box(box_b, t.t_ab), p.threshold));
+    g = analytic_witness(a.analytic, a.mesh, fa.bvh, *fa.outline, a.deflection, b.mesh, t.t_ab, region_a,
+                         o.tolerance + eps[t.sa] - r, r);
+    own = eps[t.sb];
+  }
+  if (!g || !(own + *g + r <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, own + *g + r);
+  settle(p, Verdict::Contact, DecidedBy::Analytic, t.outcome, o.clearance);
+}
+
+namespace {
+
+// A vertex that could be a witness: its distance to the other face's triangles orders the trials.
+struct Candidate {
+  double near;  // distance to the other face's triangles (A's frame)
+  bool of_a;    // a vertex of A, asked of B's face
+  Vec3 point;   // in the part frame of the face it is asked of
+};
+
+// The vertices of `from` (mapped into the other face's frame by `to_other`, inside `region` there)
+// within `limit` of the other face's triangles, found through its tree: a vertex farther from them
+// is farther than `limit` minus the other face's deflection from its exact face, no witness.
+void near_vertices(const Surface& from, const Pose& to_other, FaceView other, const Aabb& region, double limit,
+                   bool of_a, std::vector<Candidate>& out) {
+  for (const Vec3& v : from.mesh.vertices) {
+    const Vec3 w = to_other * v;
+    if (!region.contains(w)) continue;
+    const double d = point_mesh_distance(other.bvh, other.surface.mesh, w, limit);
+    if (d <= limit) out.push_back({d, of_a, w});
+  }
+}
+
+// At most this many exact point queries per pair and level: nearest first, the rest seldom help.
+constexpr std::size_t kMaxWitnessTrials = 8;
+
+// True when `p` is farther than `margin` from every segment of `outline` (plain doubles: it only
+// orders the trials, and proves nothing).
+bool clear_of(const std::vector<std::array<Vec3, 2>>& outline, const Vec3& p, double margin) {
+  const double m2 = margin * margin;
+  for (const auto& [a, b] : outline) {
+    const Vec3 ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double s = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    if ((a + s * ab - p).squaredNorm() <= m2) return false;
+  }
+  return true;
+}
+
+// Trial order: nearest first, but among the nearest a vertex whose foot lies well inside the other
+// face's outline first. A foot near the outline is the exact face classifier's slow case, and the
+// contact there is often along the edge, where the edge's own curve answers anyway.
+void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
+  const std::size_t keep = std::min<std::size_t>(cs.size(), 4 * kMaxWitnessTrials);
+  auto nearer = [](const Candidate& x, const Candidate& y) { return x.near < y.near; };
+  std::partial_sort(cs.begin(), cs.begin() + static_cast<std::ptrdiff_t>(keep), cs.end(), nearer);
+  cs.resize(keep);
+  auto inside = [&](const Candidate& c) {
+    const FaceView& other = c.of_a ? b : a;
+    return other.outline != nullptr && clear_of(*other.outline, c.point, 2.0 * other.surface.deflection + c.near);
+  };
+  std::stable_partition(cs.begin(), cs.end(), inside);
+  if (cs.size() > kMaxWitnessTrials) cs.resize(kMaxWitnessTrials);
+}
+
+}  // namespace
+
+// A vertex of a face lies on its own exact face (within that face's ε: the mesher puts nodes on the
+// surface and its edges); when its exact distance to the other face is within tolerance + that
+// face's ε (after the mapping's round-off), the faces are within T. Candidates are the vertices of
+// either face near the other's triangles, nearest first; one success settles it.
+void witness_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                  const PairOutcome* out, double band, Pending& p, const CollideOptions& o, CollideCounters& c) {
+  if (out == nullptr) return;
+  const Surface& a = fa.surface;
+  const Surface& b = fb.surface;
+  const Part& pa = m.parts[a.part];
+  const Part& pb = m.parts[b.part];
+  if (!pa.source || !pb.source || !a.has_triangles || !b.has_triangles) return;
+  // A vertex farther than this from the other face's triangles is beyond reach of its exact face.
+  const double limit_a = o.tolerance + eps[t.sb] + band;  // A's vertices, asked of B
+  const double limit_b = o.tolerance + eps[t.sa] + band;
+  std::vector<Candidate> cs;
+  near_vertices(a, t.t_ba, fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
+  near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
+  order_trials(cs, fa, fb);
+  for (const Candidate& cand : cs) {
+    ++c.witness_queries;
+    const std::optional<double> d = cand.of_a ? pb.source->point_distance(t.sb - pb.first_surface, cand.point)
+                                              : pa.source->point_distance(t.sa - pa.first_surface, cand.point);
+    if (!d) continue;
+    const double hi = (cand.of_a ? eps[t.sa] : eps[t.sb]) + *d + t.roundoff;
+    if (hi <= p.threshold) {
+      p.d.hi = std::min(p.d.hi, hi);
+      settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+      return;
+    }
+  }
+}
+
+// Step 4: the same interval on finer triangles of both faces.
+void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p,
+                  const CollideOptions& o, CollideCounters& c) {
+  const RefinedSurface& ra = cache[t.sa];
+  const RefinedSurface& rb = cache[t.sb];
+  if (!ra.ok || !rb.ok) return;
+  const double band = ra.surface.deflection + rb.surface.deflection + t.roundoff;
+  const double reach = p.threshold + band;
+  p.fine = pair_outcome(ra.surface, ra.bvh, rb.surface, rb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  const PairOutcome& out = *p.fine;
+  const Interval d = mesh_interval(out, band, reach);
+  p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
+  p.band = band;
+  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;  // cannot happen for sound bounds; keep the interval ordered
+  settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &out, o.clearance);
+  // A contact proved on finer triangles is penetrating only when they prove it.
+  if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(out, p.threshold, band))
+    p.cls = ContactClass::Penetrating;
+}
+
+// The exact faces' distance by BRepExtrema (SurfaceSource::exact_distance). Its value is the
+// distance of two points it found on the faces: an upper bound on d*, and OCCT 7.6 can miss the
+// minimum of two B-spline faces (tests/collide/test_certified_truth.cpp has such a pair). So a value
+// <= T proves contact; a larger one only lowers the interval's top, and "apart" needs a lower bound
+// from finer triangles (corroborate). Returns false when the faces have no exact geometry.
+bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, Pending& p,
+                const CollideOptions& o, CollideCounters& c) {
+  const Surface& a = m.surfaces[t.sa];
+  const Surface& b = m.surfaces[t.sb];
+  const Part& pa = m.parts[a.part];
+  const Part& pb = m.parts[b.part];
+  if (!pa.source || !pb.source) return false;
+  ++c.exact_queries;
+  const double search = std::max(p.threshold, o.clearance);
+  // Certified: any two points within T prove contact, so the search may stop there (vertex and edge
+  // levels before the face–face one). Exact mode measures the minimum.
+  const double enough = o.decision == DecisionMode::Certified ? p.threshold : 0.0;
+  const std::optional<double> d = pa.source->exact_distance(t.sa - pa.first_surface, poses[t.ia], *pb.source,
+                                                            t.sb - pb.first_surface, poses[t.ib], search, enough);
+  if (!d) return false;
+  p.exact = *d;
+  // p.band stays the triangles' band: the exact distance says nothing about how deep faces cross,
+  // so penetration is still judged on the triangles' crossing depth beyond T + band.
+  if (*d <= p.threshold) {
+    p.d.hi = std::min(p.d.hi, *d);
+    p.d.lo = std::min(p.d.lo, p.d.hi);
+    settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+  } else {
+    if (*d <= search) p.d.hi = std::max(p.d.lo, std::min(p.d.hi, *d));
+    // Apart needs a lower bound: one already known (the boxes of a face without triangles, say) or
+    // the finer triangles' (corroborate).
+    if (p.d.lo > p.threshold) settle(p, Verdict::Apart, DecidedBy::Exact, t.outcome, o.clearance);
+    else p.needs_lower = true;
+  }
+  return true;
+}
+
+// Corroborates an exact value above T: the finer triangles' lower bound proves the pair apart, their
+// upper bound or a witness on them proves it in contact (BRepExtrema missed), else it stays open.
+void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t,
+                 const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o, CollideCounters& c) {
+  // The surfaces' parameters first (exact mode has not asked them yet): a lower bound for free.
+  if (t.outcome != nullptr) analytic(m, eps, t, p, o);
+  if (!p.settled && !p.fine) refined_step(t, cache, p, o, c);
+  // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
+  // its corroboration; it is reported as decided by the exact faces.
+  if (p.settled && p.exact) p.by = DecidedBy::Exact;
+  if (p.settled || !p.fine) return;
+  const RefinedSurface& ra = cache[t.sa];
+  const RefinedSurface& rb = cache[t.sb];
+  witness_step(m, eps, t, {ra.surface, ra.bvh}, {rb.surface, rb.bvh}, &*p.fine, p.band, p, o, c);
+  if (p.settled || !p.exact) return;
+  // Deeper, for this pair alone: a band below half the exact value's margin over T proves it apart
+  // if OCCT's value is right (and shows the contact if OCCT missed it). Not below a hundredth of the
+  // model's deflection: the triangles grow with the inverse deflection, and past that a pair would
+  // cost seconds; such knife-edge pairs are reported undecided with their interval.
+  const double margin = *p.exact - p.threshold - t.roundoff;
+  const double target = 0.25 * margin;
+  const double floor = 1e-2 * std::max(m.surfaces[t.sa].deflection, m.surfaces[t.sb].deflection);
+  if (!(target > floor) || !(target < std::max(ra.surface.deflection, rb.surface.deflection))) return;
+  const RefinedSurface fa = refine_to(m, t.sa, target), fb = refine_to(m, t.sb, target);
+  if (!fa.ok || !fb.ok) return;
+  const double band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
+  const double reach = p.threshold + band;
+  const PairOutcome out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  const Interval d = mesh_interval(out, band, reach);
+  p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
+  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;
+  settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
+  if (!p.settled) witness_step(m, eps, t, {fa.surface, fa.bvh}, {fb.surface, fb.bvh}, &out, band, p, o, c);
+}
+
+void count(CollideCounters& c, DecidedBy by) {
+  switch (by) {
+    case DecidedBy::Mesh: ++c.decided_mesh; break;
+    case DecidedBy::MeshExact: ++c.decided_mesh_exact; break;
+    case DecidedBy::Analytic: ++c.decided_analytic; break;
+    case DecidedBy::Refined: ++c.decided_refined; break;
+    case DecidedBy::Exact: ++c.decided_exact; break;
+    case DecidedBy::Undecided: ++c.undecided; break;
+  }
+}
+
+SurfacePairResult make_result(const DecideTask& t, const PairOutcome* out, ContactClass cls) {
+  SurfacePairResult r;
+  r.instance_a = t.ia;
+  r.instance_b = t.ib;
+  r.surface_a = t.sa;
+  r.surface_b = t.sb;
+  r.contact = cls;
+  if (out != nullptr) {
+    r.intersecting = out->intersecting;
+    r.distance = out->intersecting ? 0.0 : out->distance;
+    r.penetration = out->penetration;
+    r.triangle_pairs = out->triangle_pairs;
+  } else {
+    r.distance = std::numeric_limits<double>::infinity();
+  }
+  return r;
+}
+
+// Fast mode: the band of the triangles alone, as before certification.
+std::optional<SurfacePairResult> fast(const Model& m, const DecideTask& t, const CollideOptions& o) {
+  if (t.outcome == nullptr) return std::nullopt;
+  const double band = m.surfaces[t.sa].deflection + m.surfaces[t.sb].deflection;
+  const double tau = o.tolerance + band;
+  const auto cls = classify(*t.outcome, tau, o.clearance);
+  if (!cls) return std::nullopt;
+  SurfacePairResult r = make_result(t, t.outcome, *cls);
+  const Interval d = mesh_interval(*t.outcome, band, tau);
+  r.distance_lo = d.lo;
+  r.distance_hi = d.hi;
+  return r;
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,123 @@
+// A point of an exact face near a given point, found in microseconds: the certified decision needs
+// an upper bound on a vertex's distance to a face (any point of the face realises one), not the
+// minimum that BRepExtrema_DistShapeShape searches for in about half a millisecond.
+#include "brep_internal.h"
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepBndLib.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepTopAdaptor_FClass2d.hxx>
+#include <Bnd_Box.hxx>
+#include <BRep_Tool.hxx>
+#include <Extrema_GenLocateExtPS.hxx>
+#include <Poly_Triangulation.hxx>
+#include <ShapeAnalysis_Curve.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopLoc_Location.hxx>
+#include <TopoDS.hxx>
+#include <gp_Pnt2d.hxx>
+#include <gp_Vec.hxx>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <vector>
+
+namespace cadclash::detail {
+namespace {
+
+// Rounding of a surface or curve evaluation and of |p - q|, relative to the magnitudes involved:
+// de Boor / Horner evaluation of a (rational) B-spline of degree <= 25 is a chain of at most ~60
+// convex combinations and one division, each rounding by at most 2^-53 of the largest control point
+// it combines, which the face's box (built from the control polygon for B-splines) bounds.
+// 2^-40 covers 8,000 such roundings.
+constexpr double kEvaluationRounding = 0x1p-40;
+
+// The parameters of the face's triangulation node nearest to `p`: a node lies on the surface, so
+// Newton started there reaches the foot point of any point within a triangle's size of the face.
+std::optional<gp_Pnt2d> nearest_node_parameters(const TopoDS_Face& face, const gp_Pnt& p) {
+  TopLoc_Location loc;
+  const Handle(Poly_Triangulation)& tri = BRep_Tool::Triangulation(face, loc);
+  if (tri.IsNull() || !tri->HasUVNodes() || tri->NbNodes() == 0) return std::nullopt;
+  const bool moved = !loc.IsIdentity();
+  const gp_Trsf& trsf = loc.Transformation();
+  int nearest = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 1; i <= tri->NbNodes(); ++i) {
+    gp_Pnt n = tri->Node(i);
+    if (moved) n.Transform(trsf);
+    const double d = n.SquareDistance(p);
+    if (d < best) best = d, nearest = i;
+  }
+  return tri->UVNode(nearest);
+}
+
+// The nearest point to `p` on the face's edges that ShapeAnalysis_Curve's projection finds (each a
+// point of the edge's 3D curve within its range, and the edges bound the face). For a foot point
+// on or past the boundary: there the face's nearest points are on an edge. Edges are projected
+// nearest box first; one whose box is farther than the best point so far cannot give a nearer one.
+std::optional<double> edge_witness(const FaceLocator& where, const gp_Pnt& p, double magnitude) {
+  std::vector<std::pair<double, std::size_t>> order;
+  for (std::size_t i = 0; i < where.edges.size(); ++i)
+    order.emplace_back(where.edges[i].second.exteriorDistance(Vec3(p.X(), p.Y(), p.Z())), i);
+  std::sort(order.begin(), order.end());
+  std::optional<double> best;
+  const ShapeAnalysis_Curve projector;
+  for (const auto& [box_distance, i] : order) {
+    if (best && box_distance > *best) break;
+    const BRepAdaptor_Curve curve(where.edges[i].first);
+    gp_Pnt projected;
+    double t = 0.0;
+    projector.Project(curve, p, Precision::Confusion(), projected, t);
+    if (!(t >= curve.FirstParameter() && t <= curve.LastParameter())) continue;
+    const double d = p.Distance(curve.Value(t)) + kEvaluationRounding * magnitude;
+    if (!best || d < *best) best = d;
+  }
+  return best;
+}
+
+}  // namespace
+
+FaceLocator::FaceLocator(const TopoDS_Face& face)
+    : domain(std::make_unique<BRepTopAdaptor_FClass2d>(face, Precision::PConfusion())) {
+  for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) {
+    const TopoDS_Edge& edge = TopoDS::Edge(e.Current());
+    if (BRep_Tool::Degenerated(edge) || !BRep_Tool::IsGeometric(edge)) continue;
+    Bnd_Box box;
+    BRepBndLib::Add(edge, box, Standard_False);
+    if (box.IsVoid()) continue;
+    double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
+    box.Get(x0, y0, z0, x1, y1, z1);
+    edges.emplace_back(edge, Aabb(Vec3(x0, y0, z0), Vec3(x1, y1, z1)));
+  }
+}
+
+FaceLocator::~FaceLocator() = default;
+
+std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
+                                         const gp_Pnt& p) {
+  const std::optional<gp_Pnt2d> start = nearest_node_parameters(face, p);
+  if (!start) return std::nullopt;
+  const BRepAdaptor_Surface surface(face, Standard_False);
+  Extrema_GenLocateExtPS foot(surface);
+  foot.Perform(p, start->X(), start->Y());
+  if (!foot.IsDone()) return std::nullopt;
+  double u = 0.0, v = 0.0;
+  foot.Point().Parameter(u, v);
+  // Every evaluated point and the control points stay within the face box's reach of the origin.
+  const double magnitude =
+      gp_Vec(p.XYZ()).Magnitude() +
+      (face_box.isEmpty() ? 0.0 : face_box.min().cwiseAbs().cwiseMax(face_box.max().cwiseAbs()).norm());
+  // Parameters the classifier puts inside name a point of the face. A foot on or past the boundary
+  // means the face's nearest points are on its edges.
+  TopAbs_State state = TopAbs_UNKNOWN;
+  {
+    std::lock_guard<std::mutex> lock(where.domain_mutex);
+    state = where.domain->Perform(gp_Pnt2d(u, v));
+  }
+  if (state != TopAbs_IN) return edge_witness(where, p, magnitude);
+  return p.Distance(surface.Value(u, v)) + kEvaluationRounding * magnitude;
+}
+
+}  // namespace cadclash::detail
