@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <cassert>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -34,19 +35,20 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_flag("--planar", in.planar, "With --segment: also split patches into planar regions");
 }
 
+TessellationOptions effective_tessellation(const InputOptions& in) {
+  TessellationOptions t;
+  t.linear_deflection = in.deflection;
+  t.relative = in.relative;
+  t.angular_deflection = in.angular;
+  if (in.preset.empty()) return t;
+  const auto preset = parse_tessellation_preset(in.preset);
+  assert(preset && "--preset is checked against the preset names by CLI11");
+  return apply_preset(t, *preset);
+}
+
 ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report, SegmentReport* segment_report) {
   ImportOptions options;
-  options.tessellation.linear_deflection = in.deflection;
-  options.tessellation.relative = in.relative;
-  options.tessellation.angular_deflection = in.angular;
-  if (!in.preset.empty()) {
-    if (const auto preset = parse_tessellation_preset(in.preset)) {
-      const TessellationOptions p = tessellation_preset(*preset);
-      options.tessellation.linear_deflection = p.linear_deflection;
-      options.tessellation.angular_deflection = p.angular_deflection;
-      options.tessellation.relative = false;
-    }
-  }
+  options.tessellation = effective_tessellation(in);
   options.lazy = in.lazy;
   options.isolate_cad_readers = !in.no_isolation;
   options.reader_time_limit_seconds = in.import_time_limit;

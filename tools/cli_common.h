@@ -37,6 +37,11 @@ struct InputOptions {
 // Adds FILE... and the tessellation switches to `cmd`, bound to `in`.
 void add_input_options(CLI::App& cmd, InputOptions& in);
 
+// The tessellation the switches ask for: --deflection, --relative and --angular, or the preset's
+// values when --preset is given (it overrides them). The one place a preset is resolved: the import
+// and the report's settings both read this.
+TessellationOptions effective_tessellation(const InputOptions& in);
+
 // Imports the files, printing every diagnostic to stderr, then repairs and segments the mesh parts
 // when asked (printing what changed to stderr). Returns the result; `repair_report` / `segment_report`,
 // when given, receive what repair and segmentation did (left empty without --repair / --segment).

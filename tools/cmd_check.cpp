@@ -80,10 +80,6 @@ CollideOptions collide_options(const CheckOptions& o) {
   c.time_budget_seconds = o.time_budget;
   c.memory_budget_bytes = static_cast<std::size_t>(o.memory_budget_mb * 1024.0 * 1024.0);
   if (o.memory_budget_mb > 0.0 && c.memory_budget_bytes == 0) c.memory_budget_bytes = 1;  // a budget, however small
-  if (!o.in.relative) {
-    c.deflection_hint = o.in.deflection;
-    c.tessellation_deflection = o.in.deflection;
-  }
   return c;
 }
 
@@ -298,11 +294,13 @@ int run_check(const CheckOptions& o) {
   j["schema"] = "cadclash-check-report";
   j["version"] = kReportVersion;
   j["files"] = o.in.files;
+  const TessellationOptions tess = effective_tessellation(o.in);
   j["settings"] = {{"tolerance", o.tolerance},
                    {"clearance", o.clearance},
-                   {"deflection", o.in.deflection},
-                   {"relative_deflection", o.in.relative},
-                   {"angular_deflection", o.in.angular},
+                   {"preset", o.in.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.in.preset)},
+                   {"deflection", tess.linear_deflection},
+                   {"relative_deflection", tess.relative},
+                   {"angular_deflection", tess.angular_deflection},
                    {"lazy", o.in.lazy},
                    {"mode", o.all_triangles ? "all-triangle-pairs" : "early-exit"},
                    {"parallel", o.parallel},
@@ -398,7 +396,7 @@ int run_check(const CheckOptions& o) {
       return kExitInputError;
     }
   }
-  if (!o.html.empty() && !save_html_report(o.html, m, scene, shown, j, copt.tessellation_deflection))
+  if (!o.html.empty() && !save_html_report(o.html, m, scene, shown, j))
     return kExitInputError;
   if (input_error) return kExitInputError;
   if (o.fail_on_collision && collision) return kExitCollision;  // a definite finding, partial report or not

@@ -211,11 +211,11 @@ bool write_html_report(std::ostream& os, const Model& model, std::span<const Pos
 }
 
 bool save_html_report(const std::string& path, Model& model, const Scene& scene, const Report& report,
-                      const nlohmann::json& meta, double deflection) {
+                      const nlohmann::json& meta) {
   std::vector<SurfaceId> missing;
   for (SurfaceId s = 0; s < model.surfaces.size(); ++s)
     if (!model.surfaces[s].has_triangles) missing.push_back(s);
-  if (!missing.empty()) print_diagnostics(require_triangles(model, missing, deflection));
+  if (!missing.empty()) print_diagnostics(require_triangles(model, missing, 0.0));
   std::vector<Pose> poses;
   poses.reserve(model.instances.size());
   for (InstanceId i = 0; i < model.instances.size(); ++i) poses.push_back(scene.pose(i));

@@ -28,10 +28,10 @@ bool write_html_report(std::ostream& os, const Model& model, std::span<const Pos
                        const nlohmann::json& meta);
 
 // What `check --html FILE` does after the query: tessellates the surfaces a lazy query never reached
-// (the page shows every surface; `deflection` <= 0 means each source's default), takes the instance
+// (the page shows every surface) at their part's load deflection, takes the instance
 // poses from `scene` (a trajectory leaves them at its last step), and writes the page to `path`.
 // Prints tessellation failures and write errors to stderr. Returns false when `path` was not written.
 bool save_html_report(const std::string& path, Model& model, const Scene& scene, const Report& report,
-                      const nlohmann::json& meta, double deflection);
+                      const nlohmann::json& meta);
 
 }  // namespace cadclash::cli

@@ -34,10 +34,6 @@ class CollideOptions:
     containment: bool = True        # detect a closed part inside another
     exact: bool = False             # every reported class from the exact B-rep faces (slow); see collide.h
     fast: bool = False              # classes from the triangles' deflection band alone, not certified
-    # Deflection (mm) assumed for lazy surfaces not yet tessellated, and the one they are tessellated
-    # at. None: the model's absolute load deflection (0 for a relative one), as ``cadclash check`` does.
-    deflection_hint: Optional[float] = None
-    tessellation_deflection: Optional[float] = None
     # Budgets; 0 = none. When one runs out the query returns a partial report (Report.complete False,
     # Report.stopped_by says which). time_budget: seconds of wall clock (for replay: the whole replay;
     # which pairs finish then depends on the machine). memory_budget: bytes of what the query builds;
@@ -68,7 +64,7 @@ def _choice(table: dict, name: str, value):
         raise ValueError(f"{name} must be one of {', '.join(table)}; got {value!r}") from None
 
 
-def _to_core(o: CollideOptions, query_deflection: float) -> "_core.CollideOptionsCore":
+def _to_core(o: CollideOptions) -> "_core.CollideOptionsCore":
     c = _core.CollideOptionsCore()
     c.tolerance = float(o.tolerance)
     c.clearance = float(o.clearance)
@@ -86,9 +82,6 @@ def _to_core(o: CollideOptions, query_deflection: float) -> "_core.CollideOption
         raise ValueError("exact and fast exclude each other")
     c.decision = (_core.DecisionMode.Exact if o.exact else
                   _core.DecisionMode.Fast if o.fast else _core.DecisionMode.Certified)
-    c.deflection_hint = query_deflection if o.deflection_hint is None else float(o.deflection_hint)
-    c.tessellation_deflection = (query_deflection if o.tessellation_deflection is None
-                                 else float(o.tessellation_deflection))
     c.time_budget_seconds = float(o.time_budget)
     if int(o.memory_budget) < 0:
         raise ValueError("memory_budget must be >= 0")

@@ -110,7 +110,7 @@ class Scene:
         Options as a ``CollideOptions`` and/or keyword arguments (see ``CollideOptions``). The query
         runs with the GIL released, so other Python threads keep running; the result does not depend
         on the thread count. Lazy surfaces a query reaches are tessellated in the model."""
-        o = _to_core(_resolve(options, kwargs), self.model._query_deflection)
+        o = _to_core(_resolve(options, kwargs))
         return _report(self.model, self._core.check(o))
 
     def __repr__(self) -> str:
@@ -121,7 +121,7 @@ def collide(model: Model, a: InstanceKey, b: InstanceKey, options: Optional[Coll
             **kwargs) -> Report:
     """One-off query of two different instances (ids, paths or Instances) at their imported poses;
     tessellates exactly the lazy surfaces it needs. Runs with the GIL released. ValueError if a == b."""
-    o = _to_core(_resolve(options, kwargs), model._query_deflection)
+    o = _to_core(_resolve(options, kwargs))
     return _report(model, _core.collide(model, model._instance_id(a), model._instance_id(b), o))
 
 
@@ -135,7 +135,7 @@ def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[
     (then nothing is run, like ``cadclash check --path``). Rows naming unknown instances are skipped
     with a warning in ``Replay.diagnostics``. Runs with the GIL released."""
     path = os.fspath(trajectory)
-    o = _to_core(_resolve(options, kwargs), scene.model._query_deflection)
+    o = _to_core(_resolve(options, kwargs))
     try:
         with open(path, "rb") as f:
             text = f.read()

@@ -50,10 +50,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   if (!a.preset.empty()) {
     const auto preset = parse_tessellation_preset(a.preset);
     if (!preset) throw pyb::value_error("unknown preset '" + a.preset + "' (coarse, normal, fine, very-fine)");
-    const TessellationOptions p = tessellation_preset(*preset);
-    options.tessellation.linear_deflection = p.linear_deflection;
-    options.tessellation.angular_deflection = p.angular_deflection;
-    options.tessellation.relative = false;
+    options.tessellation = apply_preset(options.tessellation, *preset);
   }
   options.lazy = a.lazy;
   options.isolate_cad_readers = a.isolate;
@@ -88,7 +85,6 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
       diagnostics.insert(diagnostics.end(), sr.diagnostics.begin(), sr.diagnostics.end());
     }
     s.model = std::move(r.model);
-    s.query_deflection = options.tessellation.relative ? 0.0 : options.tessellation.linear_deflection;
     s.loaded = true;
   }
   return pyb::make_tuple(diagnostics_to_list(diagnostics), complete);
@@ -125,7 +121,7 @@ MeshSpan mesh_span(ModelState& s, pyb::ssize_t id, bool tessellate) {
   Surface& surf = s.model.surfaces[static_cast<std::size_t>(id)];
   if (!surf.has_triangles && tessellate) {
     const SurfaceId sid = static_cast<SurfaceId>(id);
-    require_triangles(s.model, std::span<const SurfaceId>(&sid, 1), s.query_deflection);
+    require_triangles(s.model, std::span<const SurfaceId>(&sid, 1), 0.0);
   }
   if (surf.has_triangles && !surf.mesh.triangles.empty()) {
     out.vertices = surf.mesh.vertices.front().data();
@@ -153,7 +149,6 @@ void bind_model(pyb::module_& m) {
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
           pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"))
-      .def_property_readonly("_query_deflection", [](const ModelCore& c) { return c.state->query_deflection; })
       .def("_counts",
            [](const ModelCore& c) {
              const Model& md = c.state->model;  // sizes never change after load
@@ -232,7 +227,7 @@ void bind_model(pyb::module_& m) {
              std::vector<Diagnostic> ds;
              {
                ModelLock lock(st);
-               ds = require_triangles(st.model, list, deflection > 0.0 ? deflection : st.query_deflection);
+               ds = require_triangles(st.model, list, deflection);
              }
              return diagnostics_to_list(ds);
            })

@@ -26,7 +26,6 @@ InstanceId checked_instance(const ModelState& s, std::int64_t id) {
 void validate(const CollideOptions& o) {
   if (!(o.tolerance >= 0.0)) throw pyb::value_error("tolerance must be >= 0");
   if (!(o.clearance >= 0.0)) throw pyb::value_error("clearance must be >= 0");
-  if (!(o.deflection_hint >= 0.0)) throw pyb::value_error("deflection_hint must be >= 0");
   if (!(o.time_budget_seconds >= 0.0)) throw pyb::value_error("time_budget must be >= 0");
 }
 
@@ -65,7 +64,6 @@ void bind_scene(pyb::module_& m) {
       .def(pyb::init<>())
       .def_readwrite("tolerance", &CollideOptions::tolerance)
       .def_readwrite("clearance", &CollideOptions::clearance)
-      .def_readwrite("deflection_hint", &CollideOptions::deflection_hint)
       .def_readwrite("mode", &CollideOptions::mode)
       .def_readwrite("threads", &CollideOptions::threads)
       .def_readwrite("version", &CollideOptions::version)
@@ -75,7 +73,6 @@ void bind_scene(pyb::module_& m) {
       .def_readwrite("flat_limit", &CollideOptions::flat_limit)
       .def_readwrite("detect_containment", &CollideOptions::detect_containment)
       .def_readwrite("decision", &CollideOptions::decision)
-      .def_readwrite("tessellation_deflection", &CollideOptions::tessellation_deflection)
       .def_readwrite("time_budget_seconds", &CollideOptions::time_budget_seconds)
       .def_readwrite("memory_budget_bytes", &CollideOptions::memory_budget_bytes);
 

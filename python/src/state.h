@@ -22,9 +22,6 @@ struct ModelState {
   Model model;
   std::mutex mutex;
   bool loaded = false;
-  // deflection_hint / tessellation_deflection that `cadclash check` would use for this load:
-  // the absolute load deflection, or 0 for a relative one.
-  double query_deflection = 0.0;
 };
 
 // The Python-visible model core (subclassed in Python as cadclash.Model).

@@ -135,3 +135,21 @@ def test_off_colours(data_dir):
     model = cadclash.load(data_dir / "mesh" / "colours.off")
     assert [(s.name, s.colour) for s in model.surfaces] == [("colour-FF0000", (1.0, 0.0, 0.0)),
                                                             ("colour-0000FF", (0.0, 0.0, 1.0))]
+
+
+@pytest.mark.parametrize("preset,deflection,angular", [("coarse", 1.0, 0.8), ("normal", 0.1, 0.5), ("fine", 0.01, 0.25)])
+@pytest.mark.parametrize("lazy", [False, True])
+def test_preset_equals_its_explicit_deflections(as1_path, preset, deflection, angular, lazy):
+    """load(preset=) is the explicit deflections of that preset, eager or lazy: the same pairs, and every
+    face a query tessellated is meshed at the preset's deflection (lazy faces at the load deflection,
+    not at load()'s default 0.1 mm)."""
+    by_preset = cadclash.load(as1_path, preset=preset, lazy=lazy)
+    explicit = cadclash.load(as1_path, deflection=deflection, angular=angular, lazy=lazy)
+    ra = cadclash.Scene(by_preset).check()
+    rb = cadclash.Scene(explicit).check()
+    assert [(p.key, p.distance, p.decided_by) for p in ra.pairs] == [(p.key, p.distance, p.decided_by) for p in rb.pairs]
+    assert ra.pairs
+    meshed = [(a.deflection, b.deflection) for a, b in zip(by_preset.surfaces, explicit.surfaces) if a.has_triangles]
+    assert meshed
+    assert all(da == db for da, db in meshed)
+    assert max(da for da, _ in meshed) <= deflection

@@ -339,3 +339,44 @@ TEST(CheckCliBudget, TimeBudgetCoversTheWholeTrajectory) {
 }
 
 }  // namespace
+
+// A preset is one choice of deflections, made once: `--preset P` reports exactly what the explicit
+// `--deflection d --angular a` of that preset reports, with and without --lazy (a lazy face is meshed
+// at its part's load deflection, not at --deflection's default), and the settings show the
+// deflections in effect. Before, `--preset fine --lazy` meshed the lazy faces at 0.1 mm.
+TEST(CheckCliAs1, PresetsEqualTheirExplicitDeflectionsWithAndWithoutLazy) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!std::ifstream(step)) GTEST_SKIP() << "run scripts/setup.sh for " << step;
+  struct Preset {
+    const char* name;
+    const char* deflection;
+    const char* angular;
+    double value;
+  };
+  for (const Preset& p : {Preset{"coarse", "1", "0.8", 1.0}, Preset{"normal", "0.1", "0.5", 0.1},
+                          Preset{"fine", "0.01", "0.25", 0.01}})
+    for (const char* lazy : {"", " --lazy"}) {
+      const std::string what = std::string(p.name) + lazy;
+      const std::string a = tmp(std::string("preset_") + p.name + (*lazy ? "_lazy" : "") + ".json");
+      const std::string b = tmp(std::string("explicit_") + p.name + (*lazy ? "_lazy" : "") + ".json");
+      const Proc ra = run("check " + step + " --preset " + p.name + lazy + " --no-timings --json " + a);
+      const Proc rb = run("check " + step + " --deflection " + p.deflection + " --angular " + p.angular + lazy +
+                          " --no-timings --json " + b);
+      ASSERT_EQ(ra.code, 0) << what << ra.out;
+      ASSERT_EQ(rb.code, 0) << what << rb.out;
+      const nlohmann::json ja = nlohmann::json::parse(read(a)), jb = nlohmann::json::parse(read(b));
+      EXPECT_EQ(ja["pairs"], jb["pairs"]) << what;
+      EXPECT_EQ(ja["summary"], jb["summary"]) << what;
+      EXPECT_EQ(ja["settings"]["preset"], p.name) << what;
+      EXPECT_TRUE(jb["settings"]["preset"].is_null()) << what;
+      for (const nlohmann::json* j : {&ja, &jb}) {
+        EXPECT_EQ((*j)["settings"]["deflection"].get<double>(), p.value) << what;
+        EXPECT_EQ((*j)["settings"]["angular_deflection"].get<double>(), std::stod(p.angular)) << what;
+      }
+      // Every reported face was meshed at the preset's deflection (achieved at most that, as measured).
+      ASSERT_FALSE(ja["pairs"].empty()) << what;
+      for (const auto& pair : ja["pairs"])
+        for (const char* side : {"a", "b"})
+          EXPECT_LE(pair[side]["deflection"].get<double>(), p.value) << what << ' ' << pair.dump();
+    }
+}
