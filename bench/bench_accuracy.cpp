@@ -1,7 +1,7 @@
 // Accuracy of the reported surface pairs against the exact B-rep geometry, and what it costs.
 //
 //   bench_accuracy [--file F.stp]... [--out DIR] [--cache DIR|--no-cache] [--deflections 1,0.3,...]
-//                  [--tolerances 0,0.01,0.1] [--jitters 0,0.05] [--repeats N] [--threads N] [--no-plots]
+//                  [--tolerances 0,0.01,0.1] [--jitters 0,0.05] [--repeats N] [--threads N] [--no-plots] [--no-scenes]
 //
 // For each file, as read and with every instance moved by each --jitters distance: the ground truth
 // (cadclash/testing/truth.h: exact face distance <= tolerance + εa + εb) per tolerance, read from
@@ -13,6 +13,7 @@
 // Writes DIR/accuracy.json, DIR/accuracy.md, the plot data DIR/accuracy_*.dat and, when gnuplot is
 // installed, DIR/accuracy_trade.svg and DIR/accuracy_time.svg (scripts in bench/plots/).
 #include "bench_accuracy_run.h"
+#include "bench_accuracy_scenes.h"
 #include "cadclash/testing/scenes.h"
 #include "cadclash/testing/truth.h"
 
@@ -62,6 +63,7 @@ struct Args {
   int repeats = 3;
   int threads = 1;
   bool plots = true;
+  bool scenes = true;  // the truth-test scenes' matrix (board, as1 variants)
 };
 
 std::vector<double> parse_list(const std::string& s) {
@@ -110,6 +112,8 @@ bool parse_args(int argc, char** argv, Args& a) {
       a.repeats = std::max(1, std::atoi(v.c_str()));
     } else if (k == "--threads" && value(v)) {
       a.threads = std::atoi(v.c_str());
+    } else if (k == "--no-scenes") {
+      a.scenes = false;
     } else if (k == "--no-plots") {
       a.plots = false;
     } else {
@@ -125,17 +129,6 @@ std::string fmt(double v, int precision = 4) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", precision, v);
   return buf;
-}
-
-// "97.5 / 2.5 / 0 / 0 / 0" (+ " / undecided x" when any): decided_shares in percent; "-" when the
-// mode counts no decisions (fast).
-std::string shares_text(const CollideCounters& c) {
-  const std::vector<double> sh = decided_shares(c);
-  if (std::all_of(sh.begin(), sh.end(), [](double v) { return v == 0.0; })) return "-";
-  std::string out;
-  for (std::size_t i = 0; i < 5; ++i) out += (i ? " / " : "") + fmt(100.0 * sh[i], 3);
-  if (c.undecided) out += " / undecided " + fmt(100.0 * sh[5], 3);
-  return out;
 }
 
 // Moves instance i by `jitter` mm along a direction fixed by i (splitmix64), the same in every run.
@@ -296,7 +289,7 @@ int run(const Args& args) {
                     << fmt(r.score.precision()) << ", missed " << r.score.missed.size() << ", false "
                     << r.score.false_pairs.size() << ", undecided " << r.run.undecided.size() << ", "
                     << fmt(r.run.seconds * 1e3, 3) << " ms";
-          if (mode != Mode::OcctProximity) std::cout << ", decided by " << shares_text(r.run.counters);
+          if (mode != Mode::OcctProximity) std::cout << ", decided by " << decided_shares_text(r.run.counters);
           std::cout << '\n';
           nlohmann::json jr{{"deflection", d},
                             {"achieved_deflection", achieved},
@@ -349,13 +342,26 @@ int run(const Args& args) {
       md << fmt(r.score.recall(), 4) << " | " << fmt(r.score.precision(), 4) << " | " << fmt(r.run.seconds * 1e3, 3)
          << " | ";
       if (r.run.mode == Mode::OcctProximity) md << "- | - |\n";
-      else md << shares_text(r.run.counters) << " | " << r.run.counters.exact_queries << " |\n";
+      else md << decided_shares_text(r.run.counters) << " | " << r.run.counters.exact_queries << " |\n";
     }
     md << "\nBold: the default setting (deflection " << fmt(kDefaultDeflection) << " mm, tolerance "
        << fmt(kDefaultTolerance) << ", certified). Missed, false and undecided pairs are listed by STEP #id, with "
           "their exact distances, in `accuracy.json`.\n\n";
     jfiles.push_back(std::move(jf));
     all_rows.insert(all_rows.end(), rows.begin(), rows.end());
+  }
+
+  if (args.scenes) {
+    std::cout << "truth-test scenes (board, as1, as1 with a nut moved off the plate)\n";
+    md << "### The truth-test scenes\n\n"
+       << "The scenes of `tests/collide/test_certified_truth.cpp` (`cadclash/testing/scenes.h`): **board**, real parts on "
+          "the as1 plate, seated (exact coplanar contact), at stand-offs of 0.005–0.03 mm, sunk in by 0.001–0.01 mm, "
+          "turned by odd angles, tangent cylinders and a bolt through a hole; **as1** as read; as1 with a nut moved off "
+          "the plate by 0.005, 0.02 and 0.05 mm. Deflection "
+       << fmt(kDefaultDeflection) << " mm, " << args.threads << " thread(s); truth as above.\n\n"
+       << scene_matrix(std::string(CADCLASH_DATA_DIR) + "/external", kDefaultDeflection, {1e-4, 0.025}, args.threads,
+                       args.repeats)
+       << "\n";
   }
 
   // Plot data: one gnuplot index (block) per mode.
@@ -424,7 +430,7 @@ int main(int argc, char** argv) {
   if (!cadclash::bench::parse_args(argc, argv, args)) {
     std::cerr << "usage: bench_accuracy [--file F]... [--out DIR] [--cache DIR|--no-cache] [--deflections a,b,...]\n"
                  "                      [--tolerances a,b,...] [--jitters a,b,...] [--repeats N] [--threads N]\n"
-                 "                      [--no-plots]\n";
+                 "                      [--no-plots] [--no-scenes]\n";
     return 2;
   }
   return cadclash::bench::run(args);

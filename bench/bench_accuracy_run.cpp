@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <limits>
 
 namespace cadclash::bench {
@@ -50,7 +51,7 @@ DecisionMode decision_of(Mode m) {
   }
 }
 
-RunResult run_cadclash(Model& model, Mode mode, double tolerance, double deflection, int threads, int repeats,
+RunResult run_cadclash(Model& model, Mode mode, double tolerance, int threads, int repeats,
                        const std::function<bool(InstanceId, InstanceId)>& keep) {
   RunResult out;
   out.mode = mode;
@@ -58,8 +59,6 @@ RunResult run_cadclash(Model& model, Mode mode, double tolerance, double deflect
   CollideOptions o;
   o.tolerance = tolerance;
   o.threads = threads;
-  o.deflection_hint = deflection;
-  o.tessellation_deflection = deflection;
   o.decision = decision_of(mode);
   o.detect_containment = false;  // whole-instance rows have no surface pair to score
   const SceneSelection sel = selection_of(model, keep);
@@ -169,10 +168,24 @@ std::vector<double> decided_shares(const CollideCounters& c) {
   return out;
 }
 
+std::string decided_shares_text(const CollideCounters& c) {
+  const std::vector<double> sh = decided_shares(c);
+  if (std::all_of(sh.begin(), sh.end(), [](double v) { return v == 0.0; })) return "-";
+  auto percent = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", 100.0 * v);
+    return std::string(buf);
+  };
+  std::string out;
+  for (std::size_t i = 0; i < 5; ++i) out += (i ? " / " : "") + percent(sh[i]);
+  if (c.undecided) out += " / undecided " + percent(sh[5]);
+  return out;
+}
+
 RunResult run_mode(Model& model, Mode mode, double tolerance, double deflection, int threads, int repeats,
                    const std::function<bool(InstanceId, InstanceId)>& keep) {
   if (mode == Mode::OcctProximity) return run_occt(model, tolerance, deflection, repeats, keep);
-  return run_cadclash(model, mode, tolerance, deflection, threads, repeats, keep);
+  return run_cadclash(model, mode, tolerance, threads, repeats, keep);
 }
 
 }  // namespace cadclash::bench

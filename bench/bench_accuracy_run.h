@@ -44,6 +44,10 @@ struct RunResult {
 // refined, exact, undecided (sums to 1 when any pair was decided; all 0 otherwise).
 std::vector<double> decided_shares(const CollideCounters& c);
 
+// decided_shares in percent, "97.5 / 2.5 / 0 / 0 / 0" (+ " / undecided x" when any); "-" when the
+// mode counts no decisions (fast).
+std::string decided_shares_text(const CollideCounters& c);
+
 // Runs one mode on `model` (eagerly tessellated B-rep parts) at `tolerance` with the library's
 // default options otherwise (containment off: whole-instance rows have no surface pair to score).
 // `keep`, when given, restricts the instance pairs as in truth::compute_ground_truth.
