@@ -105,6 +105,12 @@ void Transfer::set_loose(const TopoDS_Shape& compound, const FaceEntityMap& enti
   complete = false;
 }
 
+void record_occt_failure(Transfer& t, const std::string& path, const std::string& format, const Standard_Failure& e) {
+  t.diagnostics.push_back({Severity::Error, path, 0, -1, "OCCT failed while reading " + format + ": " + e.GetMessageString()});
+  t.complete = false;
+  t.discard_shapes();
+}
+
 Handle(TDocStd_Document) new_xcaf_document() {
   Handle(TDocStd_Document) doc;
   application()->NewDocument("BinXCAF", doc);

@@ -6,6 +6,7 @@
 #include "cad_xcaf.h"
 #include "isolated_run.h"
 
+#include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
 
 #include <functional>
@@ -44,6 +45,10 @@ struct Transfer {
   // Makes `faces` the loose faces, each tagged with its entity from `entities` (by TShape).
   void set_loose(const TopoDS_Shape& compound, const FaceEntityMap& entities, std::string note);
 };
+
+// What a reader's transfer keeps when OCCT threw while reading the `format` file ("STEP", "IGES",
+// "BREP"): an error with OCCT's message, and no shapes, since a transfer cut short keeps nothing.
+void record_occt_failure(Transfer& t, const std::string& path, const std::string& format, const Standard_Failure& e);
 
 // A new XCAF document that pack_transfer can store. Throws Standard_Failure if OCCT cannot make one.
 Handle(TDocStd_Document) new_xcaf_document();

@@ -45,7 +45,7 @@ Transfer read_brep_shape(const std::string& path) {
     BRepTools::Clean(shape, Standard_True);
     t.loose = shape;
   } catch (const Standard_Failure& e) {
-    return fail(std::string("OCCT failed while reading BREP: ") + e.GetMessageString());
+    record_occt_failure(t, path, "BREP", e);
   }
   return t;
 }

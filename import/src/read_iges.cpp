@@ -116,9 +116,7 @@ Transfer read_iges_transfer(const std::string& path, bool one_by_one, const std:
       result.faces = map_face_entities(process, describe_iges_face(label));
     }
   } catch (const Standard_Failure& e) {
-    result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string("OCCT failed while reading IGES: ") + e.GetMessageString()});
-    result.complete = false;
-    result.discard_shapes();  // a transfer cut short keeps nothing
+    record_occt_failure(result, path, "IGES", e);
   }
   return result;
 }

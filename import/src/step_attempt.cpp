@@ -1,0 +1,207 @@
+// One attempt at a STEP file (step_attempt.h): its text checked and corrected, the file parsed, the
+// model repaired and transferred into an XCAF document, or its faces transferred one by one.
+#include "step_attempt.h"
+
+#include "step_model_repairs.h"
+#include "step_text.h"
+#include "step_uncertainty.h"
+
+#include <IFSelect_ReturnStatus.hxx>
+#include <Interface_Static.hxx>
+#include <STEPCAFControl_Reader.hxx>
+#include <StepRepr_RepresentationItem.hxx>
+#include <StepShape_Face.hxx>
+#include <TCollection_HAsciiString.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp_Explorer.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
+
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+namespace cadclash::detail {
+namespace {
+
+const char* status_text(IFSelect_ReturnStatus status) {
+  switch (status) {
+    case IFSelect_RetVoid: return "the file holds no data";
+    case IFSelect_RetDone: return "read";
+    case IFSelect_RetError: return "the file could not be opened or is not STEP";
+    case IFSelect_RetFail: return "the file could not be parsed";
+    case IFSelect_RetStop: return "reading was stopped";
+  }
+  return "unknown status";
+}
+
+// Whether the document holds at least one face: products without any mean the attempt gave nothing.
+bool has_faces(const Handle(TDocStd_Document)& doc) {
+  TDF_LabelSequence free;
+  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetFreeShapes(free);
+  for (Standard_Integer i = 1; i <= free.Length(); ++i)
+    if (TopExp_Explorer(XCAFDoc_ShapeTool::GetShape(free(i)), TopAbs_FACE).More()) return true;
+  return false;
+}
+
+// Lengths in millimetres, colours and names; the file's other attributes (layers, properties, GD&T,
+// materials, views) are not read.
+void configure(STEPCAFControl_Reader& reader) {
+  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+  reader.SetColorMode(Standard_True);
+  reader.SetNameMode(Standard_True);
+  reader.SetLayerMode(Standard_False);
+  reader.SetPropsMode(Standard_False);
+  reader.SetGDTMode(Standard_False);
+  reader.SetMatMode(Standard_False);
+  reader.SetViewMode(Standard_False);
+}
+
+// The file's bytes; empty when it cannot be read.
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+// Parses the file into the reader's model. A truncated file is read up to its last complete entity,
+// and references to entities the file does not define are unset first (step_text.h): OCCT then
+// reads a corrected copy of `text` instead of the file.
+IFSelect_ReturnStatus parse(STEPCAFControl_Reader& reader, const std::string& path, const std::string& text,
+                            bool readable, Transfer& result) {
+  STEPControl_Reader& step = reader.ChangeReader();
+  auto read_text = [&](const std::string& source, bool whole_file) {
+    if (auto unset = unset_undefined_references(source, path)) {
+      result.diagnostics.insert(result.diagnostics.end(), unset->diagnostics.begin(), unset->diagnostics.end());
+      result.complete = false;
+      std::istringstream stream(unset->text);
+      return step.ReadStream(path.c_str(), stream);
+    }
+    if (whole_file) return reader.ReadFile(path.c_str());
+    std::istringstream stream(source);
+    return step.ReadStream(path.c_str(), stream);
+  };
+  if (!readable) return reader.ReadFile(path.c_str());  // OCCT's own message for a file it cannot open
+  if (const auto truncated = close_truncated(text)) {
+    result.diagnostics.push_back({Severity::Error, path, truncated->second, -1,
+                                  "STEP file is truncated (no END-ISO-10303-21); read up to its last complete entity, "
+                                  "which ends on this line"});
+    result.complete = false;
+    return read_text(truncated->first, false);
+  }
+  return read_text(text, true);
+}
+
+// The products into result.doc with the entity of each face, after the repairs that keep OCCT's
+// transfer from crashing or dropping products silently (step_model_repairs.h).
+void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
+                       const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
+                       const AttemptRun& run, Transfer& result) {
+  if (run.attempt == Attempt::WithoutBrokenFaces) drop_broken_shapes(model, label, path, result);
+  cut_deep_mapped_items(model, label, path, result);
+  report_assembly_cycles(model, label, path, result);
+
+  result.doc = new_xcaf_document();
+  const bool transferred = reader.Transfer(result.doc) == Standard_True;
+  const Handle(Transfer_TransientProcess) process =
+      ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
+  if (!process.IsNull() &&
+      append_checks(process->CheckList(Standard_True), model, label, path, "STEP transfer", false, result.diagnostics) > 0)
+    result.complete = false;
+  run.mark(kTransferred);
+  if (!transferred) {
+    result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP transfer failed; no shape could be made"});
+    result.complete = false;
+    result.discard_shapes();
+    return;
+  }
+  if (has_faces(result.doc)) run.mark(kShapes);
+  result.faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
+    if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
+    out.id = label(entity);
+    const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
+    if (!item.IsNull() && !item->Name().IsNull()) out.name = item->Name()->ToCString();
+    return true;
+  });
+}
+
+// The parsed model into shapes: its products, or its face entities one by one when the attempt
+// says so or the file has no product that can be transferred.
+void transfer_model(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
+                    const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
+                    const AttemptRun& run, Transfer& result) {
+  STEPControl_Reader& step = reader.ChangeReader();
+  if (run.attempt == Attempt::LooseFaces) {
+    recover_loose_faces(step, model, path, label, run, "the products could not be transferred", result);
+    return;
+  }
+  if (reader.NbRootsForTransfer() == 0) {
+    recover_loose_faces(step, model, path, label, run, "no product structure could be read", result);
+    if (!result.loose.IsNull()) return;
+    result.diagnostics.push_back({Severity::Error, path, 0, -1,
+                                  "STEP file holds no shape to transfer (no product with a shape representation "
+                                  "that this reader's schema knows)"});
+    result.complete = false;
+    return;
+  }
+  transfer_products(reader, model, ws, label, path, run, result);
+}
+
+}  // namespace
+
+Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
+  prepare_occt_exchange();
+  Transfer result;
+  try {
+    STEPCAFControl_Reader reader;  // its constructor registers the STEP controller and its parameters
+    configure(reader);
+
+    // One read of the text for every scan below; OCCT reads the file (or a corrected copy) itself.
+    const bool readable = static_cast<bool>(std::ifstream(path));
+    const std::string text = file_text(path);
+    for (Diagnostic& d : unknown_schemas(text, path)) {
+      result.diagnostics.push_back(std::move(d));
+      result.complete = false;
+    }
+    const IFSelect_ReturnStatus status = parse(reader, path, text, readable, result);
+    STEPControl_Reader& step = reader.ChangeReader();
+    const Handle(StepData_StepModel) model = step.StepModel();
+    const EntityLabelFn label = [&model](const Handle(Standard_Transient)& entity) -> std::int64_t {
+      if (model.IsNull()) return -1;
+      const Standard_Integer id = model->IdentLabel(entity);
+      return id > 0 ? id : -1;
+    };
+    const Handle(XSControl_WorkSession) ws = step.WS();
+    std::size_t load_fails = 0;
+    if (!ws.IsNull() && !model.IsNull() && model->NbEntities() > 0)
+      load_fails = append_checks(ws->ModelCheckList(Standard_False), model, label, path, "STEP syntax", false,
+                                 result.diagnostics);
+    if (status != IFSelect_RetDone) {
+      result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string("cannot read STEP file: ") + status_text(status)});
+      result.complete = false;
+      return result;
+    }
+    run.mark(kParsed);
+    if (load_fails > 0) result.complete = false;
+    for (Diagnostic& d : unit_context_problems(text, path)) {
+      if (d.severity == Severity::Error) result.complete = false;
+      result.diagnostics.push_back(std::move(d));
+    }
+    result.declared_uncertainty = declared_length_uncertainty(text, path, result.diagnostics);
+    if (model.IsNull() || model->NbEntities() == 0) {
+      result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP file has an empty DATA section"});
+      result.complete = false;
+      return result;
+    }
+    transfer_model(reader, model, ws, label, path, run, result);
+  } catch (const Standard_Failure& e) {
+    record_occt_failure(result, path, "STEP", e);
+  }
+  return result;
+}
+
+}  // namespace cadclash::detail
