@@ -327,7 +327,7 @@ SurfacePairResult make_result(const DecideTask& t, const PairOutcome* out, Conta
 std::optional<SurfacePairResult> fast(const Model& m, const DecideTask& t, const CollideOptions& o) {
   if (t.outcome == nullptr) return std::nullopt;
   const double band = m.surfaces[t.sa].deflection + m.surfaces[t.sb].deflection;
-  const double tau = o.tolerance + band;
+  const double tau = band_threshold(m.surfaces[t.sa], m.surfaces[t.sb], o.tolerance);  // tolerance + band
   const auto cls = classify(*t.outcome, tau, o.clearance);
   if (!cls) return std::nullopt;
   SurfacePairResult r = make_result(t, t.outcome, *cls);

@@ -158,8 +158,8 @@ double winding_number(const Vec3& p, std::span<const Surface* const> surfaces) {
 void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
                   const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, PreparedPair& out,
                   CollideCounters& counters) {
-  prepare_pair_reach(sa, bvh_a, sb, bvh_b, t_ab, t_ba, options, options.tolerance + sa.deflection + sb.deflection,
-                     out, counters);
+  prepare_pair_reach(sa, bvh_a, sb, bvh_b, t_ab, t_ba, options, band_threshold(sa, sb, options.tolerance), out,
+                     counters);
 }
 
 void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,

@@ -7,6 +7,7 @@
 #include "cadclash/collide.h"
 #include "surface_bvh.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -21,6 +22,18 @@ struct PreparedPair {
   std::vector<Aabb> box_a, box_b;              // their boxes in A's frame, parallel to la / lb
   std::vector<std::array<Vec3, 3>> tri_b;      // Sl's survivors mapped into A's frame
 };
+
+// The touching bound of fast mode (and of the paper's narrow phase): tolerance + both surfaces'
+// deflections. Certified decisions use certified_reach (decide.h) instead.
+inline double band_threshold(const Surface& a, const Surface& b, double tolerance) {
+  return tolerance + (a.deflection + b.deflection);
+}
+
+// How far apart two boxes may be and still hold a pair the query must see: the tolerance plus what
+// each side adds (deflection, uncertainty) plus the round-off bound, or the clearance when larger.
+inline double search_reach(const CollideOptions& o, double share_a, double share_b, double roundoff) {
+  return std::max(o.tolerance + share_a + share_b + roundoff, o.clearance);
+}
 
 struct PairOutcome {
   bool intersecting = false;

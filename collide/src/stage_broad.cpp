@@ -49,7 +49,7 @@ void broad_phase_stage(SceneData& s, QueryState& q) {
   if (o.use_oaabb) {
     double share = 0.0;  // the largest deflection (+ uncertainty) any surface brings to the reach
     for (PartId p = 0; p < model.parts.size(); ++p) share = std::max(share, s.part_reach_share(p, o));
-    ids = sweep(s, std::max(o.tolerance + 2.0 * share, o.clearance), total);
+    ids = sweep(s, search_reach(o, share, share, 0.0), total);
   } else {
     for (InstanceId i = 0; i < s.poses.size(); ++i)
       for (InstanceId j = i + 1; j < s.poses.size(); ++j)

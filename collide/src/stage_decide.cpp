@@ -135,8 +135,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
       // Counted (with what proved it) when the triangles' band alone, fast mode, would have called it
       // in contact; the many pairs every mode leaves out are not.
       if (t.outcome != nullptr) {
-        const double tau = o.tolerance + model.surfaces[t.sa].deflection + model.surfaces[t.sb].deflection;
-        if (classify(*t.outcome, tau, 0.0)) {
+        if (classify(*t.outcome, band_threshold(model.surfaces[t.sa], model.surfaces[t.sb], o.tolerance), 0.0)) {
           ++counters.dismissed_pairs;
           count(counters, p.by);
         }

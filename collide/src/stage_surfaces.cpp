@@ -35,8 +35,8 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
     c.surface_pairs += ip.candidates.size();
     return;
   }
-  const double tol_margin = std::max(
-      o.tolerance + s.part_reach_share(ia.part, o) + s.part_reach_share(ib.part, o) + ip.roundoff, o.clearance);
+  const double tol_margin =
+      search_reach(o, s.part_reach_share(ia.part, o), s.part_reach_share(ib.part, o), ip.roundoff);
   // The OAABB in A's frame, then its single update into B's frame.
   const Aabb oaabb = pad_box(s.part_box[ia.part], tol_margin)
                          .intersection(transform_box(pad_box(s.part_box[ib.part], tol_margin), ip.t_ab));
@@ -63,8 +63,7 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
   for (SurfaceId sa : surv_a) {
     const Aabb box_a = s.surface_box(sa);
     for (std::size_t k = 0; k < surv_b.size(); ++k) {
-      const double m =
-          std::max(o.tolerance + s.reach_share(sa, o) + s.reach_share(surv_b[k], o) + ip.roundoff, o.clearance);
+      const double m = search_reach(o, s.reach_share(sa, o), s.reach_share(surv_b[k], o), ip.roundoff);
       ++c.aabb_tests;
       if (boxes_within(box_a, box_b[k], m + kRelativePad * (1.0 + box_magnitude(box_b[k]))))
         ip.candidates.push_back({sa, surv_b[k]});

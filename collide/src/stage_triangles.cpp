@@ -23,7 +23,7 @@ bool usable(const Model& m, const Task& t) {
 double task_tau(const SceneData& s, const QueryState& q, const Task& t) {
   const Surface& a = s.model.surfaces[t.sa];
   const Surface& b = s.model.surfaces[t.sb];
-  if (q.o.decision == DecisionMode::Fast) return q.o.tolerance + a.deflection + b.deflection;
+  if (q.o.decision == DecisionMode::Fast) return band_threshold(a, b, q.o.tolerance);
   return certified_reach(a, s.eps[t.sa], b, s.eps[t.sb], q.o.tolerance, q.pairs[t.pair].roundoff);
 }
 
