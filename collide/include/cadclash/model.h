@@ -1,0 +1,217 @@
+// cadclash/model.h — the surface-tagged model: parts, their surfaces (each CAD face or mesh patch
+// with its triangles, provenance and exact-geometry facts), placed instances, and diagnostics.
+//
+// Part of cadclash::collide (cadclash/collide.h includes it; the queries over the model are there).
+// It depends on Eigen and the standard library only. Importers (cadclash::import) fill a Model;
+// a design-review tool can also build one by hand.
+//
+// Conventions
+// - Ids are small integers that index the flat arrays of a Model (parts, surfaces, instances).
+// - Units are millimetres; importers convert.
+// - Caller mistakes (an id out of range, a malformed Model) are assertions. Untrusted input (files)
+//   is reported through Diagnostic values; library code never prints.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace cadclash {
+
+// ---------------------------------------------------------------------------------------------
+// Ids and basic geometry
+// ---------------------------------------------------------------------------------------------
+
+using PartId = std::uint32_t;
+using SurfaceId = std::uint32_t;
+using InstanceId = std::uint32_t;
+inline constexpr std::uint32_t kInvalidId = ~std::uint32_t{0};
+
+using Vec3 = Eigen::Vector3d;
+// Axis-aligned box; a default-constructed box is empty (min > max).
+using Aabb = Eigen::AlignedBox3d;
+// Rigid transform (rotation + translation) from a part's local frame to the world frame.
+using Pose = Eigen::Isometry3d;
+
+// Indexed triangles in double precision, in the owning part's local frame.
+struct TriangleMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+};
+
+// ---------------------------------------------------------------------------------------------
+// Diagnostics: what went wrong in untrusted input, and where
+// ---------------------------------------------------------------------------------------------
+
+enum class Severity : std::uint8_t { Warning, Error };
+
+struct Diagnostic {
+  Severity severity = Severity::Error;
+  std::string file;           // source file path as given by the caller; empty if none
+  std::int64_t line = 0;      // 1-based line in `file`; 0 when the format has no lines
+  std::int64_t step_id = -1;  // STEP entity #id the message is about; -1 when none
+  std::string message;        // one sentence, no trailing newline
+};
+
+// Formats a diagnostic as "file:line: error: message" or "file: #id: error: message".
+std::string format_diagnostic(const Diagnostic& d);
+
+// Returns true if any diagnostic in `ds` is an error.
+bool has_error(std::span<const Diagnostic> ds);
+
+// ---------------------------------------------------------------------------------------------
+// The surface-tagged model
+// ---------------------------------------------------------------------------------------------
+
+// Where a surface came from.
+enum class SourceKind : std::uint8_t {
+  StepFace,        // a face of a STEP B-rep; step_id is its ADVANCED_FACE (or FACE_SURFACE) #id
+  IgesFace,        // a face of an IGES B-rep; step_id holds the IGES directory entry number if known
+  BrepFace,        // a face of an OCCT .brep shape
+  ObjGroup,        // an OBJ `g` group or `o` object
+  OffColourGroup,  // all faces of an OFF file sharing one face colour
+  MeshFile,        // one mesh of an STL/PLY/glTF/... file read whole
+  Segment,         // a patch cut out of another surface by segmentation; see Provenance::parent
+};
+
+// Returns a stable lower-case name for a source kind ("step-face", "obj-group", ...).
+const char* source_kind_name(SourceKind kind);
+
+struct Provenance {
+  SourceKind kind = SourceKind::MeshFile;
+  std::string source_file;          // file the surface was read from
+  std::int64_t step_id = -1;        // STEP entity #id of the face (as written in the file); -1 if none
+  std::int32_t face_index = -1;     // index of the face / group / colour within its part, as read
+  std::string source_name;          // the file's own name for it (group name, STEP face name); may be empty
+  SurfaceId parent = kInvalidId;    // for Segment: the surface this patch was cut from
+  std::optional<std::array<float, 3>> colour;  // RGB in [0,1] as the file writes it (STEP: sRGB, not linearised)
+  bool healed = false;              // OCCT shape fixing changed the face before tessellation
+  bool repaired = false;            // mesh repair changed the surface's triangles
+};
+
+class SurfaceSource;
+
+// The exact surface a face lies on, part-local, when it is one of the elementary kinds. Lets
+// collide prove two faces apart without OCCT (see "Certified decisions" below).
+enum class SurfaceShape : std::uint8_t { Other, Plane, Cylinder, Cone, Sphere, Torus };
+
+struct AnalyticSurface {
+  SurfaceShape shape = SurfaceShape::Other;
+  Vec3 origin = Vec3::Zero();  // plane: a point on it; cylinder: a point on the axis; cone: the apex;
+                               // sphere, torus: the centre
+  Vec3 axis = Vec3::UnitZ();   // plane: unit normal; cylinder, cone, torus: unit axis direction
+  double radius = 0.0;         // cylinder, sphere: radius; torus: major radius (centre to tube axis)
+  double radius2 = 0.0;        // torus: minor (tube) radius; cone: half-angle, radians in (0, pi/2)
+};
+
+struct Surface {
+  std::string name;        // unique within its part
+  PartId part = kInvalidId;
+  Provenance provenance;
+  Aabb aabb;               // part-local; encloses the exact surface (B-rep) or its triangles (mesh)
+  double deflection = 0.0; // achieved bound on the distance between triangles and the exact surface; 0 for meshes
+  // Model uncertainty ε (mm): how far the stated geometry may be from the intended one. B-rep faces:
+  // the largest OCCT tolerance of the face, its edges and vertices (never below Precision::Confusion,
+  // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger. Meshes: the single-precision
+  // representation bound 2^-24 · (largest coordinate magnitude of the part), or the importer's
+  // model_tolerance when given. 0 (a Model built by hand) means that same bound, derived by collide
+  // from the part's box. Two faces touch when their exact distance <= tolerance + εa + εb.
+  double uncertainty = 0.0;
+  // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
+  // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
+  bool exact_triangles = false;
+  AnalyticSurface analytic;  // shape Other when the face is not elementary or the source is a mesh
+  bool has_triangles = false;  // false while a lazy source has not yet been asked for them
+  TriangleMesh mesh;       // part-local triangles (empty until has_triangles)
+};
+
+struct Part {
+  std::string name;
+  std::string source_file;
+  SurfaceId first_surface = 0;      // surfaces of a part are contiguous: [first_surface, first_surface + surface_count)
+  std::uint32_t surface_count = 0;
+  // Produces triangles on demand and answers exact-geometry queries; null for parts whose
+  // surfaces all carry their triangles (meshes).
+  std::shared_ptr<SurfaceSource> source;
+};
+
+struct Instance {
+  std::string path;  // "/root/sub::2/leaf": names from the root joined by '/', "::k" when a name repeats among siblings
+  PartId part = kInvalidId;
+  Pose pose = Pose::Identity();  // part-local → world
+};
+
+// A whole scene: flat arrays indexed by the ids above.
+struct Model {
+  std::vector<Part> parts;
+  std::vector<Surface> surfaces;
+  std::vector<Instance> instances;
+};
+
+// Supplies what a part's importer knows beyond triangles: lazy tessellation and exact geometry.
+// Implemented in cadclash::tessellate for B-rep parts; collide never sees OCCT.
+class SurfaceSource {
+ public:
+  virtual ~SurfaceSource() = default;
+
+  // Triangulates the part's `local_index`-th surface with a deflection no larger than `deflection`
+  // (<= 0 means the source's configured default). Writes triangles in the part's local frame and the
+  // achieved deflection. Returns false and fills `error` if the face could not be meshed.
+  // Thread-safe for concurrent calls on different parts; calls on one part may serialise.
+  virtual bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
+                           double& achieved_deflection, Diagnostic& error) = 0;
+
+  // The deflection the part was loaded with (absolute, mm): what triangulate() meshes at when given
+  // deflection <= 0, so what a query assumes for a lazy surface not tessellated yet. 0 when unknown.
+  virtual double default_deflection() const { return 0.0; }
+
+  // An upper bound on the distance from `point` (this part's local frame) to surface `local_index`'s
+  // exact face, realised by a point of that face (its distance to `point`, rounding included): the
+  // exact distance is the tightest such bound. nullopt when there is no exact geometry or no point
+  // was found. Thread-safe like exact_distance. The certified decision asks it about mesh vertices:
+  // a vertex of one face within T of the other face proves the two in contact, at a fraction of a
+  // face–face distance's cost.
+  virtual std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const {
+    (void)local_index, (void)point;
+    return std::nullopt;
+  }
+
+  // Exact distance between this part's surface `local_a` placed by `pose_a` and `other`'s surface
+  // `local_b` placed by `pose_b`, searching only up to `max_distance` (a value > max_distance means
+  // "farther than that"). With `enough` > 0 the search may stop at the first two points of the faces
+  // within `enough` of each other: the value is then their distance, an upper bound <= enough (the
+  // certified decision needs no more to prove contact). Returns nullopt when either side has no
+  // exact geometry. Called from several threads at once, also for the same parts: thread-safe.
+  virtual std::optional<double> exact_distance(std::uint32_t local_a, const Pose& pose_a,
+                                               const SurfaceSource& other, std::uint32_t local_b,
+                                               const Pose& pose_b, double max_distance,
+                                               double enough = 0.0) const {
+    (void)local_a, (void)pose_a, (void)other, (void)local_b, (void)pose_b, (void)max_distance, (void)enough;
+    return std::nullopt;
+  }
+};
+
+// Appends `from` to `into`, shifting its ids. Used to form one scene from several files.
+// Instance paths of `from` are prefixed with `path_prefix` (e.g. "/file.stp") when it is not empty.
+void append_model(Model& into, Model from, const std::string& path_prefix = {});
+
+// Computes a surface's AABB from its triangles (part-local). Empty box for an empty mesh.
+Aabb mesh_aabb(const TriangleMesh& mesh);
+
+// Makes sure every listed surface has triangles, asking its part's SurfaceSource for the missing
+// ones (in parallel across parts). Surfaces that fail are listed in the returned diagnostics and
+// keep has_triangles == false. `deflection` <= 0 uses each source's default.
+// Precondition: every id < model.surfaces.size().
+std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
+                                          double deflection = 0.0);
+
+// Counts triangles over all surfaces that have them.
+std::size_t triangle_count(const Model& model);
+
+}  // namespace cadclash
