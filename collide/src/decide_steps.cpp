@@ -202,6 +202,68 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   }
 }
 
+namespace {
+
+// Where two outlines (segments, both in one frame) come closest, by their vertices against the
+// other's segments (a tangent point lies inside a segment, seldom at a vertex): the two points.
+struct Closest {
+  double d2 = std::numeric_limits<double>::infinity();
+  Vec3 a, b;
+};
+
+void vertices_against_segments(const std::vector<std::array<Vec3, 2>>& from, const std::vector<std::array<Vec3, 2>>& to,
+                               bool from_is_a, Closest& best) {
+  for (const auto& e : from)
+    for (const auto& f : to) {
+      const Vec3 ab = f[1] - f[0];
+      const double len2 = ab.squaredNorm();
+      const Vec3& v = e[0];
+      const double s = len2 > 0.0 ? std::clamp((v - f[0]).dot(ab) / len2, 0.0, 1.0) : 0.0;
+      const Vec3 q = f[0] + s * ab;
+      if (const double d2 = (q - v).squaredNorm(); d2 < best.d2) best = {d2, from_is_a ? v : q, from_is_a ? q : v};
+    }
+}
+
+// The segments of `outline` mapped by `to` whose boxes meet `region`.
+std::vector<std::array<Vec3, 2>> outline_near(const std::vector<std::array<Vec3, 2>>& outline, const Pose& to,
+                                              const Aabb& region) {
+  std::vector<std::array<Vec3, 2>> out;
+  for (const auto& e : outline) {
+    const std::array<Vec3, 2> m{to * e[0], to * e[1]};
+    Aabb box;
+    box.extend(m[0]);
+    box.extend(m[1]);
+    if (box.intersects(region)) out.push_back(m);
+  }
+  return out;
+}
+
+// Outline segments compared pairwise at most: beyond this the pair is left to the next steps.
+constexpr std::size_t kMaxOutlinePairs = 1u << 16;
+
+}  // namespace
+
+void edge_witness_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, FaceView fa, FaceView fb,
+                       Pending& p, const CollideOptions& o, CollideCounters& c) {
+  const Part& pa = m.parts[fa.surface.part];
+  const Part& pb = m.parts[fb.surface.part];
+  if (!pa.source || !pb.source || fa.outline == nullptr || fb.outline == nullptr) return;  // closed faces: no outline
+  // Both in A's frame: A's outline near B, and B's near A.
+  const double reach = p.threshold + p.band;
+  const auto sa = outline_near(*fa.outline, Pose::Identity(), pad_box(transform_box(own_box(fb.surface), t.t_ab), reach));
+  const auto sb = outline_near(*fb.outline, t.t_ab, pad_box(own_box(fa.surface), reach));
+  if (sa.empty() || sb.empty() || sa.size() * sb.size() > kMaxOutlinePairs) return;
+  Closest best;
+  vertices_against_segments(sa, sb, true, best);
+  vertices_against_segments(sb, sa, false, best);
+  ++c.witness_queries;
+  const std::optional<double> d = pa.source->edge_distance(t.sa - pa.first_surface, poses[t.ia], *pb.source,
+                                                           t.sb - pb.first_surface, poses[t.ib], best.a, t.t_ba * best.b);
+  if (!d || !(*d + t.roundoff <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, *d + t.roundoff);
+  settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+}
+
 // Step 4: the same interval on finer triangles of both faces.
 void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p,
                   const CollideOptions& o, CollideCounters& c) {

@@ -58,6 +58,12 @@ void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView
 void witness_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                   const PairOutcome* out, double band, Pending& p, const CollideOptions& o, CollideCounters& c);
 
+// Step 3b: an edge witness (contact): where the faces' outlines come closest, a point on an edge of
+// each (SurfaceSource::edge_distance) within T proves the faces meet edge to edge. Faces without an
+// outline (closed ones) are skipped.
+void edge_witness_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, FaceView a, FaceView b,
+                       Pending& p, const CollideOptions& o, CollideCounters& c);
+
 // Step 4: the same interval on finer triangles of both faces.
 void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o,
                   CollideCounters& c);

@@ -107,6 +107,14 @@ void describe_face(const TopoDS_Face& face, Surface& out);
 std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
                                          const gp_Pnt& p);
 
+// An upper bound on the distance between two placed faces realised by a point on an edge of each:
+// the edges of `a` and `b` nearest `near_a` / `near_b` (part frames), Newton (Extrema_LocateExtCC)
+// from the projections of those points, the curves placed by `place_a` / `place_b`; the nearer of
+// the start and the extremum, plus the evaluation's rounding. nullopt when a face has no edge with a
+// 3D curve near its point. Reads the faces only. May throw Standard_Failure.
+std::optional<double> edge_pair_witness(const FaceLocator& a, const gp_Trsf& place_a, const gp_Pnt& near_a,
+                                        const FaceLocator& b, const gp_Trsf& place_b, const gp_Pnt& near_b);
+
 gp_Trsf to_trsf(const Pose& pose);
 Pose to_pose(const gp_Trsf& trsf);
 

@@ -30,6 +30,20 @@ double box_distance(const Aabb& a, const Aabb& b) {
   return gap.norm();
 }
 
+// Shared locks on both parts: either part's faces may be meshed by another thread meanwhile
+// (triangulate holds the lock exclusively); distances only read the faces, so any number run at once.
+class PairLock {
+ public:
+  PairLock(const BrepSource::Impl& a, const BrepSource::Impl& b)
+      : a_(a.mutex, std::defer_lock), b_(b.mutex, std::defer_lock) {
+    if (&a == &b) a_.lock();
+    else std::lock(a_, b_);
+  }
+
+ private:
+  std::shared_lock<std::shared_mutex> a_, b_;
+};
+
 }  // namespace
 
 const detail::FaceLocator& BrepSource::Impl::locator(std::uint32_t local_index) const {
@@ -95,6 +109,23 @@ std::optional<double> BrepSource::point_distance(std::uint32_t local_index, cons
   }
 }
 
+std::optional<double> BrepSource::edge_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
+                                                std::uint32_t local_b, const Pose& pose_b, const Vec3& near_a,
+                                                const Vec3& near_b) const {
+  const auto* other_brep = dynamic_cast<const BrepSource*>(&other);
+  if (other_brep == nullptr) return std::nullopt;
+  const Impl& a = *impl_;
+  const Impl& b = *other_brep->impl_;
+  assert(local_a < a.faces.size() && local_b < b.faces.size());
+  const PairLock lock(a, b);
+  try {
+    return detail::edge_pair_witness(a.locator(local_a), detail::to_trsf(pose_a), gp_Pnt(near_a.x(), near_a.y(), near_a.z()),
+                                     b.locator(local_b), detail::to_trsf(pose_b), gp_Pnt(near_b.x(), near_b.y(), near_b.z()));
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
                                                  std::uint32_t local_b, const Pose& pose_b, double max_distance,
                                                  double enough) const {
@@ -107,12 +138,7 @@ std::optional<double> BrepSource::exact_distance(std::uint32_t local_a, const Po
   const double boxes_apart = box_distance(placed_box(a.boxes[local_a], pose_a), placed_box(b.boxes[local_b], pose_b));
   if (!a.boxes[local_a].isEmpty() && !b.boxes[local_b].isEmpty() && boxes_apart > max_distance) return boxes_apart;
 
-  // Either part's faces may be meshed by another thread meanwhile (triangulate holds the lock
-  // exclusively); distances only read the faces, so any number of them run at once.
-  std::shared_lock<std::shared_mutex> lock_a(a.mutex, std::defer_lock);
-  std::shared_lock<std::shared_mutex> lock_b(b.mutex, std::defer_lock);
-  if (&a == &b) lock_a.lock();
-  else std::lock(lock_a, lock_b);
+  const PairLock lock(a, b);
   try {
     // Moved() shares the face's geometry and only composes the location: nothing is copied.
     const TopoDS_Shape fa = a.faces[local_a].Moved(TopLoc_Location(detail::to_trsf(pose_a)));

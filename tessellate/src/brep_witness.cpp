@@ -10,6 +10,8 @@
 #include <Bnd_Box.hxx>
 #include <BRep_Tool.hxx>
 #include <Extrema_GenLocateExtPS.hxx>
+#include <Extrema_LocateExtCC.hxx>
+#include <Extrema_POnCurv.hxx>
 #include <Poly_Triangulation.hxx>
 #include <ShapeAnalysis_Curve.hxx>
 #include <TopExp_Explorer.hxx>
@@ -78,6 +80,51 @@ std::optional<double> edge_witness(const FaceLocator& where, const gp_Pnt& p, do
 }
 
 }  // namespace
+
+namespace {
+
+// The edge of `where` nearest `p` (by box, then projection) and the parameter of that projection.
+std::optional<std::pair<std::size_t, double>> nearest_edge(const FaceLocator& where, const gp_Pnt& p) {
+  std::optional<std::pair<std::size_t, double>> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  const ShapeAnalysis_Curve projector;
+  for (std::size_t i = 0; i < where.edges.size(); ++i) {
+    if (where.edges[i].second.exteriorDistance(Vec3(p.X(), p.Y(), p.Z())) > best_d) continue;
+    const BRepAdaptor_Curve curve(where.edges[i].first);
+    gp_Pnt projected;
+    double t = 0.0;
+    const double d = projector.Project(curve, p, Precision::Confusion(), projected, t);
+    if (d < best_d && t >= curve.FirstParameter() && t <= curve.LastParameter()) best_d = d, best = {i, t};
+  }
+  return best;
+}
+
+}  // namespace
+
+std::optional<double> edge_pair_witness(const FaceLocator& a, const gp_Trsf& place_a, const gp_Pnt& near_a,
+                                        const FaceLocator& b, const gp_Trsf& place_b, const gp_Pnt& near_b) {
+  const auto ea = nearest_edge(a, near_a);
+  const auto eb = nearest_edge(b, near_b);
+  if (!ea || !eb) return std::nullopt;
+  const TopoDS_Edge edge_a = TopoDS::Edge(a.edges[ea->first].first.Moved(TopLoc_Location(place_a)));
+  const TopoDS_Edge edge_b = TopoDS::Edge(b.edges[eb->first].first.Moved(TopLoc_Location(place_b)));
+  const BRepAdaptor_Curve ca(edge_a), cb(edge_b);
+  // Every evaluated point stays within the placed edges' reach of the origin.
+  const gp_Pnt pa0 = ca.Value(ea->second), pb0 = cb.Value(eb->second);
+  const double magnitude = 2.0 * (gp_Vec(pa0.XYZ()).Magnitude() + gp_Vec(pb0.XYZ()).Magnitude()) +
+                           a.edges[ea->first].second.diagonal().norm() + b.edges[eb->first].second.diagonal().norm();
+  // The start points are points of both edges already; Newton from them finds the local extremum.
+  double d = pa0.Distance(pb0);
+  Extrema_LocateExtCC local(ca, cb, ea->second, eb->second);
+  if (local.IsDone()) {
+    Extrema_POnCurv p1, p2;
+    local.Point(p1, p2);
+    const bool on_a = p1.Parameter() >= ca.FirstParameter() && p1.Parameter() <= ca.LastParameter();
+    const bool on_b = p2.Parameter() >= cb.FirstParameter() && p2.Parameter() <= cb.LastParameter();
+    if (on_a && on_b) d = std::min(d, ca.Value(p1.Parameter()).Distance(cb.Value(p2.Parameter())));
+  }
+  return d + kEvaluationRounding * magnitude;
+}
 
 FaceLocator::FaceLocator(const TopoDS_Face& face)
     : domain(std::make_unique<BRepTopAdaptor_FClass2d>(face, Precision::PConfusion())) {

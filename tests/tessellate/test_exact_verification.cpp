@@ -134,6 +134,38 @@ TEST(ExactDistance, StopsAtTheFirstPointsWithinEnough) {
   EXPECT_GT(apart, 10);
 }
 
+// edge_distance: a disk (a cylinder's top face, radius 3 at z = 8) and a box's side face whose top
+// edge is the line x = 3, z = 8, tangent to the disk's circle at (3, 0, 8): the faces meet at that one
+// point, edge to edge, where no vertex of either mesh lies. Newton on the two edge curves finds it
+// from nearby outline points; moved 0.5 mm off, the bound is the true 0.5 (never below it).
+TEST(EdgeDistance, FindsTheTangentPointOfTwoEdges) {
+  const Model m = build({BRepPrimAPI_MakeCylinder(3, 8).Shape(), BRepPrimAPI_MakeBox(10, 10, 10).Shape()}, 0.1);
+  const auto* cyl = dynamic_cast<const BrepSource*>(m.parts[0].source.get());
+  const auto* box = dynamic_cast<const BrepSource*>(m.parts[1].source.get());
+  ASSERT_TRUE(cyl && box);
+  std::uint32_t disk = kInvalidId, side = kInvalidId;
+  for (std::uint32_t i = 0; i < cyl->face_count(); ++i) {
+    const Aabb& b = m.surfaces[m.parts[0].first_surface + i].aabb;
+    if (b.min().z() > 7.9) disk = i;  // the top face
+  }
+  for (std::uint32_t i = 0; i < box->face_count(); ++i) {
+    const Aabb& b = m.surfaces[m.parts[1].first_surface + i].aabb;
+    if (b.max().x() < 0.1) side = i;  // the face x = 0 of the box
+  }
+  ASSERT_NE(disk, kInvalidId);
+  ASSERT_NE(side, kInvalidId);
+  const double angle = 0.2;  // an outline point of the disk near the tangent point, not on it
+  const Vec3 near_disk(3.0 * std::cos(angle), 3.0 * std::sin(angle), 8.0);
+  const Vec3 near_side(0.0, 5.4, 10.0);  // box frame: on its top edge x = 0, z = 10, off the tangent point
+  for (double gap : {0.0, 0.5}) {
+    const Pose pose = placed(Vec3(3.0 + gap, -5.0, -2.0));
+    const auto d = cyl->edge_distance(disk, Pose::Identity(), *box, side, pose, near_disk, near_side);
+    ASSERT_TRUE(d.has_value()) << gap;
+    EXPECT_GE(*d, gap) << "an upper bound is never below the distance";
+    EXPECT_LE(*d, gap + 1e-9) << gap;
+  }
+}
+
 // point_distance answers the witness step: its value must never be below the exact distance to the
 // face (a point of the face realises it), and it should be the distance itself wherever the
 // nearest point is inside the face or on an edge. Points near as1's faces (B-spline cylinders and

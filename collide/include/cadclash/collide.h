@@ -87,7 +87,9 @@ namespace cadclash {
 //             of that face: SurfaceSource::point_distance gives an upper bound realised by a point of
 //             that face (B-rep: a Newton foot point inside the face, or a point of its edges), so
 //             contact is proved (decided_by Exact: measured on the exact face); nearest vertices
-//             first, at most 8 per pair;
+//             first, at most 8 per pair; then, where the outlines come closest, a point on an edge of
+//             each face (SurfaceSource::edge_distance: Newton on the two edge curves) — faces meeting
+//             edge to edge, as a curved edge tangent to a straight one;
 //   refined   both faces re-tessellated at a tenth of their deflection by their SurfaceSource (cached
 //             in the Scene) and the interval taken again;
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
@@ -194,7 +196,7 @@ struct CollideCounters {
   std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
   std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
   std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
-  std::uint64_t witness_queries = 0;    // SurfaceSource::point_distance calls (witness vertices)
+  std::uint64_t witness_queries = 0;    // SurfaceSource::point_distance and edge_distance calls (witnesses)
   std::uint64_t dismissed_pairs = 0;    // candidate pairs the triangles' band would call touching
                                         // (fast mode's answer) that a certificate proved apart
 };

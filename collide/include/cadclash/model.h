@@ -182,6 +182,20 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // An upper bound on the distance between this part's surface `local_a` placed by `pose_a` and
+  // `other`'s surface `local_b` placed by `pose_b`, realised by a point on an edge of each: the local
+  // extremum of the two edges nearest `near_a` and `near_b` (each in its own part frame; typically
+  // the mesh outline points where the faces come closest), found by Newton from those points. Cheap
+  // (no global search); proves contact where two faces meet edge to edge, as a curved edge tangent
+  // to a straight one. nullopt when there is no exact geometry or no such point was found.
+  // Thread-safe like exact_distance.
+  virtual std::optional<double> edge_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
+                                              std::uint32_t local_b, const Pose& pose_b, const Vec3& near_a,
+                                              const Vec3& near_b) const {
+    (void)local_a, (void)pose_a, (void)other, (void)local_b, (void)pose_b, (void)near_a, (void)near_b;
+    return std::nullopt;
+  }
+
   // Exact distance between this part's surface `local_a` placed by `pose_a` and `other`'s surface
   // `local_b` placed by `pose_b`, searching only up to `max_distance` (a value > max_distance means
   // "farther than that"). With `enough` > 0 the search may stop at the first two points of the faces

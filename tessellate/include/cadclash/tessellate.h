@@ -132,6 +132,12 @@ class BrepSource final : public SurfaceSource {
   // between a vertex at `point` and the face.
   std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const override;
 
+  // Extrema_LocateExtCC between the edge of each face nearest its given point, started at their
+  // projections (ShapeAnalysis_Curve); `other` must be a BrepSource, else nullopt.
+  std::optional<double> edge_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
+                                      std::uint32_t local_b, const Pose& pose_b, const Vec3& near_a,
+                                      const Vec3& near_b) const override;
+
   // BRepExtrema_DistShapeShape on the two placed faces; `other` must be a BrepSource, else nullopt.
   // When the faces' boxes are farther apart than max_distance, returns that box distance (a lower
   // bound > max_distance) without running the exact search. With `enough` > 0 the sub-shape search
