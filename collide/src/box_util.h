@@ -8,6 +8,15 @@
 
 namespace cadclash::detail {
 
+// The point of the segment [a, b] nearest `p`, by projection in plain doubles (a few roundings of the
+// coordinates' magnitude).
+inline Vec3 closest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double s = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return a + s * ab;
+}
+
 // Relative padding that absorbs the rounding of mapping points between frames (a few ulps of the
 // largest coordinate involved), so culling never drops what exact arithmetic would keep.
 inline constexpr double kRelativePad = 1e-12;

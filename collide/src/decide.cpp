@@ -250,12 +250,7 @@ std::optional<Vec3> foot_point(const AnalyticSurface& an, const Vec3& p) {
 // Distance from p to the segment [a, b] by projection in plain doubles: a few roundings of the
 // coordinates' magnitude, well within the slack its caller adds (the pair's round-off bound, which
 // allows 64 of them for triangle_distance alone).
-double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double s = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + s * ab - p).norm();
-}
+double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) { return (closest_on_segment(p, a, b) - p).norm(); }
 
 }  // namespace
 

@@ -142,12 +142,8 @@ constexpr std::size_t kMaxWitnessTrials = 8;
 // orders the trials, and proves nothing).
 bool clear_of(const std::vector<std::array<Vec3, 2>>& outline, const Vec3& p, double margin) {
   const double m2 = margin * margin;
-  for (const auto& [a, b] : outline) {
-    const Vec3 ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double s = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    if ((a + s * ab - p).squaredNorm() <= m2) return false;
-  }
+  for (const auto& [a, b] : outline)
+    if ((closest_on_segment(p, a, b) - p).squaredNorm() <= m2) return false;
   return true;
 }
 
@@ -215,11 +211,8 @@ void vertices_against_segments(const std::vector<std::array<Vec3, 2>>& from, con
                                bool from_is_a, Closest& best) {
   for (const auto& e : from)
     for (const auto& f : to) {
-      const Vec3 ab = f[1] - f[0];
-      const double len2 = ab.squaredNorm();
       const Vec3& v = e[0];
-      const double s = len2 > 0.0 ? std::clamp((v - f[0]).dot(ab) / len2, 0.0, 1.0) : 0.0;
-      const Vec3 q = f[0] + s * ab;
+      const Vec3 q = closest_on_segment(v, f[0], f[1]);
       if (const double d2 = (q - v).squaredNorm(); d2 < best.d2) best = {d2, from_is_a ? v : q, from_is_a ? q : v};
     }
 }

@@ -55,67 +55,60 @@ std::optional<gp_Pnt2d> nearest_node_parameters(const TopoDS_Face& face, const g
   return tri->UVNode(nearest);
 }
 
-// The nearest point to `p` on the face's edges that ShapeAnalysis_Curve's projection finds (each a
-// point of the edge's 3D curve within its range, and the edges bound the face). For a foot point
-// on or past the boundary: there the face's nearest points are on an edge. Edges are projected
-// nearest box first; one whose box is farther than the best point so far cannot give a nearer one.
-std::optional<double> edge_witness(const FaceLocator& where, const gp_Pnt& p, double magnitude) {
+// The point of the face's edges nearest `p` that ShapeAnalysis_Curve's projection finds (a point of
+// an edge's 3D curve within its range; the edges bound the face): the edge, the parameter and the
+// distance. Edges are projected nearest box first; one whose box is farther than the best point so
+// far cannot give a nearer one.
+struct EdgePoint {
+  std::size_t edge = 0;
+  double t = 0.0;
+  double distance = 0.0;
+};
+
+std::optional<EdgePoint> nearest_edge_point(const FaceLocator& where, const gp_Pnt& p) {
   std::vector<std::pair<double, std::size_t>> order;
   for (std::size_t i = 0; i < where.edges.size(); ++i)
     order.emplace_back(where.edges[i].second.exteriorDistance(Vec3(p.X(), p.Y(), p.Z())), i);
   std::sort(order.begin(), order.end());
-  std::optional<double> best;
+  std::optional<EdgePoint> best;
   const ShapeAnalysis_Curve projector;
   for (const auto& [box_distance, i] : order) {
-    if (best && box_distance > *best) break;
+    if (best && box_distance > best->distance) break;
     const BRepAdaptor_Curve curve(where.edges[i].first);
     gp_Pnt projected;
     double t = 0.0;
     projector.Project(curve, p, Precision::Confusion(), projected, t);
     if (!(t >= curve.FirstParameter() && t <= curve.LastParameter())) continue;
-    const double d = p.Distance(curve.Value(t)) + kEvaluationRounding * magnitude;
-    if (!best || d < *best) best = d;
+    const double d = p.Distance(curve.Value(t));
+    if (!best || d < best->distance) best = EdgePoint{i, t, d};
   }
   return best;
 }
 
-}  // namespace
-
-namespace {
-
-// The edge of `where` nearest `p` (by box, then projection) and the parameter of that projection.
-std::optional<std::pair<std::size_t, double>> nearest_edge(const FaceLocator& where, const gp_Pnt& p) {
-  std::optional<std::pair<std::size_t, double>> best;
-  double best_d = std::numeric_limits<double>::infinity();
-  const ShapeAnalysis_Curve projector;
-  for (std::size_t i = 0; i < where.edges.size(); ++i) {
-    if (where.edges[i].second.exteriorDistance(Vec3(p.X(), p.Y(), p.Z())) > best_d) continue;
-    const BRepAdaptor_Curve curve(where.edges[i].first);
-    gp_Pnt projected;
-    double t = 0.0;
-    const double d = projector.Project(curve, p, Precision::Confusion(), projected, t);
-    if (d < best_d && t >= curve.FirstParameter() && t <= curve.LastParameter()) best_d = d, best = {i, t};
-  }
-  return best;
+// For a foot point on or past the boundary: there the face's nearest points are on an edge.
+std::optional<double> edge_witness(const FaceLocator& where, const gp_Pnt& p, double magnitude) {
+  const std::optional<EdgePoint> e = nearest_edge_point(where, p);
+  if (!e) return std::nullopt;
+  return e->distance + kEvaluationRounding * magnitude;
 }
 
 }  // namespace
 
 std::optional<double> edge_pair_witness(const FaceLocator& a, const gp_Trsf& place_a, const gp_Pnt& near_a,
                                         const FaceLocator& b, const gp_Trsf& place_b, const gp_Pnt& near_b) {
-  const auto ea = nearest_edge(a, near_a);
-  const auto eb = nearest_edge(b, near_b);
+  const auto ea = nearest_edge_point(a, near_a);
+  const auto eb = nearest_edge_point(b, near_b);
   if (!ea || !eb) return std::nullopt;
-  const TopoDS_Edge edge_a = TopoDS::Edge(a.edges[ea->first].first.Moved(TopLoc_Location(place_a)));
-  const TopoDS_Edge edge_b = TopoDS::Edge(b.edges[eb->first].first.Moved(TopLoc_Location(place_b)));
+  const TopoDS_Edge edge_a = TopoDS::Edge(a.edges[ea->edge].first.Moved(TopLoc_Location(place_a)));
+  const TopoDS_Edge edge_b = TopoDS::Edge(b.edges[eb->edge].first.Moved(TopLoc_Location(place_b)));
   const BRepAdaptor_Curve ca(edge_a), cb(edge_b);
   // Every evaluated point stays within the placed edges' reach of the origin.
-  const gp_Pnt pa0 = ca.Value(ea->second), pb0 = cb.Value(eb->second);
+  const gp_Pnt pa0 = ca.Value(ea->t), pb0 = cb.Value(eb->t);
   const double magnitude = 2.0 * (gp_Vec(pa0.XYZ()).Magnitude() + gp_Vec(pb0.XYZ()).Magnitude()) +
-                           a.edges[ea->first].second.diagonal().norm() + b.edges[eb->first].second.diagonal().norm();
+                           a.edges[ea->edge].second.diagonal().norm() + b.edges[eb->edge].second.diagonal().norm();
   // The start points are points of both edges already; Newton from them finds the local extremum.
   double d = pa0.Distance(pb0);
-  Extrema_LocateExtCC local(ca, cb, ea->second, eb->second);
+  Extrema_LocateExtCC local(ca, cb, ea->t, eb->t);
   if (local.IsDone()) {
     Extrema_POnCurv p1, p2;
     local.Point(p1, p2);
