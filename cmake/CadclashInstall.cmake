@@ -1,5 +1,5 @@
-# Installs the three libraries, their headers, the cadclash tool, a CMake package
-# (find_package(cadclash [COMPONENTS collide tessellate import]) → cadclash::<component>) and cadclash.pc.
+# Installs the four libraries, their headers, the cadclash tool, a CMake package
+# (find_package(cadclash [COMPONENTS collide report tessellate import]) → cadclash::<component>) and cadclash.pc.
 #
 # Each library gets its own export file so that a consumer asking only for `collide` needs neither
 # OpenCASCADE nor assimp. The libraries are static by default: their PRIVATE dependencies are exported
@@ -32,6 +32,7 @@ function(cadclash_install_component component)
     DESTINATION ${CADCLASH_INSTALL_CMAKEDIR} COMPONENT cadclash_development)
 endfunction()
 cadclash_install_component(collide cadclash_collide cadclash_triangle_exact)
+cadclash_install_component(report cadclash_report)
 cadclash_install_component(tessellate cadclash_tessellate)
 cadclash_install_component(import cadclash_import)
 

@@ -2,6 +2,8 @@
 #include "cli_common.h"
 #include "html_report.h"
 
+#include "cadclash/report.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -16,8 +18,6 @@
 namespace cadclash::cli {
 namespace {
 
-// Version of the JSON report; see docs/report-schema.md. Bump on any incompatible change.
-constexpr int kReportVersion = 2;
 // Exit code of --fail-on-collision when a penetrating or touching pair (or containment) was found.
 constexpr int kExitCollision = 3;
 // Exit code when --time-budget or --memory-budget ran out: the report was written, marked partial.
@@ -63,17 +63,24 @@ std::vector<InstanceId> select(const Model& m, const std::vector<std::string>& p
   return out;
 }
 
+// Every name of E, for CLI11's IsMember.
+template <class E>
+std::vector<std::string> names_of() {
+  std::vector<std::string> out;
+  for (E e : EnumNames<E>::values) out.emplace_back(EnumNames<E>::name(e));
+  return out;
+}
+
 CollideOptions collide_options(const CheckOptions& o) {
   CollideOptions c;
   c.tolerance = o.tolerance;
   c.clearance = o.clearance;
   c.threads = o.threads;
   c.mode = o.all_triangles ? CollideMode::AllTrianglePairs : CollideMode::EarlyExit;
-  c.version = o.parallel == "v2" ? ParallelVersion::V2 : ParallelVersion::V1;
-  c.schedule = o.schedule == "dynamic" ? Schedule::Dynamic : o.schedule == "static" ? Schedule::Static : Schedule::Guided;
-  c.triangle_level = o.triangle_level == "flat" ? TriangleLevel::Flat
-                     : o.triangle_level == "bvh" ? TriangleLevel::Bvh
-                                                 : TriangleLevel::Auto;
+  // CLI11 checks the names against the same lists (EnumNames, cadclash/report.h).
+  c.version = enum_from_name<ParallelVersion>(o.parallel).value_or(ParallelVersion::V1);
+  c.schedule = enum_from_name<Schedule>(o.schedule).value_or(Schedule::Guided);
+  c.triangle_level = enum_from_name<TriangleLevel>(o.triangle_level).value_or(TriangleLevel::Auto);
   c.use_oaabb = !o.brute_force;
   c.detect_containment = !o.no_containment;
   c.decision = o.exact ? DecisionMode::Exact : o.fast ? DecisionMode::Fast : DecisionMode::Certified;
@@ -83,27 +90,27 @@ CollideOptions collide_options(const CheckOptions& o) {
   return c;
 }
 
+// The report's settings: the query's options, and the tessellation and selection as given.
+ReportSettings report_settings_of(const CheckOptions& o, const CollideOptions& c) {
+  ReportSettings s = report_settings(c);
+  const TessellationOptions tess = effective_tessellation(o.in);
+  s.preset = o.in.preset;
+  s.deflection = tess.linear_deflection;
+  s.relative_deflection = tess.relative;
+  s.angular_deflection = tess.angular_deflection;
+  s.lazy = o.in.lazy;
+  s.exclude_under = o.exclude_under;
+  s.select_a = o.select_a;
+  s.select_b = o.select_b;
+  s.memory_budget_mb = o.memory_budget_mb;  // as given, not rounded through bytes
+  return s;
+}
+
 // "#123" for STEP faces, the group name for mesh groups, else the face index.
 std::string source_label(const Surface& s) {
   if (s.provenance.step_id >= 0) return "#" + std::to_string(s.provenance.step_id);
   if (!s.provenance.source_name.empty()) return s.provenance.source_name;
   return "face " + std::to_string(s.provenance.face_index);
-}
-
-nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json side_json(const Model& m, InstanceId i, SurfaceId s) {
-  const Instance& inst = m.instances[i];
-  nlohmann::json j{{"instance", inst.path}, {"part", m.parts[inst.part].name}};
-  if (s == kInvalidId) return j;
-  const Surface& surf = m.surfaces[s];
-  j["surface"] = surf.name;
-  j["kind"] = source_kind_name(surf.provenance.kind);
-  j["face_index"] = surf.provenance.face_index;
-  if (surf.provenance.step_id >= 0) j["step_id"] = surf.provenance.step_id;
-  if (!surf.provenance.source_name.empty()) j["source_name"] = surf.provenance.source_name;
-  j["deflection"] = surf.deflection;
-  return j;
 }
 
 struct ClassCounts {
@@ -114,61 +121,6 @@ struct ClassCounts {
   // An undecided pair may be a contact: an audit fails safe.
   bool collision() const { return c[0] + c[1] + c[3] + c[4] > 0; }
 };
-
-nlohmann::json summary_json(const Report& r) {
-  ClassCounts n;
-  n.add(r);
-  nlohmann::json by = nlohmann::json::object();
-  for (DecidedBy d : {DecidedBy::Mesh, DecidedBy::MeshExact, DecidedBy::Analytic, DecidedBy::Refined,
-                      DecidedBy::Exact, DecidedBy::Undecided})
-    by[decided_by_name(d)] = 0;
-  for (const SurfacePairResult& p : r.pairs)
-    if (p.contact != ContactClass::Containment) by[decided_by_name(p.decided_by)] = by[decided_by_name(p.decided_by)].get<int>() + 1;
-  return {{"pairs", r.pairs.size()}, {"penetrating", n.c[0]}, {"touching", n.c[1]}, {"clearance", n.c[2]},
-          {"containment", n.c[3]},   {"undecided", n.c[4]},   {"decided_by", by}};
-}
-
-nlohmann::json counters_json(const CollideCounters& c) {
-  return {{"instance_pairs", c.instance_pairs},   {"aabb_tests", c.aabb_tests},
-          {"aabb_updates", c.aabb_updates},       {"surfaces_a", c.surfaces_a},
-          {"surfaces_b", c.surfaces_b},           {"surface_pairs", c.surface_pairs},
-          {"triangles_a", c.triangles_a},         {"triangles_b", c.triangles_b},
-          {"triangle_tests", c.triangle_tests},   {"exact_fallbacks", c.exact_fallbacks},
-          {"distance_tests", c.distance_tests},   {"intersecting_pairs", c.intersecting_pairs},
-          {"tessellated_surfaces", c.tessellated_surfaces}, {"decided_mesh", c.decided_mesh},
-          {"decided_mesh_exact", c.decided_mesh_exact},     {"decided_analytic", c.decided_analytic},
-          {"decided_refined", c.decided_refined},           {"decided_exact", c.decided_exact},
-          {"undecided", c.undecided},                       {"ambiguous_pairs", c.ambiguous_pairs},
-          {"refined_surfaces", c.refined_surfaces},         {"exact_queries", c.exact_queries},
-          {"witness_queries", c.witness_queries},
-          {"dismissed_pairs", c.dismissed_pairs}};
-}
-
-nlohmann::json timings_json(const CollideTimings& t) {
-  return {{"broad", t.broad},
-          {"surface_level", t.surface_level},
-          {"tessellation", t.tessellation},
-          {"triangle_level", t.triangle_level},
-          {"total", t.total}};
-}
-
-nlohmann::json pairs_json(const Model& m, const Report& r) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const SurfacePairResult& p : r.pairs) {
-    nlohmann::json j{{"a", side_json(m, p.instance_a, p.surface_a)},
-                     {"b", side_json(m, p.instance_b, p.surface_b)},
-                     {"class", contact_class_name(p.contact)},
-                     {"decided_by", decided_by_name(p.decided_by)},
-                     {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
-                     {"intersecting", p.intersecting},
-                     {"distance", number_or_null(p.distance)},
-                     {"penetration", p.penetration}};
-    if (p.exact_distance) j["exact_distance"] = *p.exact_distance;
-    if (!p.triangle_pairs.empty()) j["triangle_pairs"] = p.triangle_pairs;
-    out.push_back(std::move(j));
-  }
-  return out;
-}
 
 std::string fmt(double v) {
   if (!std::isfinite(v)) return "-";
@@ -227,15 +179,6 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
        << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
 }
 
-// The budget marker of one query: stopped_by (null when complete) and the instance pairs not examined.
-void add_budget_json(const Model& m, const Report& r, nlohmann::json& j) {
-  j["stopped_by"] = r.complete ? nlohmann::json(nullptr) : nlohmann::json(r.stopped_by);
-  nlohmann::json u = nlohmann::json::array();
-  for (const auto& p : r.unexamined_pairs) u.push_back({{"a", m.instances[p[0]].path}, {"b", m.instances[p[1]].path}});
-  j["unexamined_pairs"] = std::move(u);
-  j["memory_charged_bytes"] = r.memory_charged;
-}
-
 // A loud line (and the first few pairs not examined) when a budget ran out.
 void print_partial(const Model& m, const Report& r, std::ostream& os) {
   if (r.complete) return;
@@ -290,30 +233,9 @@ int run_check(const CheckOptions& o) {
   const CollideOptions copt = collide_options(o);
   Scene scene(m, sel);
 
-  nlohmann::json j;
-  j["schema"] = "cadclash-check-report";
-  j["version"] = kReportVersion;
-  j["files"] = o.in.files;
-  const TessellationOptions tess = effective_tessellation(o.in);
-  j["settings"] = {{"tolerance", o.tolerance},
-                   {"clearance", o.clearance},
-                   {"preset", o.in.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.in.preset)},
-                   {"deflection", tess.linear_deflection},
-                   {"relative_deflection", tess.relative},
-                   {"angular_deflection", tess.angular_deflection},
-                   {"lazy", o.in.lazy},
-                   {"mode", o.all_triangles ? "all-triangle-pairs" : "early-exit"},
-                   {"parallel", o.parallel},
-                   {"schedule", o.schedule},
-                   {"triangle_level", o.triangle_level},
-                   {"oaabb", !o.brute_force},
-                   {"containment", !o.no_containment},
-                   {"decision", o.exact ? "exact" : o.fast ? "fast" : "certified"},
-                   {"exclude_under", o.exclude_under},
-                   {"select_a", o.select_a},
-                   {"select_b", o.select_b},
-                   {"time_budget", o.time_budget},
-                   {"memory_budget_mb", o.memory_budget_mb}};
+  CheckReport report;
+  report.files = o.in.files;
+  report.settings = report_settings_of(o, copt);
   bool collision = false;
   std::string stopped_by;  // first budget that ran out; empty when every query finished
   std::vector<Diagnostic> run_diags;
@@ -332,18 +254,13 @@ int run_check(const CheckOptions& o) {
     if (o.fast) std::cout << "fast mode: classes from the triangles' deflection band, not certified on the exact faces\n";
     print_partial(m, r, std::cout);
     if (!r.complete) stopped_by = r.stopped_by;
-    add_budget_json(m, r, j);
-    j["pairs"] = pairs_json(m, r);
-    j["summary"] = summary_json(r);
-    j["counters"] = counters_json(r.counters);
-    if (!o.no_timings) j["timings"] = timings_json(r.timings);
+    report.query = query_report(m, r);
     shown = std::move(r);
   } else {
     std::vector<Diagnostic> ds;
     std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
     print_diagnostics(ds);
-    j["trajectory"] = o.path_csv;
-    j["steps"] = nlohmann::json::array();
+    report.trajectory = o.path_csv;
     for (const StepResult& s : steps) {
       ClassCounts n;
       n.add(s.report);
@@ -358,39 +275,33 @@ int run_check(const CheckOptions& o) {
         if (stopped_by.empty()) stopped_by = s.report.stopped_by;
       }
       std::cout << '\n';
-      nlohmann::json js{{"step", s.step},
-                        {"pairs", pairs_json(m, s.report)},
-                        {"summary", summary_json(s.report)},
-                        {"counters", counters_json(s.report.counters)}};
-      if (!o.no_timings) js["timings"] = timings_json(s.report.timings);
-      add_budget_json(m, s.report, js);
-      j["steps"].push_back(std::move(js));
+      report.steps.push_back({s.step, query_report(m, s.report)});
     }
     std::size_t distinct_steps = 0;
     for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
     const std::size_t not_checked = distinct_steps - steps.size();
-    j["steps_not_checked"] = not_checked;
+    report.steps_not_checked = not_checked;
     if (not_checked > 0) {
       std::cout << "\nPARTIAL REPORT: stopped by the time budget: " << not_checked << " of " << distinct_steps
                 << " steps not checked\n";
       if (stopped_by.empty()) stopped_by = "time budget";
     }
-    j["stopped_by"] = stopped_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(stopped_by);
-    for (const Diagnostic& d : ds) j["diagnostics"].push_back(format_diagnostic(d));
+    report.stopped_by = stopped_by;
+    for (const Diagnostic& d : ds) report.diagnostics.push_back(format_diagnostic(d));
     if (!steps.empty()) shown = std::move(steps.back().report);
   }
   print_diagnostics(run_diags);
   input_error = input_error || has_error(run_diags);
-  for (const Diagnostic& d : imported.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
-  for (const Diagnostic& d : run_diags) j["diagnostics"].push_back(format_diagnostic(d));
-  if (!j.contains("diagnostics")) j["diagnostics"] = nlohmann::json::array();
-  j["complete"] = imported.complete && !has_error(run_diags) && stopped_by.empty();
+  for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
+  for (const Diagnostic& d : run_diags) report.diagnostics.push_back(format_diagnostic(d));
+  report.complete = imported.complete && !has_error(run_diags) && stopped_by.empty();
   if (!stopped_by.empty())
     std::cerr << "cadclash check: warning: partial report: the " << stopped_by << " ran out before every pair was examined\n";
 
+  const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
   if (!o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);
-    f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+    f << report_text(j);
     if (!f) {
       std::cerr << o.json << ": error: cannot write the report\n";
       return kExitInputError;
@@ -443,10 +354,10 @@ void register_check(CLI::App& app) {
                 "Classes from the triangles' deflection band alone (not certified on the exact faces)")
       ->excludes(exact);
   cmd->add_option("--parallel", o->parallel, "Parallel version: v1 (per surface pair) or v2 (flattened)")
-      ->check(CLI::IsMember({"v1", "v2"}));
-  cmd->add_option("--schedule", o->schedule, "OpenMP schedule")->check(CLI::IsMember({"guided", "dynamic", "static"}));
+      ->check(CLI::IsMember(names_of<ParallelVersion>()));
+  cmd->add_option("--schedule", o->schedule, "OpenMP schedule")->check(CLI::IsMember(names_of<Schedule>()));
   cmd->add_option("--triangle-level", o->triangle_level, "Candidate triangle pairs: auto, flat loops or bvh")
-      ->check(CLI::IsMember({"auto", "flat", "bvh"}));
+      ->check(CLI::IsMember(names_of<TriangleLevel>()));
   cmd->add_option("--select-a", o->select_a, "Check only instances under these paths (set A) ...");
   cmd->add_option("--select-b", o->select_b, "... against instances under these paths (set B)");
   cmd->add_option("--exclude-under", o->exclude_under, "Skip pairs whose instances are both under this sub-assembly path");

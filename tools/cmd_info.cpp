@@ -1,6 +1,8 @@
 // cadclash info: what a file holds — parts, instances, surfaces, triangles.
 #include "cli_common.h"
 
+#include "cadclash/report.h"
+
 #include <nlohmann/json.hpp>
 
 #include <iostream>
@@ -15,14 +17,11 @@ struct InfoOptions {
   bool surfaces = false;
 };
 
-nlohmann::json surface_json(const Surface& s) {
-  nlohmann::json j{{"name", s.name},
-                   {"kind", source_kind_name(s.provenance.kind)},
-                   {"face_index", s.provenance.face_index},
-                   {"triangles", s.mesh.triangles.size()},
-                   {"deflection", s.deflection}};
-  if (s.provenance.step_id >= 0) j["step_id"] = s.provenance.step_id;
-  if (!s.provenance.source_name.empty()) j["source_name"] = s.provenance.source_name;
+// The report's surface fields (cadclash/report.h), the name, the triangle count and the repair flags.
+nlohmann::json info_surface_json(const Surface& s) {
+  nlohmann::json j = surface_json(s);
+  j["name"] = s.name;
+  j["triangles"] = s.mesh.triangles.size();
   if (s.provenance.healed) j["healed"] = true;
   if (s.provenance.repaired) j["repaired"] = true;
   return j;
@@ -76,7 +75,7 @@ int run_info(const InfoOptions& o) {
     for (const Part& p : m.parts) {
       nlohmann::json jp{{"name", p.name}, {"source_file", p.source_file}, {"surfaces", nlohmann::json::array()}};
       for (SurfaceId s = p.first_surface; s < p.first_surface + p.surface_count; ++s) {
-        jp["surfaces"].push_back(surface_json(m.surfaces[s]));
+        jp["surfaces"].push_back(info_surface_json(m.surfaces[s]));
         if (repaired[s] && repaired[s]->changed) jp["surfaces"].back()["repair"] = repair_json(*repaired[s]);
       }
       j["parts"].push_back(jp);
@@ -85,8 +84,7 @@ int run_info(const InfoOptions& o) {
     if (o.in.segment) j["segment"] = {{"surfaces_split", segment.surfaces_split}, {"patches", segment.patches}};
     for (const Instance& i : m.instances) j["instances"].push_back({{"path", i.path}, {"part", i.part}});
     for (const Diagnostic& d : r.diagnostics) j["diagnostics"].push_back(format_diagnostic(d));
-    // File text quoted in names and messages need not be UTF-8; never abort on it.
-    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+    std::cout << report_text(j);  // as the check report: invalid UTF-8 in file text replaced
   } else {
     std::size_t instance_faces = 0;
     for (const Instance& i : m.instances) instance_faces += m.parts[i.part].surface_count;

@@ -3,6 +3,8 @@
 
 #include "cli_common.h"
 
+#include "cadclash/report.h"
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -69,8 +71,6 @@ void put_f32(std::vector<unsigned char>& out, double v) {
   put_u32(out, bits);
 }
 
-nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 // One part's surfaces concatenated: positions and indices, and each surface's triangle range.
 nlohmann::json part_json(const Model& m, PartId p, nlohmann::json& surfaces) {
   const Part& part = m.parts[p];
@@ -84,14 +84,10 @@ nlohmann::json part_json(const Model& m, PartId p, nlohmann::json& surfaces) {
   std::uint32_t base = 0, triangles = 0;
   for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s) {
     const Surface& surf = m.surfaces[s];
-    nlohmann::json js{{"part", p},
-                      {"name", surf.name},
-                      {"kind", source_kind_name(surf.provenance.kind)},
-                      {"face_index", surf.provenance.face_index},
-                      {"deflection", surf.deflection},
-                      {"first_triangle", triangles}};
-    if (surf.provenance.step_id >= 0) js["step_id"] = surf.provenance.step_id;
-    if (!surf.provenance.source_name.empty()) js["source_name"] = surf.provenance.source_name;
+    nlohmann::json js = surface_json(surf);
+    js["part"] = p;
+    js["name"] = surf.name;
+    js["first_triangle"] = triangles;
     std::uint32_t count = 0;
     if (surf.has_triangles) {
       for (const Vec3& v : surf.mesh.vertices)
@@ -135,19 +131,16 @@ nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Repo
     std::vector<double> columns(t.data(), t.data() + 16);  // Eigen is column-major, like three.js
     instances.push_back({{"path", m.instances[i].path}, {"part", m.instances[i].part}, {"matrix", columns}});
   }
+  // The JSON report's pair fields (cadclash/report.h), with ids in place of the sides.
+  const QueryReport q = query_report(m, r);
   nlohmann::json pairs = nlohmann::json::array();
-  for (const SurfacePairResult& p : r.pairs) {
-    nlohmann::json jp{{"instance_a", p.instance_a},
-                      {"instance_b", p.instance_b},
-                      {"surface_a", signed_id(p.surface_a)},
-                      {"surface_b", signed_id(p.surface_b)},
-                      {"class", contact_class_name(p.contact)},
-                      {"decided_by", decided_by_name(p.decided_by)},
-                      {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
-                      {"intersecting", p.intersecting},
-                      {"distance", number_or_null(p.distance)},
-                      {"penetration", p.penetration}};
-    if (p.exact_distance) jp["exact_distance"] = number_or_null(*p.exact_distance);
+  for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+    const SurfacePairResult& p = r.pairs[k];
+    nlohmann::json jp = pair_json(q.pairs[k], /*sides=*/false);
+    jp["instance_a"] = p.instance_a;
+    jp["instance_b"] = p.instance_b;
+    jp["surface_a"] = signed_id(p.surface_a);
+    jp["surface_b"] = signed_id(p.surface_b);
     pairs.push_back(std::move(jp));
   }
   j["parts"] = std::move(parts);

@@ -1,0 +1,293 @@
+// cadclash/report.h — the versioned JSON report of a collision check, in the library.
+//
+// One writer and one reader for the report `cadclash check --json` writes (docs/report-schema.md),
+// the names of every enum the report spells out, the list of counter and timing fields, and the
+// surface/provenance JSON the CLI, the HTML report, the exporters and the Python bindings share.
+//
+// Contracts:
+// - The report is held in plain structs (CheckReport): a query's results with every id resolved to
+//   the names a reader of the JSON sees (instance paths, part and surface names, provenance), so a
+//   report can be written, read back and written again without the model.
+// - check_report_json() writes keys in sorted order and numbers in shortest round-trip form;
+//   check_report_text() is the exact text of `cadclash check --json` (2-space indent, invalid UTF-8
+//   replaced, one trailing newline). The same CheckReport always gives the same bytes.
+// - check_report_from_json() never throws and never prints: malformed input gives a ReportError
+//   naming the JSON pointer of the problem ("/pairs/3/class"). Unknown fields are ignored (adding
+//   a field is not a schema break). For every text T this writer produced,
+//   check_report_text(check_report_from_json(T).report) == T.
+// - Non-finite numbers are written as null and read back as +infinity where the schema allows null.
+// Depends on cadclash::collide and nlohmann_json only (no OpenCASCADE, no assimp).
+#pragma once
+
+#include "cadclash/collide.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cadclash {
+
+inline constexpr std::string_view kCheckReportSchema = "cadclash-check-report";
+// Bumped for any change that can break a reader (a field removed, renamed or given another meaning).
+inline constexpr int kCheckReportVersion = 2;
+
+// ---------------------------------------------------------------------------------------------
+// Enum names: every value of each enum the report spells out, and its name
+// ---------------------------------------------------------------------------------------------
+
+// Returns "early-exit" or "all-triangle-pairs".
+const char* collide_mode_name(CollideMode m);
+// Returns "v1" or "v2".
+const char* parallel_version_name(ParallelVersion v);
+// Returns "guided", "dynamic" or "static".
+const char* schedule_name(Schedule s);
+// Returns "auto", "flat" or "bvh".
+const char* triangle_level_name(TriangleLevel t);
+
+// EnumNames<E>::values lists every value of E in declaration order; EnumNames<E>::name(e) is its
+// name in the report (contact_class_name, decided_by_name, ... of collide.h and model.h).
+template <class E> struct EnumNames;
+template <> struct EnumNames<ContactClass> {
+  static constexpr std::array values{ContactClass::Penetrating, ContactClass::Touching, ContactClass::Clearance,
+                                     ContactClass::Containment, ContactClass::Undecided};
+  static const char* name(ContactClass c) { return contact_class_name(c); }
+};
+template <> struct EnumNames<DecidedBy> {
+  static constexpr std::array values{DecidedBy::Mesh,    DecidedBy::MeshExact, DecidedBy::Analytic,
+                                     DecidedBy::Refined, DecidedBy::Exact,     DecidedBy::Undecided};
+  static const char* name(DecidedBy d) { return decided_by_name(d); }
+};
+template <> struct EnumNames<DecisionMode> {
+  static constexpr std::array values{DecisionMode::Certified, DecisionMode::Fast, DecisionMode::Exact};
+  static const char* name(DecisionMode m) { return decision_mode_name(m); }
+};
+template <> struct EnumNames<SourceKind> {
+  static constexpr std::array values{SourceKind::StepFace, SourceKind::IgesFace,       SourceKind::BrepFace,
+                                     SourceKind::ObjGroup, SourceKind::OffColourGroup, SourceKind::MeshFile,
+                                     SourceKind::Segment};
+  static const char* name(SourceKind k) { return source_kind_name(k); }
+};
+template <> struct EnumNames<CollideMode> {
+  static constexpr std::array values{CollideMode::EarlyExit, CollideMode::AllTrianglePairs};
+  static const char* name(CollideMode m) { return collide_mode_name(m); }
+};
+template <> struct EnumNames<ParallelVersion> {
+  static constexpr std::array values{ParallelVersion::V1, ParallelVersion::V2};
+  static const char* name(ParallelVersion v) { return parallel_version_name(v); }
+};
+template <> struct EnumNames<Schedule> {
+  static constexpr std::array values{Schedule::Guided, Schedule::Dynamic, Schedule::Static};
+  static const char* name(Schedule s) { return schedule_name(s); }
+};
+template <> struct EnumNames<TriangleLevel> {
+  static constexpr std::array values{TriangleLevel::Auto, TriangleLevel::Flat, TriangleLevel::Bvh};
+  static const char* name(TriangleLevel t) { return triangle_level_name(t); }
+};
+
+// The value of E named `name`; nullopt when no value has that name.
+template <class E>
+std::optional<E> enum_from_name(std::string_view name) {
+  for (E e : EnumNames<E>::values)
+    if (name == EnumNames<E>::name(e)) return e;
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Counter and timing fields: the report's (and the bindings') names of each member
+// ---------------------------------------------------------------------------------------------
+
+struct CounterField {
+  const char* name;
+  std::uint64_t CollideCounters::*member;
+};
+// Every CollideCounters member, in the order the schema documents them.
+inline constexpr std::array<CounterField, 24> kCounterFields{{
+    {"instance_pairs", &CollideCounters::instance_pairs},
+    {"aabb_tests", &CollideCounters::aabb_tests},
+    {"aabb_updates", &CollideCounters::aabb_updates},
+    {"surfaces_a", &CollideCounters::surfaces_a},
+    {"surfaces_b", &CollideCounters::surfaces_b},
+    {"surface_pairs", &CollideCounters::surface_pairs},
+    {"triangles_a", &CollideCounters::triangles_a},
+    {"triangles_b", &CollideCounters::triangles_b},
+    {"triangle_tests", &CollideCounters::triangle_tests},
+    {"exact_fallbacks", &CollideCounters::exact_fallbacks},
+    {"distance_tests", &CollideCounters::distance_tests},
+    {"intersecting_pairs", &CollideCounters::intersecting_pairs},
+    {"tessellated_surfaces", &CollideCounters::tessellated_surfaces},
+    {"decided_mesh", &CollideCounters::decided_mesh},
+    {"decided_mesh_exact", &CollideCounters::decided_mesh_exact},
+    {"decided_analytic", &CollideCounters::decided_analytic},
+    {"decided_refined", &CollideCounters::decided_refined},
+    {"decided_exact", &CollideCounters::decided_exact},
+    {"undecided", &CollideCounters::undecided},
+    {"ambiguous_pairs", &CollideCounters::ambiguous_pairs},
+    {"refined_surfaces", &CollideCounters::refined_surfaces},
+    {"witness_queries", &CollideCounters::witness_queries},
+    {"exact_queries", &CollideCounters::exact_queries},
+    {"dismissed_pairs", &CollideCounters::dismissed_pairs},
+}};
+
+struct TimingField {
+  const char* name;
+  double CollideTimings::*member;
+};
+inline constexpr std::array<TimingField, 5> kTimingFields{{
+    {"broad", &CollideTimings::broad},
+    {"surface_level", &CollideTimings::surface_level},
+    {"tessellation", &CollideTimings::tessellation},
+    {"triangle_level", &CollideTimings::triangle_level},
+    {"total", &CollideTimings::total},
+}};
+
+// ---------------------------------------------------------------------------------------------
+// The report as plain structs
+// ---------------------------------------------------------------------------------------------
+
+// `settings`: the options the report was computed with (docs/report-schema.md, "settings").
+struct ReportSettings {
+  double tolerance = 0.0;  // mm
+  double clearance = 0.0;  // mm
+  std::string preset;      // the tessellation preset's name; empty: none (null)
+  double deflection = 0.1;  // in effect (the preset's when one was given): mm, or a fraction when relative
+  bool relative_deflection = false;
+  double angular_deflection = 0.5;  // rad
+  bool lazy = false;
+  CollideMode mode = CollideMode::EarlyExit;
+  ParallelVersion parallel = ParallelVersion::V1;
+  Schedule schedule = Schedule::Guided;
+  TriangleLevel triangle_level = TriangleLevel::Auto;
+  bool oaabb = true;
+  bool containment = true;
+  DecisionMode decision = DecisionMode::Certified;
+  std::vector<std::string> exclude_under, select_a, select_b;  // path prefixes as given
+  double time_budget = 0.0;       // s; 0 = none
+  double memory_budget_mb = 0.0;  // MiB; 0 = none
+};
+
+// The query half of the settings from `o` (tolerance ... memory_budget_mb; memory_budget_mb =
+// memory_budget_bytes / 2^20). Tessellation fields and the path prefixes keep their defaults.
+ReportSettings report_settings(const CollideOptions& o);
+
+// One side of a pair. For containment (`whole_part`) only `instance` and `part` are written.
+struct ReportSide {
+  std::string instance;  // instance path
+  std::string part;      // part name
+  bool whole_part = false;
+  std::string surface;   // surface name within the part
+  SourceKind kind = SourceKind::MeshFile;
+  std::int32_t face_index = -1;
+  std::int64_t step_id = -1;  // < 0: not written
+  std::string source_name;    // empty: not written
+  double deflection = 0.0;
+};
+
+struct ReportPair {
+  ReportSide a, b;
+  ContactClass contact = ContactClass::Touching;
+  DecidedBy decided_by = DecidedBy::Mesh;
+  double distance_lo = 0.0, distance_hi = 0.0;  // +infinity: unbounded (null)
+  bool intersecting = false;
+  double distance = 0.0;  // +infinity: null
+  double penetration = 0.0;
+  std::optional<double> exact_distance;
+  std::vector<std::array<std::uint32_t, 2>> triangle_pairs;  // --all-triangles only
+};
+
+// One query's results: top level of a report without a trajectory, or one step of one.
+struct QueryReport {
+  std::vector<ReportPair> pairs;
+  CollideCounters counters;
+  std::optional<CollideTimings> timings;  // absent: not written (--no-timings)
+  std::string stopped_by;                 // empty: every instance pair was examined (null)
+  std::vector<std::array<std::string, 2>> unexamined_pairs;  // instance paths
+  std::uint64_t memory_charged_bytes = 0;
+};
+
+struct StepReport {
+  std::int64_t step = 0;
+  QueryReport query;
+};
+
+struct CheckReport {
+  int version = kCheckReportVersion;
+  std::vector<std::string> files;  // as given
+  ReportSettings settings;
+  // Without a trajectory: the query (top-level pairs, summary, counters, timings, stopped_by,
+  // unexamined_pairs, memory_charged_bytes). With one: nullopt, and the fields below.
+  std::optional<QueryReport> query;
+  std::string trajectory;  // the CSV file
+  std::vector<StepReport> steps;
+  std::uint64_t steps_not_checked = 0;
+  std::string stopped_by;  // first budget that ran out over the steps; empty: none (null)
+  std::vector<std::string> diagnostics;  // format_diagnostic() lines
+  bool complete = true;
+};
+
+// `r` over `model` with every id resolved to names: what the report says about one query.
+// Timings are included; reset `timings` to leave them out.
+// Precondition: every id in `r` is valid for `model`.
+QueryReport query_report(const Model& model, const Report& r);
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+// ---------------------------------------------------------------------------------------------
+
+struct ReportWriteOptions {
+  bool timings = true;  // false: leave every `timings` out, as --no-timings does
+};
+
+nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions& o = {});
+// The file `cadclash check --json` writes: check_report_json(r, o) as report_text().
+std::string check_report_text(const CheckReport& r, const ReportWriteOptions& o = {});
+// JSON as the report files are written: 2-space indent, invalid UTF-8 replaced, a final newline.
+std::string report_text(const nlohmann::json& j);
+
+// The pieces, for the JSON documents built around them (HTML report, `cadclash info`):
+// `summary`: counts per class and per decided_by (containment excluded from decided_by).
+nlohmann::json summary_json(const std::vector<ReportPair>& pairs);
+nlohmann::json counters_json(const CollideCounters& c);
+nlohmann::json timings_json(const CollideTimings& t);
+// One pair's fields; the sides `a`/`b` only with `sides`.
+nlohmann::json pair_json(const ReportPair& p, bool sides = true);
+// What every JSON of cadclash says about a surface: kind, face_index, deflection, and step_id /
+// source_name when it has them (the name is left to the caller: "surface" or "name").
+nlohmann::json surface_json(const Surface& s);
+// v when finite, else null.
+nlohmann::json number_or_null(double v);
+
+// A surface's name and complete provenance (the OBJ comment lines and the .glb extras of the
+// exporters): every Provenance field, the deflection, and the part-local box when not empty.
+nlohmann::json provenance_json(const Surface& s);
+
+// ---------------------------------------------------------------------------------------------
+// Reading
+// ---------------------------------------------------------------------------------------------
+
+struct ReportError {
+  std::string path;     // JSON pointer of the offending value ("/pairs/3/class"); "" = the whole text
+  std::string message;  // one sentence
+};
+// "path: message" (or the message alone when the path is empty).
+std::string format_report_error(const ReportError& e);
+
+struct ReportReadResult {
+  CheckReport report;                // meaningful only when !error
+  std::optional<ReportError> error;  // the first problem found
+};
+
+// Parses a report written by check_report_text() (schema "cadclash-check-report", version 2).
+// Checks types, enum names, that `summary` matches the pairs, and the trajectory/query layout.
+ReportReadResult check_report_from_json(std::string_view text);
+ReportReadResult check_report_from_json(const nlohmann::json& j);
+
+// Reads back what provenance_json() wrote into `s` (name, provenance, deflection, box; the box is
+// emptied when none was written). Returns the first problem; `s` is then partly assigned.
+std::optional<ReportError> provenance_from_json(const nlohmann::json& j, Surface& s);
+
+}  // namespace cadclash

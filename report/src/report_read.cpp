@@ -1,0 +1,275 @@
+// The report's reader: JSON back into CheckReport, with the JSON pointer of the first problem.
+#include "cadclash/report.h"
+
+#include <limits>
+#include <utility>
+
+namespace cadclash {
+namespace {
+
+using Json = nlohmann::json;
+
+// Thrown inside this file only; the public functions turn it into a ReportError.
+struct ReadFailure {
+  ReportError error;
+};
+
+[[noreturn]] void fail(const std::string& path, std::string message) { throw ReadFailure{{path, std::move(message)}}; }
+
+const Json& object(const Json& j, const std::string& path) {
+  if (!j.is_object()) fail(path, "expected an object");
+  return j;
+}
+
+const Json& array(const Json& j, const std::string& path) {
+  if (!j.is_array()) fail(path, "expected an array");
+  return j;
+}
+
+// The member `key` of the object `j` at `path`.
+const Json& field(const Json& j, const std::string& path, const char* key) {
+  object(j, path);
+  const auto it = j.find(key);
+  if (it == j.end()) fail(path + "/" + key, "is missing");
+  return *it;
+}
+
+std::string text(const Json& j, const std::string& path) {
+  if (!j.is_string()) fail(path, "expected a string");
+  return j.get<std::string>();
+}
+
+bool boolean(const Json& j, const std::string& path) {
+  if (!j.is_boolean()) fail(path, "expected true or false");
+  return j.get<bool>();
+}
+
+// A number; null (a non-finite value when written) reads as +infinity where `null_ok`.
+double number(const Json& j, const std::string& path, bool null_ok = false) {
+  if (null_ok && j.is_null()) return std::numeric_limits<double>::infinity();
+  if (!j.is_number()) fail(path, null_ok ? "expected a number or null" : "expected a number");
+  return j.get<double>();
+}
+
+std::int64_t integer(const Json& j, const std::string& path, std::int64_t lo, std::int64_t hi) {
+  if (!j.is_number_integer()) fail(path, "expected an integer");
+  if (j.is_number_unsigned() ? j.get<std::uint64_t>() > static_cast<std::uint64_t>(hi) : j.get<std::int64_t>() < lo ||
+                                                                                             j.get<std::int64_t>() > hi)
+    fail(path, "is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return j.get<std::int64_t>();
+}
+
+std::uint64_t count(const Json& j, const std::string& path) {
+  if (!j.is_number_unsigned()) fail(path, "expected a non-negative integer");
+  return j.get<std::uint64_t>();
+}
+
+std::string string_or_null(const Json& j, const std::string& path) { return j.is_null() ? std::string() : text(j, path); }
+
+std::vector<std::string> strings(const Json& j, const std::string& path) {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < array(j, path).size(); ++k) out.push_back(text(j[k], path + "/" + std::to_string(k)));
+  return out;
+}
+
+template <class E>
+E named(const Json& j, const std::string& path, const char* what) {
+  const std::string name = text(j, path);
+  if (const std::optional<E> e = enum_from_name<E>(name)) return *e;
+  std::string known;
+  for (E e : EnumNames<E>::values) known += std::string(known.empty() ? "" : ", ") + EnumNames<E>::name(e);
+  fail(path, "unknown " + std::string(what) + " '" + name + "' (one of " + known + ")");
+}
+
+ReportSettings read_settings(const Json& j, const std::string& p) {
+  ReportSettings s;
+  s.tolerance = number(field(j, p, "tolerance"), p + "/tolerance");
+  s.clearance = number(field(j, p, "clearance"), p + "/clearance");
+  s.preset = string_or_null(field(j, p, "preset"), p + "/preset");
+  s.deflection = number(field(j, p, "deflection"), p + "/deflection");
+  s.relative_deflection = boolean(field(j, p, "relative_deflection"), p + "/relative_deflection");
+  s.angular_deflection = number(field(j, p, "angular_deflection"), p + "/angular_deflection");
+  s.lazy = boolean(field(j, p, "lazy"), p + "/lazy");
+  s.mode = named<CollideMode>(field(j, p, "mode"), p + "/mode", "mode");
+  s.parallel = named<ParallelVersion>(field(j, p, "parallel"), p + "/parallel", "parallel version");
+  s.schedule = named<Schedule>(field(j, p, "schedule"), p + "/schedule", "schedule");
+  s.triangle_level = named<TriangleLevel>(field(j, p, "triangle_level"), p + "/triangle_level", "triangle level");
+  s.oaabb = boolean(field(j, p, "oaabb"), p + "/oaabb");
+  s.containment = boolean(field(j, p, "containment"), p + "/containment");
+  s.decision = named<DecisionMode>(field(j, p, "decision"), p + "/decision", "decision");
+  s.exclude_under = strings(field(j, p, "exclude_under"), p + "/exclude_under");
+  s.select_a = strings(field(j, p, "select_a"), p + "/select_a");
+  s.select_b = strings(field(j, p, "select_b"), p + "/select_b");
+  s.time_budget = number(field(j, p, "time_budget"), p + "/time_budget");
+  s.memory_budget_mb = number(field(j, p, "memory_budget_mb"), p + "/memory_budget_mb");
+  return s;
+}
+
+ReportSide read_side(const Json& j, const std::string& p) {
+  ReportSide s;
+  s.instance = text(field(j, p, "instance"), p + "/instance");
+  s.part = text(field(j, p, "part"), p + "/part");
+  s.whole_part = !j.contains("surface");
+  if (s.whole_part) return s;
+  s.surface = text(field(j, p, "surface"), p + "/surface");
+  s.kind = named<SourceKind>(field(j, p, "kind"), p + "/kind", "surface kind");
+  s.face_index = static_cast<std::int32_t>(integer(field(j, p, "face_index"), p + "/face_index", INT32_MIN, INT32_MAX));
+  if (j.contains("step_id")) s.step_id = integer(j["step_id"], p + "/step_id", 0, INT64_MAX);
+  if (j.contains("source_name")) s.source_name = text(j["source_name"], p + "/source_name");
+  s.deflection = number(field(j, p, "deflection"), p + "/deflection");
+  return s;
+}
+
+ReportPair read_pair(const Json& j, const std::string& p) {
+  ReportPair r;
+  r.a = read_side(field(j, p, "a"), p + "/a");
+  r.b = read_side(field(j, p, "b"), p + "/b");
+  r.contact = named<ContactClass>(field(j, p, "class"), p + "/class", "contact class");
+  r.decided_by = named<DecidedBy>(field(j, p, "decided_by"), p + "/decided_by", "decided_by value");
+  if ((r.contact == ContactClass::Containment) != (r.a.whole_part && r.b.whole_part) || r.a.whole_part != r.b.whole_part)
+    fail(p, "the sides name surfaces exactly when the class is not containment");
+  const std::string pi = p + "/distance_interval";
+  const Json& interval = array(field(j, p, "distance_interval"), pi);
+  if (interval.size() != 2) fail(pi, "expected [lo, hi]");
+  r.distance_lo = number(interval[0], pi + "/0", true);
+  r.distance_hi = number(interval[1], pi + "/1", true);
+  r.intersecting = boolean(field(j, p, "intersecting"), p + "/intersecting");
+  r.distance = number(field(j, p, "distance"), p + "/distance", true);
+  r.penetration = number(field(j, p, "penetration"), p + "/penetration");
+  if (j.contains("exact_distance")) r.exact_distance = number(j["exact_distance"], p + "/exact_distance", true);
+  if (j.contains("triangle_pairs")) {
+    const std::string pt = p + "/triangle_pairs";
+    const Json& t = array(j["triangle_pairs"], pt);
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      const std::string pk = pt + "/" + std::to_string(k);
+      if (!t[k].is_array() || t[k].size() != 2) fail(pk, "expected [triangle of A, triangle of B]");
+      r.triangle_pairs.push_back({static_cast<std::uint32_t>(integer(t[k][0], pk + "/0", 0, UINT32_MAX)),
+                                  static_cast<std::uint32_t>(integer(t[k][1], pk + "/1", 0, UINT32_MAX))});
+    }
+  }
+  return r;
+}
+
+// Every member of `expected` is in `actual` with the same value (recursively for objects).
+bool agrees(const Json& expected, const Json& actual) {
+  if (!expected.is_object()) return expected == actual;
+  if (!actual.is_object()) return false;
+  for (const auto& [key, value] : expected.items())
+    if (!actual.contains(key) || !agrees(value, actual[key])) return false;
+  return true;
+}
+
+QueryReport read_query(const Json& j, const std::string& p) {
+  QueryReport q;
+  const Json& pairs = array(field(j, p, "pairs"), p + "/pairs");
+  for (std::size_t k = 0; k < pairs.size(); ++k) q.pairs.push_back(read_pair(pairs[k], p + "/pairs/" + std::to_string(k)));
+  const std::string ps = p + "/summary";
+  if (!agrees(summary_json(q.pairs), object(field(j, p, "summary"), ps)))
+    fail(ps, "does not match the pairs (expected " + summary_json(q.pairs).dump() + ")");
+  const std::string pc = p + "/counters";
+  const Json& counters = object(field(j, p, "counters"), pc);
+  for (const CounterField& f : kCounterFields) q.counters.*f.member = count(field(counters, pc, f.name), pc + "/" + f.name);
+  if (j.contains("timings")) {
+    const std::string pt = p + "/timings";
+    CollideTimings t;
+    for (const TimingField& f : kTimingFields) t.*f.member = number(field(j["timings"], pt, f.name), pt + "/" + f.name);
+    q.timings = t;
+  }
+  q.stopped_by = string_or_null(field(j, p, "stopped_by"), p + "/stopped_by");
+  const std::string pu = p + "/unexamined_pairs";
+  const Json& u = array(field(j, p, "unexamined_pairs"), pu);
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    const std::string pk = pu + "/" + std::to_string(k);
+    q.unexamined_pairs.push_back({text(field(u[k], pk, "a"), pk + "/a"), text(field(u[k], pk, "b"), pk + "/b")});
+  }
+  q.memory_charged_bytes = count(field(j, p, "memory_charged_bytes"), p + "/memory_charged_bytes");
+  return q;
+}
+
+CheckReport read_report(const Json& j) {
+  CheckReport r;
+  object(j, "");
+  if (text(field(j, "", "schema"), "/schema") != kCheckReportSchema)
+    fail("/schema", "expected \"" + std::string(kCheckReportSchema) + "\"");
+  r.version = static_cast<int>(integer(field(j, "", "version"), "/version", 0, INT32_MAX));
+  if (r.version != kCheckReportVersion)
+    fail("/version", "version " + std::to_string(r.version) + " is not supported (this reader reads version " +
+                         std::to_string(kCheckReportVersion) + ")");
+  r.files = strings(field(j, "", "files"), "/files");
+  r.settings = read_settings(object(field(j, "", "settings"), "/settings"), "/settings");
+  if (j.contains("steps")) {
+    r.trajectory = text(field(j, "", "trajectory"), "/trajectory");
+    const Json& steps = array(j["steps"], "/steps");
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      const std::string pk = "/steps/" + std::to_string(k);
+      r.steps.push_back({integer(field(steps[k], pk, "step"), pk + "/step", INT64_MIN, INT64_MAX), read_query(steps[k], pk)});
+    }
+    r.steps_not_checked = count(field(j, "", "steps_not_checked"), "/steps_not_checked");
+    r.stopped_by = string_or_null(field(j, "", "stopped_by"), "/stopped_by");
+  } else {
+    r.query = read_query(j, "");
+  }
+  r.diagnostics = strings(field(j, "", "diagnostics"), "/diagnostics");
+  r.complete = boolean(field(j, "", "complete"), "/complete");
+  return r;
+}
+
+}  // namespace
+
+std::string format_report_error(const ReportError& e) { return e.path.empty() ? e.message : e.path + ": " + e.message; }
+
+ReportReadResult check_report_from_json(const nlohmann::json& j) {
+  ReportReadResult out;
+  try {
+    out.report = read_report(j);
+  } catch (const ReadFailure& f) {
+    out.error = f.error;
+  }
+  return out;
+}
+
+ReportReadResult check_report_from_json(std::string_view text) {
+  Json j = Json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) {
+    ReportReadResult out;
+    out.error = ReportError{"", "not valid JSON"};
+    return out;
+  }
+  return check_report_from_json(j);
+}
+
+std::optional<ReportError> provenance_from_json(const nlohmann::json& j, Surface& s) {
+  try {
+    Provenance& p = s.provenance;
+    s.name = text(field(j, "", "name"), "/name");
+    p.kind = named<SourceKind>(field(j, "", "kind"), "/kind", "surface kind");
+    p.step_id = integer(field(j, "", "step_id"), "/step_id", INT64_MIN, INT64_MAX);
+    p.face_index = static_cast<std::int32_t>(integer(field(j, "", "face_index"), "/face_index", INT32_MIN, INT32_MAX));
+    p.source_name = text(field(j, "", "source_name"), "/source_name");
+    p.source_file = text(field(j, "", "source_file"), "/source_file");
+    s.deflection = number(field(j, "", "deflection"), "/deflection");
+    p.healed = boolean(field(j, "", "healed"), "/healed");
+    p.repaired = boolean(field(j, "", "repaired"), "/repaired");
+    p.parent = j.contains("parent") ? static_cast<SurfaceId>(integer(j["parent"], "/parent", 0, UINT32_MAX)) : kInvalidId;
+    p.colour.reset();
+    if (j.contains("colour")) {
+      const Json& c = array(j["colour"], "/colour");
+      if (c.size() != 3) fail("/colour", "expected [r, g, b]");
+      p.colour = std::array<float, 3>{};
+      for (std::size_t k = 0; k < 3; ++k) (*p.colour)[k] = static_cast<float>(number(c[k], "/colour/" + std::to_string(k)));
+    }
+    s.aabb.setEmpty();
+    if (j.contains("aabb")) {
+      const Json& b = array(j["aabb"], "/aabb");
+      if (b.size() != 6) fail("/aabb", "expected [min x, y, z, max x, y, z]");
+      double v[6];
+      for (std::size_t k = 0; k < 6; ++k) v[k] = number(b[k], "/aabb/" + std::to_string(k));
+      s.aabb = Aabb(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]));
+    }
+  } catch (const ReadFailure& f) {
+    return f.error;
+  }
+  return std::nullopt;
+}
+
+}  // namespace cadclash

@@ -1,0 +1,260 @@
+// The report's writer: enum names, the model + query → QueryReport resolution, and the JSON.
+#include "cadclash/report.h"
+
+#include <cmath>
+#include <limits>
+
+namespace cadclash {
+
+const char* collide_mode_name(CollideMode m) {
+  return m == CollideMode::AllTrianglePairs ? "all-triangle-pairs" : "early-exit";
+}
+
+const char* parallel_version_name(ParallelVersion v) { return v == ParallelVersion::V2 ? "v2" : "v1"; }
+
+const char* schedule_name(Schedule s) {
+  switch (s) {
+    case Schedule::Dynamic: return "dynamic";
+    case Schedule::Static: return "static";
+    case Schedule::Guided: break;
+  }
+  return "guided";
+}
+
+const char* triangle_level_name(TriangleLevel t) {
+  switch (t) {
+    case TriangleLevel::Flat: return "flat";
+    case TriangleLevel::Bvh: return "bvh";
+    case TriangleLevel::Auto: break;
+  }
+  return "auto";
+}
+
+ReportSettings report_settings(const CollideOptions& o) {
+  ReportSettings s;
+  s.tolerance = o.tolerance;
+  s.clearance = o.clearance;
+  s.mode = o.mode;
+  s.parallel = o.version;
+  s.schedule = o.schedule;
+  s.triangle_level = o.triangle_level;
+  s.oaabb = o.use_oaabb;
+  s.containment = o.detect_containment;
+  s.decision = o.decision;
+  s.time_budget = o.time_budget_seconds;
+  s.memory_budget_mb = static_cast<double>(o.memory_budget_bytes) / (1024.0 * 1024.0);
+  return s;
+}
+
+namespace {
+
+ReportSide side(const Model& m, InstanceId i, SurfaceId s) {
+  const Instance& inst = m.instances[i];
+  ReportSide out;
+  out.instance = inst.path;
+  out.part = m.parts[inst.part].name;
+  out.whole_part = s == kInvalidId;
+  if (out.whole_part) return out;
+  const Surface& surf = m.surfaces[s];
+  out.surface = surf.name;
+  out.kind = surf.provenance.kind;
+  out.face_index = surf.provenance.face_index;
+  out.step_id = surf.provenance.step_id;
+  out.source_name = surf.provenance.source_name;
+  out.deflection = surf.deflection;
+  return out;
+}
+
+double or_infinity(double v) { return std::isfinite(v) ? v : std::numeric_limits<double>::infinity(); }
+
+nlohmann::json side_json(const ReportSide& s) {
+  nlohmann::json j{{"instance", s.instance}, {"part", s.part}};
+  if (s.whole_part) return j;
+  j["surface"] = s.surface;
+  j["kind"] = source_kind_name(s.kind);
+  j["face_index"] = s.face_index;
+  if (s.step_id >= 0) j["step_id"] = s.step_id;
+  if (!s.source_name.empty()) j["source_name"] = s.source_name;
+  j["deflection"] = s.deflection;
+  return j;
+}
+
+nlohmann::json string_or_null(const std::string& s) { return s.empty() ? nlohmann::json(nullptr) : nlohmann::json(s); }
+
+nlohmann::json settings_json(const ReportSettings& s) {
+  return {{"tolerance", s.tolerance},
+          {"clearance", s.clearance},
+          {"preset", string_or_null(s.preset)},
+          {"deflection", s.deflection},
+          {"relative_deflection", s.relative_deflection},
+          {"angular_deflection", s.angular_deflection},
+          {"lazy", s.lazy},
+          {"mode", collide_mode_name(s.mode)},
+          {"parallel", parallel_version_name(s.parallel)},
+          {"schedule", schedule_name(s.schedule)},
+          {"triangle_level", triangle_level_name(s.triangle_level)},
+          {"oaabb", s.oaabb},
+          {"containment", s.containment},
+          {"decision", decision_mode_name(s.decision)},
+          {"exclude_under", s.exclude_under},
+          {"select_a", s.select_a},
+          {"select_b", s.select_b},
+          {"time_budget", s.time_budget},
+          {"memory_budget_mb", s.memory_budget_mb}};
+}
+
+// The fields of one query, into `j` (the top level, or a step).
+void put_query(const QueryReport& q, const ReportWriteOptions& o, nlohmann::json& j) {
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const ReportPair& p : q.pairs) pairs.push_back(pair_json(p));
+  j["pairs"] = std::move(pairs);
+  j["summary"] = summary_json(q.pairs);
+  j["counters"] = counters_json(q.counters);
+  if (o.timings && q.timings) j["timings"] = timings_json(*q.timings);
+  j["stopped_by"] = string_or_null(q.stopped_by);
+  nlohmann::json u = nlohmann::json::array();
+  for (const auto& [a, b] : q.unexamined_pairs) u.push_back({{"a", a}, {"b", b}});
+  j["unexamined_pairs"] = std::move(u);
+  j["memory_charged_bytes"] = q.memory_charged_bytes;
+}
+
+}  // namespace
+
+QueryReport query_report(const Model& model, const Report& r) {
+  QueryReport q;
+  q.pairs.reserve(r.pairs.size());
+  for (const SurfacePairResult& p : r.pairs) {
+    ReportPair out;
+    out.a = side(model, p.instance_a, p.surface_a);
+    out.b = side(model, p.instance_b, p.surface_b);
+    out.contact = p.contact;
+    out.decided_by = p.decided_by;
+    out.distance_lo = or_infinity(p.distance_lo);
+    out.distance_hi = or_infinity(p.distance_hi);
+    out.intersecting = p.intersecting;
+    out.distance = or_infinity(p.distance);
+    out.penetration = p.penetration;
+    if (p.exact_distance) out.exact_distance = or_infinity(*p.exact_distance);
+    out.triangle_pairs = p.triangle_pairs;
+    q.pairs.push_back(std::move(out));
+  }
+  q.counters = r.counters;
+  q.timings = r.timings;
+  if (!r.complete) q.stopped_by = r.stopped_by;
+  for (const auto& [a, b] : r.unexamined_pairs) q.unexamined_pairs.push_back({model.instances[a].path, model.instances[b].path});
+  q.memory_charged_bytes = r.memory_charged;
+  return q;
+}
+
+nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json summary_json(const std::vector<ReportPair>& pairs) {
+  std::array<std::size_t, EnumNames<ContactClass>::values.size()> by_class{};
+  std::array<std::size_t, EnumNames<DecidedBy>::values.size()> by_decision{};
+  for (const ReportPair& p : pairs) {
+    ++by_class[static_cast<std::size_t>(p.contact)];
+    if (p.contact != ContactClass::Containment) ++by_decision[static_cast<std::size_t>(p.decided_by)];
+  }
+  nlohmann::json j{{"pairs", pairs.size()}};
+  for (ContactClass c : EnumNames<ContactClass>::values) j[contact_class_name(c)] = by_class[static_cast<std::size_t>(c)];
+  nlohmann::json by = nlohmann::json::object();
+  for (DecidedBy d : EnumNames<DecidedBy>::values) by[decided_by_name(d)] = by_decision[static_cast<std::size_t>(d)];
+  j["decided_by"] = std::move(by);
+  return j;
+}
+
+nlohmann::json counters_json(const CollideCounters& c) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const CounterField& f : kCounterFields) j[f.name] = c.*f.member;
+  return j;
+}
+
+nlohmann::json timings_json(const CollideTimings& t) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const TimingField& f : kTimingFields) j[f.name] = t.*f.member;
+  return j;
+}
+
+nlohmann::json pair_json(const ReportPair& p, bool sides) {
+  nlohmann::json j{{"class", contact_class_name(p.contact)},
+                   {"decided_by", decided_by_name(p.decided_by)},
+                   {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
+                   {"intersecting", p.intersecting},
+                   {"distance", number_or_null(p.distance)},
+                   {"penetration", p.penetration}};
+  if (p.exact_distance) j["exact_distance"] = number_or_null(*p.exact_distance);
+  if (!sides) return j;
+  j["a"] = side_json(p.a);
+  j["b"] = side_json(p.b);
+  if (!p.triangle_pairs.empty()) j["triangle_pairs"] = p.triangle_pairs;
+  return j;
+}
+
+nlohmann::json surface_json(const Surface& s) {
+  ReportSide side;
+  side.kind = s.provenance.kind;
+  side.face_index = s.provenance.face_index;
+  side.step_id = s.provenance.step_id;
+  side.source_name = s.provenance.source_name;
+  side.deflection = s.deflection;
+  nlohmann::json j = side_json(side);
+  j.erase("instance");
+  j.erase("part");
+  j.erase("surface");
+  return j;
+}
+
+nlohmann::json provenance_json(const Surface& s) {
+  const Provenance& p = s.provenance;
+  nlohmann::json j{{"name", s.name},
+                   {"kind", source_kind_name(p.kind)},
+                   {"step_id", p.step_id},
+                   {"face_index", p.face_index},
+                   {"source_name", p.source_name},
+                   {"source_file", p.source_file},
+                   {"deflection", s.deflection},
+                   {"healed", p.healed},
+                   {"repaired", p.repaired}};
+  if (p.parent != kInvalidId) j["parent"] = p.parent;
+  if (p.colour) j["colour"] = *p.colour;
+  // B-rep surfaces carry a box around the exact surface, larger than their triangles' box.
+  if (!s.aabb.isEmpty())
+    j["aabb"] = {s.aabb.min().x(), s.aabb.min().y(), s.aabb.min().z(), s.aabb.max().x(), s.aabb.max().y(), s.aabb.max().z()};
+  return j;
+}
+
+nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions& o) {
+  nlohmann::json j;
+  j["schema"] = kCheckReportSchema;
+  j["version"] = r.version;
+  j["files"] = r.files;
+  j["settings"] = settings_json(r.settings);
+  if (r.query) {
+    put_query(*r.query, o, j);
+  } else {
+    j["trajectory"] = r.trajectory;
+    nlohmann::json steps = nlohmann::json::array();
+    for (const StepReport& s : r.steps) {
+      nlohmann::json js{{"step", s.step}};
+      put_query(s.query, o, js);
+      steps.push_back(std::move(js));
+    }
+    j["steps"] = std::move(steps);
+    j["steps_not_checked"] = r.steps_not_checked;
+    j["stopped_by"] = string_or_null(r.stopped_by);
+  }
+  j["diagnostics"] = r.diagnostics;
+  j["complete"] = r.complete;
+  return j;
+}
+
+std::string report_text(const nlohmann::json& j) {
+  // File text quoted in names and messages need not be UTF-8; never abort on it.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n';
+}
+
+std::string check_report_text(const CheckReport& r, const ReportWriteOptions& o) {
+  return report_text(check_report_json(r, o));
+}
+
+}  // namespace cadclash
