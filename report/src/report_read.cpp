@@ -218,7 +218,7 @@ CheckReport read_report(const Json& j) {
 
 std::string format_report_error(const ReportError& e) { return e.path.empty() ? e.message : e.path + ": " + e.message; }
 
-ReportReadResult check_report_from_json(const nlohmann::json& j) {
+ReportReadResult check_report_from_parsed(const nlohmann::json& j) {
   ReportReadResult out;
   try {
     out.report = read_report(j);
@@ -235,7 +235,7 @@ ReportReadResult check_report_from_json(std::string_view text) {
     out.error = ReportError{"", "not valid JSON"};
     return out;
   }
-  return check_report_from_json(j);
+  return check_report_from_parsed(j);
 }
 
 std::optional<ReportError> provenance_from_json(const nlohmann::json& j, Surface& s) {

@@ -284,7 +284,8 @@ struct ReportReadResult {
 // Parses a report written by check_report_text() (schema "cadclash-check-report", version 2).
 // Checks types, enum names, that `summary` matches the pairs, and the trajectory/query layout.
 ReportReadResult check_report_from_json(std::string_view text);
-ReportReadResult check_report_from_json(const nlohmann::json& j);
+// The same on a document already parsed.
+ReportReadResult check_report_from_parsed(const nlohmann::json& j);
 
 // Reads back what provenance_json() wrote into `s` (name, provenance, deflection, box; the box is
 // emptied when none was written). Returns the first problem; `s` is then partly assigned.
