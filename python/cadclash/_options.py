@@ -9,9 +9,10 @@ from . import _cadclash as _core
 
 __all__ = ["CollideOptions"]
 
-_PARALLEL = {"v1": _core.ParallelVersion.V1, "v2": _core.ParallelVersion.V2}
-_SCHEDULE = {"guided": _core.Schedule.Guided, "dynamic": _core.Schedule.Dynamic, "static": _core.Schedule.Static}
-_TRIANGLE_LEVEL = {"auto": _core.TriangleLevel.Auto, "flat": _core.TriangleLevel.Flat, "bvh": _core.TriangleLevel.Bvh}
+# Name -> value, from the C++ library's name tables (cadclash/report.h): the CLI's switch values.
+_PARALLEL = _core.PARALLEL_VERSIONS
+_SCHEDULE = _core.SCHEDULES
+_TRIANGLE_LEVEL = _core.TRIANGLE_LEVELS
 
 
 @dataclass(frozen=True)

@@ -16,8 +16,9 @@ __all__ = ["Scene", "collide", "replay"]
 InstanceKey = Union[int, str, Instance]
 
 
-def _report(model: Model, raw) -> Report:
-    raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged = raw
+def _report(model: Model, raw, settings=None) -> Report:
+    """The Report of one query; with the report's ``settings`` it also holds its JSON document."""
+    raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged, record = raw
     paths, part_names, surface_names, step_ids = model._names()
     pairs = []
     for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri, by, lo, hi in raw_pairs:
@@ -30,8 +31,24 @@ def _report(model: Model, raw) -> Report:
             penetration=penetration, exact_distance=exact, instance_id_a=ia, instance_id_b=ib,
             surface_id_a=None if whole else sa, surface_id_b=None if whole else sb, triangle_pairs=tri,
             decided_by=by, distance_lo=lo, distance_hi=hi))
-    return Report(pairs, Counters(**counters), Timings(**timings), _diagnostics(diags), complete, stopped_by,
-                  [(paths[a], paths[b]) for a, b in unexamined], memory_charged)
+    run_diagnostics = _diagnostics(diags)
+    document = None
+    if settings is not None:  # as `cadclash check --json` assembles it
+        document = _core.ReportDocument(
+            list(model.files), settings, record, [str(d) for d in model.diagnostics + run_diagnostics],
+            model.complete and complete and not any(d.is_error for d in run_diagnostics))
+    return Report(pairs, Counters(**counters), Timings(**timings), run_diagnostics, complete, stopped_by,
+                  [(paths[a], paths[b]) for a, b in unexamined], memory_charged, document)
+
+
+def _given(model: Model, keys) -> List[str]:
+    """select_a / select_b as the report's settings show them: path prefixes as given, ids and
+    Instances as their paths."""
+    if keys is None:
+        return []
+    if isinstance(keys, (str, int, Instance)):
+        keys = [keys]
+    return [k if isinstance(k, str) else model.instances[model._instance_id(k)].path for k in keys]
 
 
 def _select(model: Model, keys: Optional[Iterable], what: str) -> List[int]:
@@ -81,6 +98,7 @@ class Scene:
         if isinstance(exclude, str):
             exclude = [exclude]
         self.model = model
+        self._given = (_given(model, select_a), _given(model, select_b), list(exclude or []))
         self._core = _core.SceneCore(model, _select(model, select_a, "select_a"), _select(model, select_b, "select_b"),
                                      [tuple(p) for p in (exclude_pairs or [])], list(exclude or []))
 
@@ -111,7 +129,8 @@ class Scene:
         runs with the GIL released, so other Python threads keep running; the result does not depend
         on the thread count. Lazy surfaces a query reaches are tessellated in the model."""
         o = _to_core(_resolve(options, kwargs))
-        return _report(self.model, self._core.check(o))
+        settings = _core.report_settings(o, self.model, *self._given)
+        return _report(self.model, self._core.check(o), settings)
 
     def __repr__(self) -> str:
         return f"Scene({self.model!r})"
@@ -122,7 +141,8 @@ def collide(model: Model, a: InstanceKey, b: InstanceKey, options: Optional[Coll
     """One-off query of two different instances (ids, paths or Instances) at their imported poses;
     tessellates exactly the lazy surfaces it needs. Runs with the GIL released. ValueError if a == b."""
     o = _to_core(_resolve(options, kwargs))
-    return _report(model, _core.collide(model, model._instance_id(a), model._instance_id(b), o))
+    settings = _core.report_settings(o, model, [], [], [])
+    return _report(model, _core.collide(model, model._instance_id(a), model._instance_id(b), o), settings)
 
 
 def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[CollideOptions] = None,

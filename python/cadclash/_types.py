@@ -5,10 +5,12 @@ stays valid after they are gone.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, make_dataclass
 from typing import Iterator, List, Optional, Tuple
 
 import numpy as np
+
+from . import _cadclash as _core
 
 __all__ = ["Diagnostic", "InputError", "Provenance", "PairResult", "Counters", "Timings", "Report",
            "StepResult", "Replay"]
@@ -35,6 +37,25 @@ class Diagnostic:
 
     def __str__(self) -> str:
         return self.text
+
+    @classmethod
+    def _from_text(cls, text: str) -> "Diagnostic":
+        """The inverse of ``format_diagnostic``: "file[:line]: [#id: ]error|warning: message"."""
+        for severity in ("error", "warning"):
+            head, sep, message = text.partition(f": {severity}: ")
+            if sep:
+                break
+        else:
+            return cls("error", "", 0, None, text, text)
+        step_id = None
+        if ": #" in head:
+            head, _, sid = head.rpartition(": #")
+            step_id = int(sid) if sid.isdigit() else None
+        file, line = head, 0
+        stem, colon, number = head.rpartition(":")
+        if colon and number.isdigit():
+            file, line = stem, int(number)
+        return cls(severity, "" if file == "<input>" else file, line, step_id, message, text)
 
     @classmethod
     def _from_raw(cls, raw) -> "Diagnostic":
@@ -99,8 +120,8 @@ class PairResult:
     distance: float
     penetration: float
     exact_distance: Optional[float]   # BRepExtrema's distance when the decision asked for it (an upper bound)
-    instance_id_a: int
-    instance_id_b: int
+    instance_id_a: Optional[int]   # None in a report read by Report.from_json
+    instance_id_b: Optional[int]
     surface_id_a: Optional[int]
     surface_id_b: Optional[int]
     # all_triangles=True only: intersecting (triangle of A, triangle of B) index pairs, k x 2 uint32 (a copy).
@@ -120,49 +141,19 @@ class PairResult:
         return (self.instance_a, self.instance_b, side_a, side_b, self.contact)
 
 
-@dataclass(frozen=True)
-class Counters:
-    """Work counters of one query (the paper's Table 2); independent of the thread count."""
+# The field lists and enum names are the C++ library's (cadclash/report.h), so the bindings, the
+# CLI and the JSON report cannot disagree on them.
+Counters = make_dataclass("Counters", [(name, int, 0) for name in _core.COUNTER_FIELDS], frozen=True)
+Counters.__module__ = __name__
+Counters.__doc__ = ("Work counters of one query (the paper's Table 2); independent of the thread count. The fields "
+                    "are the JSON report's `counters` (docs/report-schema.md).")
 
-    instance_pairs: int = 0
-    aabb_tests: int = 0
-    aabb_updates: int = 0
-    surfaces_a: int = 0
-    surfaces_b: int = 0
-    surface_pairs: int = 0
-    triangles_a: int = 0
-    triangles_b: int = 0
-    triangle_tests: int = 0
-    exact_fallbacks: int = 0
-    distance_tests: int = 0
-    intersecting_pairs: int = 0
-    tessellated_surfaces: int = 0
-    decided_mesh: int = 0
-    decided_mesh_exact: int = 0
-    decided_analytic: int = 0
-    decided_refined: int = 0
-    decided_exact: int = 0
-    undecided: int = 0
-    ambiguous_pairs: int = 0
-    refined_surfaces: int = 0
-    exact_queries: int = 0
-    witness_queries: int = 0
-    dismissed_pairs: int = 0
+Timings = make_dataclass("Timings", [(name, float, 0.0) for name in _core.TIMING_FIELDS], frozen=True)
+Timings.__module__ = __name__
+Timings.__doc__ = "Seconds spent per stage of one query. Never deterministic; leave out of comparisons."
 
-
-@dataclass(frozen=True)
-class Timings:
-    """Seconds spent per stage of one query. Never deterministic; leave out of comparisons."""
-
-    broad: float = 0.0
-    surface_level: float = 0.0
-    tessellation: float = 0.0
-    triangle_level: float = 0.0
-    total: float = 0.0
-
-
-_CLASSES = ("penetrating", "touching", "clearance", "containment", "undecided")
-_DECIDED_BY = ("mesh", "mesh-exact", "analytic", "refined", "exact", "undecided")
+_CLASSES = _core.CONTACT_CLASSES
+_DECIDED_BY = _core.DECIDED_BY
 
 
 @dataclass(frozen=True)
@@ -184,12 +175,44 @@ class Report:
     stopped_by: str = ""
     unexamined_pairs: List[Tuple[str, str]] = field(default_factory=list)
     memory_charged: int = 0
+    # The JSON report of this query (files, settings, model diagnostics); None for a Report made by hand.
+    _document: Optional["_core.ReportDocument"] = field(default=None, repr=False, compare=False)
 
     def __iter__(self) -> Iterator[PairResult]:
         return iter(self.pairs)
 
     def __len__(self) -> int:
         return len(self.pairs)
+
+    def to_json(self, timings: bool = False) -> str:
+        """The versioned JSON report (docs/report-schema.md), byte for byte what
+        ``cadclash check FILES --json OUT [--no-timings]`` writes for the same files, load and
+        query options: ``files`` are the paths given to ``load()``, ``settings`` the load's
+        tessellation and this query's options (``select_a``/``select_b``/``exclude`` as given, ids
+        and Instances as their paths; ``exclude_pairs`` has no CLI switch and is not shown),
+        ``diagnostics`` the model's and then the query's, ``complete`` false when the model is
+        incomplete, the query reported an error or a budget ran out. ``timings=False`` is
+        ``--no-timings``. ValueError for a Report built by hand or a trajectory step."""
+        if self._document is None:
+            raise ValueError("this report has no JSON document (only Scene.check(), collide() and "
+                             "Report.from_json() reports have one)")
+        return self._document.to_json(timings)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Report":
+        """Reads a report written by ``cadclash check --json`` or ``to_json()``; ``to_json()`` of
+        the result gives ``text`` back byte for byte (with ``timings=True`` when it has timings).
+
+        Pairs carry names and STEP ids but no model ids (``instance_id_a`` ... are None) and
+        ``diagnostics`` are every diagnostic of the report (the model's and the query's), parsed
+        from their text. ValueError, naming the JSON path (e.g. ``/pairs/3/class``), for anything
+        that is not a version-2 report of one query (a ``--path`` report holds several)."""
+        doc = _core.ReportDocument.from_json(text)
+        raw_pairs, counters, timings, stopped_by, unexamined, memory_charged = doc._query()
+        pairs = [_pair_from_document(raw) for raw in raw_pairs]
+        return cls(pairs, Counters(**counters), Timings(**(timings or {})),
+                   [Diagnostic._from_text(t) for t in doc.diagnostics], doc.complete, stopped_by,
+                   [tuple(u) for u in unexamined], memory_charged, doc)
 
     def count(self, contact: str) -> int:
         """Number of pairs of one class ("penetrating", "touching", "clearance", "containment")."""
@@ -213,6 +236,16 @@ class Report:
                 by[p.decided_by] += 1
         out["decided_by"] = by
         return out
+
+
+def _pair_from_document(raw) -> PairResult:
+    contact, by, lo, hi, intersecting, distance, penetration, exact, tri, a, b = raw
+    (instance_a, part_a, surface_a, step_a), (instance_b, part_b, surface_b, step_b) = a, b
+    return PairResult(
+        contact=contact, instance_a=instance_a, instance_b=instance_b, part_a=part_a, part_b=part_b,
+        surface_a=surface_a, surface_b=surface_b, step_id_a=step_a, step_id_b=step_b, intersecting=intersecting,
+        distance=distance, penetration=penetration, exact_distance=exact, instance_id_a=None, instance_id_b=None,
+        surface_id_a=None, surface_id_b=None, triangle_pairs=tri, decided_by=by, distance_lo=lo, distance_hi=hi)
 
 
 @dataclass(frozen=True)

@@ -71,57 +71,34 @@ pyb::list diagnostics_to_list(std::span<const Diagnostic> ds) {
   return out;
 }
 
-namespace {
-
 pyb::dict counters_to_dict(const CollideCounters& c) {
   pyb::dict d;
-  d["instance_pairs"] = c.instance_pairs;
-  d["aabb_tests"] = c.aabb_tests;
-  d["aabb_updates"] = c.aabb_updates;
-  d["surfaces_a"] = c.surfaces_a;
-  d["surfaces_b"] = c.surfaces_b;
-  d["surface_pairs"] = c.surface_pairs;
-  d["triangles_a"] = c.triangles_a;
-  d["triangles_b"] = c.triangles_b;
-  d["triangle_tests"] = c.triangle_tests;
-  d["exact_fallbacks"] = c.exact_fallbacks;
-  d["distance_tests"] = c.distance_tests;
-  d["intersecting_pairs"] = c.intersecting_pairs;
-  d["tessellated_surfaces"] = c.tessellated_surfaces;
-  d["decided_mesh"] = c.decided_mesh;
-  d["decided_mesh_exact"] = c.decided_mesh_exact;
-  d["decided_analytic"] = c.decided_analytic;
-  d["decided_refined"] = c.decided_refined;
-  d["decided_exact"] = c.decided_exact;
-  d["undecided"] = c.undecided;
-  d["ambiguous_pairs"] = c.ambiguous_pairs;
-  d["refined_surfaces"] = c.refined_surfaces;
-  d["exact_queries"] = c.exact_queries;
-  d["witness_queries"] = c.witness_queries;
-  d["dismissed_pairs"] = c.dismissed_pairs;
+  for (const CounterField& f : kCounterFields) d[f.name] = c.*f.member;
   return d;
 }
 
 pyb::dict timings_to_dict(const CollideTimings& t) {
   pyb::dict d;
-  d["broad"] = t.broad;
-  d["surface_level"] = t.surface_level;
-  d["tessellation"] = t.tessellation;
-  d["triangle_level"] = t.triangle_level;
-  d["total"] = t.total;
+  for (const TimingField& f : kTimingFields) d[f.name] = t.*f.member;
   return d;
 }
+
+pyb::array_t<std::uint32_t> triangle_pairs_array(const std::vector<std::array<std::uint32_t, 2>>& pairs) {
+  pyb::array_t<std::uint32_t> tri({static_cast<pyb::ssize_t>(pairs.size()), pyb::ssize_t{2}});
+  if (!pairs.empty()) std::memcpy(tri.mutable_data(), pairs.data(), pairs.size() * sizeof(pairs[0]));
+  return tri;
+}
+
+namespace {
 
 std::int64_t id_or_minus_one(std::uint32_t id) { return id == kInvalidId ? -1 : static_cast<std::int64_t>(id); }
 
 }  // namespace
 
-pyb::tuple report_to_tuple(const Report& report) {
+pyb::tuple report_to_tuple(const Report& report, QueryReport record) {
   pyb::list pairs;
   for (const SurfacePairResult& p : report.pairs) {
-    pyb::array_t<std::uint32_t> tri({static_cast<pyb::ssize_t>(p.triangle_pairs.size()), pyb::ssize_t{2}});
-    if (!p.triangle_pairs.empty())
-      std::memcpy(tri.mutable_data(), p.triangle_pairs.data(), p.triangle_pairs.size() * sizeof(p.triangle_pairs[0]));
+    pyb::array_t<std::uint32_t> tri = triangle_pairs_array(p.triangle_pairs);
     pyb::object exact = p.exact_distance ? pyb::object(pyb::float_(*p.exact_distance)) : pyb::object(pyb::none());
     pairs.append(pyb::make_tuple(p.instance_a, p.instance_b, id_or_minus_one(p.surface_a), id_or_minus_one(p.surface_b),
                                  contact_class_name(p.contact), p.intersecting, p.distance, p.penetration, exact,
@@ -131,7 +108,7 @@ pyb::tuple report_to_tuple(const Report& report) {
   for (const auto& [a, b] : report.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));
   return pyb::make_tuple(pairs, counters_to_dict(report.counters), timings_to_dict(report.timings),
                          diagnostics_to_list(report.diagnostics), report.complete, report.stopped_by, unexamined,
-                         report.memory_charged);
+                         report.memory_charged, std::move(record));
 }
 
 }  // namespace cadclash::py

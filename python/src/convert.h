@@ -3,6 +3,8 @@
 
 #include "state.h"
 
+#include "cadclash/report.h"
+
 #include <pybind11/numpy.h>
 
 #include <span>
@@ -24,9 +26,19 @@ Pose pose_from_translation_quaternion(const pyb::handle& translation, const pyb:
 pyb::list diagnostics_to_list(std::span<const Diagnostic> ds);
 
 // (pairs, counters, timings, diagnostics, complete, stopped_by, unexamined_pairs [(a, b)],
-//  memory_charged) with each pair as
+//  memory_charged, record) with each pair as
 // (instance_a, instance_b, surface_a|-1, surface_b|-1, class, intersecting, distance, penetration,
-//  exact_distance|None, triangle_pairs (k x 2 uint32 array)). Builds Python objects: needs the GIL.
-pyb::tuple report_to_tuple(const Report& report);
+//  exact_distance|None, triangle_pairs (k x 2 uint32 array), decided_by, distance_lo, distance_hi),
+// and `record` the same query as the JSON report holds it (query_report(model, report), made under
+// the model's lock: surface deflections change when a running query tessellates).
+// Builds Python objects: needs the GIL.
+pyb::tuple report_to_tuple(const Report& report, QueryReport record);
+
+// {name: value} of the counters / timings (kCounterFields, kTimingFields).
+pyb::dict counters_to_dict(const CollideCounters& c);
+pyb::dict timings_to_dict(const CollideTimings& t);
+
+// A k x 2 uint32 array (a copy) of triangle index pairs.
+pyb::array_t<std::uint32_t> triangle_pairs_array(const std::vector<std::array<std::uint32_t, 2>>& pairs);
 
 }  // namespace cadclash::py

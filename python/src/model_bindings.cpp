@@ -86,6 +86,9 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
     }
     s.model = std::move(r.model);
     s.loaded = true;
+    s.preset = a.preset;
+    s.tessellation = options.tessellation;
+    s.lazy = a.lazy;
   }
   return pyb::make_tuple(diagnostics_to_list(diagnostics), complete);
 }

@@ -6,4 +6,5 @@ PYBIND11_MODULE(_cadclash, m) {
   m.doc() = "Compiled core of the cadclash package; use `import cadclash`.";
   cadclash::py::bind_model(m);
   cadclash::py::bind_scene(m);
+  cadclash::py::bind_report(m);
 }

@@ -126,27 +126,32 @@ void bind_scene(pyb::module_& m) {
            [](SceneCore& c, const CollideOptions& o) {
              validate(o);
              Report r;
+             QueryReport record;
              {
                ModelLock lock(*c.state);
                Running running(c.running);
                r = c.scene->check(o);
+               record = query_report(c.state->model, r);
              }
-             return report_to_tuple(r);
+             return report_to_tuple(r, std::move(record));
            })
       .def("replay", [](SceneCore& c, const std::string& csv_text, const std::string& file, const CollideOptions& o) {
         validate(o);
         std::vector<Diagnostic> parse_diags, run_diags;
         std::vector<StepResult> steps;
+        std::vector<QueryReport> records;
         {
           ModelLock lock(*c.state);
           const std::vector<TrajectoryRow> rows = parse_trajectory(csv_text, file, parse_diags);
           if (!has_error(parse_diags)) {  // like `cadclash check --path`: a bad row means nothing is run
             Running running(c.running);
             steps = replay_trajectory(*c.scene, rows, o, run_diags, file);
+            for (const StepResult& s : steps) records.push_back(query_report(c.state->model, s.report));
           }
         }
         pyb::list out;
-        for (const StepResult& s : steps) out.append(pyb::make_tuple(s.step, report_to_tuple(s.report)));
+        for (std::size_t k = 0; k < steps.size(); ++k)
+          out.append(pyb::make_tuple(steps[k].step, report_to_tuple(steps[k].report, std::move(records[k]))));
         return pyb::make_tuple(diagnostics_to_list(parse_diags), out, diagnostics_to_list(run_diags));
       });
 
@@ -156,11 +161,13 @@ void bind_scene(pyb::module_& m) {
     if (ia == ib) throw pyb::value_error("collide() needs two different instances");
     validate(o);
     Report r;
+    QueryReport record;
     {
       ModelLock lock(st);
       r = collide(st.model, ia, ib, o);
+      record = query_report(st.model, r);
     }
-    return report_to_tuple(r);
+    return report_to_tuple(r, std::move(record));
   });
 }
 

@@ -22,6 +22,11 @@ struct ModelState {
   Model model;
   std::mutex mutex;
   bool loaded = false;
+  // How it was loaded, for the report's settings: the preset's name (empty: none), the
+  // tessellation in effect (the preset's when one was given) and lazy.
+  std::string preset;
+  TessellationOptions tessellation;
+  bool lazy = false;
 };
 
 // The Python-visible model core (subclassed in Python as cadclash.Model).
@@ -42,5 +47,6 @@ class ModelLock {
 
 void bind_model(pyb::module_& m);
 void bind_scene(pyb::module_& m);
+void bind_report(pyb::module_& m);
 
 }  // namespace cadclash::py

@@ -1,0 +1,120 @@
+// cadclash._cadclash's report pieces: the JSON report document (cadclash/report.h) and the name
+// tables the pure-Python package takes its counter fields and enum names from.
+#include "convert.h"
+
+#include <pybind11/stl.h>
+
+namespace cadclash::py {
+namespace {
+
+// {name: pybind enum value} for an enum the options take by name.
+template <class E>
+pyb::dict names_to_values() {
+  pyb::dict d;
+  for (E e : EnumNames<E>::values) d[EnumNames<E>::name(e)] = pyb::cast(e);
+  return d;
+}
+
+template <class E>
+pyb::tuple names() {
+  pyb::list out;
+  for (E e : EnumNames<E>::values) out.append(EnumNames<E>::name(e));
+  return pyb::tuple(out);
+}
+
+pyb::object side_tuple(const ReportSide& s) {
+  if (s.whole_part) return pyb::make_tuple(s.instance, s.part, pyb::none(), pyb::none());
+  return pyb::make_tuple(s.instance, s.part, s.surface, s.step_id >= 0 ? pyb::object(pyb::int_(s.step_id)) : pyb::none());
+}
+
+// (pairs, counters, timings|None, stopped_by, unexamined [(a, b)], memory_charged) with each pair
+// (class, decided_by, lo, hi, intersecting, distance, penetration, exact|None, triangle_pairs,
+//  (instance, part, surface|None, step_id|None) of a, the same of b).
+pyb::tuple query_tuple(const QueryReport& q) {
+  pyb::list pairs;
+  for (const ReportPair& p : q.pairs) {
+    pyb::object exact = p.exact_distance ? pyb::object(pyb::float_(*p.exact_distance)) : pyb::object(pyb::none());
+    pairs.append(pyb::make_tuple(contact_class_name(p.contact), decided_by_name(p.decided_by), p.distance_lo,
+                                 p.distance_hi, p.intersecting, p.distance, p.penetration, exact,
+                                 triangle_pairs_array(p.triangle_pairs), side_tuple(p.a), side_tuple(p.b)));
+  }
+  pyb::list unexamined;
+  for (const auto& [a, b] : q.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));
+  pyb::object timings = q.timings ? pyb::object(timings_to_dict(*q.timings)) : pyb::object(pyb::none());
+  return pyb::make_tuple(pairs, counters_to_dict(q.counters), timings, q.stopped_by, unexamined, q.memory_charged_bytes);
+}
+
+}  // namespace
+
+void bind_report(pyb::module_& m) {
+  m.attr("REPORT_SCHEMA") = std::string(kCheckReportSchema);
+  m.attr("REPORT_VERSION") = kCheckReportVersion;
+  pyb::list counters, timings;
+  for (const CounterField& f : kCounterFields) counters.append(f.name);
+  for (const TimingField& f : kTimingFields) timings.append(f.name);
+  m.attr("COUNTER_FIELDS") = pyb::tuple(counters);
+  m.attr("TIMING_FIELDS") = pyb::tuple(timings);
+  m.attr("CONTACT_CLASSES") = names<ContactClass>();
+  m.attr("DECIDED_BY") = names<DecidedBy>();
+  m.attr("SOURCE_KINDS") = names<SourceKind>();
+  m.attr("PARALLEL_VERSIONS") = names_to_values<ParallelVersion>();
+  m.attr("SCHEDULES") = names_to_values<Schedule>();
+  m.attr("TRIANGLE_LEVELS") = names_to_values<TriangleLevel>();
+
+  pyb::class_<QueryReport>(m, "QueryRecord", "One query's results as the JSON report holds them (names resolved).");
+  pyb::class_<ReportSettings>(m, "ReportSettings", "The report's `settings` (cadclash::ReportSettings).");
+
+  m.def(
+      "report_settings",
+      [](const CollideOptions& o, const ModelCore& model, std::vector<std::string> select_a,
+         std::vector<std::string> select_b, std::vector<std::string> exclude_under) {
+        const ModelState& st = *model.state;  // the load settings are fixed after load
+        ReportSettings s = report_settings(o);
+        s.preset = st.preset;
+        s.deflection = st.tessellation.linear_deflection;
+        s.relative_deflection = st.tessellation.relative;
+        s.angular_deflection = st.tessellation.angular_deflection;
+        s.lazy = st.lazy;
+        s.select_a = std::move(select_a);
+        s.select_b = std::move(select_b);
+        s.exclude_under = std::move(exclude_under);
+        return s;
+      },
+      pyb::arg("options"), pyb::arg("model"), pyb::arg("select_a"), pyb::arg("select_b"), pyb::arg("exclude_under"),
+      "The report's settings for a query with these options on this model (as `cadclash check` writes them).");
+
+  pyb::class_<CheckReport>(m, "ReportDocument", "A `cadclash check --json` report (cadclash::CheckReport).")
+      .def(pyb::init([](std::vector<std::string> files, ReportSettings settings, QueryReport query,
+                        std::vector<std::string> diagnostics, bool complete) {
+             CheckReport r;
+             r.files = std::move(files);
+             r.settings = std::move(settings);
+             r.query = std::move(query);
+             r.diagnostics = std::move(diagnostics);
+             r.complete = complete;
+             return r;
+           }),
+           pyb::arg("files"), pyb::arg("settings"), pyb::arg("query"), pyb::arg("diagnostics"), pyb::arg("complete"))
+      .def(
+          "to_json",
+          [](const CheckReport& r, bool with_timings) { return check_report_text(r, {.timings = with_timings}); },
+          pyb::arg("timings"), "The report's JSON text, byte for byte as `cadclash check --json` writes it.")
+      .def_static(
+          "from_json",
+          [](const std::string& text) {
+            ReportReadResult read = check_report_from_json(text);
+            if (read.error) throw pyb::value_error("not a cadclash check report: " + format_report_error(*read.error));
+            return std::move(read.report);
+          },
+          pyb::arg("text"), "Parses a report; ValueError naming the JSON path of the first problem.")
+      .def_readonly("files", &CheckReport::files)
+      .def_readonly("diagnostics", &CheckReport::diagnostics)
+      .def_readonly("complete", &CheckReport::complete)
+      .def_property_readonly("is_trajectory", [](const CheckReport& r) { return !r.query.has_value(); })
+      .def("_query", [](const CheckReport& r) {
+        if (!r.query) throw pyb::value_error("a trajectory report (--path) holds steps, not one query");
+        return query_tuple(*r.query);
+      });
+}
+
+}  // namespace cadclash::py
