@@ -58,31 +58,44 @@ Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask&
   return p;
 }
 
-// Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
-void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
-  const Surface& a = m.surfaces[t.sa];
-  const Surface& b = m.surfaces[t.sb];
+namespace {
+
+// A lower bound on the exact faces' distance from their planes, cylinders and spheres: the two
+// surfaces' parameters, and each one's triangles kept off the other's surface (0 when none helps).
+// `a`, `b` are the model's faces or finer copies of them (same analytic surface and box).
+double analytic_bound(const Surface& a, const Surface& b, double eps_a, double eps_b, const DecideTask& t,
+                      double threshold) {
   const double r = t.roundoff;
   double lb = 0.0;
   // The two surfaces' parameters: where the faces can come within T of each other, both lie in A's
   // face box and in B's grown by T.
   const Aabb box_b = transform_box(own_box(b), t.t_ab);
-  const Aabb region = own_box(a).intersection(pad_box(box_b, p.threshold));
+  const Aabb region = own_box(a).intersection(pad_box(box_b, threshold));
   if (region.isEmpty()) {
     lb = box_distance(own_box(a), box_b);  // the boxes enclose the exact faces
   } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab), region)) {
-    lb = std::max(lb, *g - eps[t.sa] - eps[t.sb] - r);
+    lb = std::max(lb, *g - eps_a - eps_b - r);
   }
+  // The triangles' gap is searched up to twice what proving "apart" needs (farther triangles are
+  // skipped and count as that reach), so a gap that proves it is never cut short.
   if (b.has_triangles) {
-    const double reach = p.threshold + b.deflection + r;
+    const double reach = 2.0 * (threshold + b.deflection + r + eps_a);
     if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab, own_box(a), reach))
-      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps[t.sa]);
+      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps_a);
   }
   if (a.has_triangles) {
-    const double reach = p.threshold + a.deflection + r;
+    const double reach = 2.0 * (threshold + a.deflection + r + eps_b);
     if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba, own_box(b), reach))
-      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps[t.sb]);
+      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps_b);
   }
+  return lb;
+}
+
+}  // namespace
+
+// Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
+void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
+  const double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], eps[t.sa], eps[t.sb], t, p.threshold);
   if (!(lb > p.threshold)) return;
   p.d.lo = std::max(p.d.lo, lb);
   settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);
@@ -165,6 +178,17 @@ void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
 
 }  // namespace
 
+// Inside-ness by the triangles (decide_steps.h). A point of a face's exact surface lies inside the face when the face's triangles come within its
+// deflection (they stand for the face) and it is clear of their outline by twice that (the outline is
+// within a deflection of the face's boundary): analytic_witness's test. Faces without an outline
+// (not made, or closed) are not judged here.
+bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles) {
+  if (f.outline == nullptr || f.outline->empty()) return false;
+  const double delta = f.surface.deflection;
+  return clear_of(*f.outline, x, 2.0 * delta + slack) &&
+         (on_triangles || point_mesh_distance(f.bvh, f.surface.mesh, x, delta + slack) <= delta + slack);
+}
+
 // A vertex of a face lies on its own exact face (within that face's ε: the mesher puts nodes on the
 // surface and its edges); when its exact distance to the other face is within tolerance + that
 // face's ε (after the mapping's round-off), the faces are within T. Candidates are the vertices of
@@ -185,11 +209,28 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
   order_trials(cs, fa, fb);
   for (const Candidate& cand : cs) {
+    const Part& asked = cand.of_a ? pb : pa;
+    const FaceView& face = cand.of_a ? fb : fa;
+    const std::uint32_t local = (cand.of_a ? t.sb : t.sa) - asked.first_surface;
+    const double own = (cand.of_a ? eps[t.sa] : eps[t.sb]) + t.roundoff;
+    // The foot point on the other face's surface, kept when that face's triangles put it inside; a
+    // foot outside is mostly on the face's boundary (faces meeting along an edge), where a point of
+    // its edge curves answers; last, the source's exact classifier decides (ten times the cost).
     ++c.witness_queries;
-    const std::optional<double> d = cand.of_a ? pb.source->point_distance(t.sb - pb.first_surface, cand.point)
-                                              : pa.source->point_distance(t.sa - pa.first_surface, cand.point);
+    const auto sp = asked.source->surface_point(local, cand.point);
+    std::optional<double> d;
+    if (sp && inside_face(face, sp->point, sp->rounding + t.roundoff)) {
+      d = (sp->point - cand.point).norm() + sp->rounding;
+    } else {
+      ++c.witness_queries;
+      d = asked.source->boundary_distance(local, cand.point);
+      if (!d || !(own + *d <= p.threshold)) {
+        ++c.witness_queries;
+        d = asked.source->point_distance(local, cand.point);
+      }
+    }
     if (!d) continue;
-    const double hi = (cand.of_a ? eps[t.sa] : eps[t.sb]) + *d + t.roundoff;
+    const double hi = own + *d;
     if (hi <= p.threshold) {
       p.d.hi = std::min(p.d.hi, hi);
       settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
@@ -257,23 +298,61 @@ void edge_witness_step(const Model& m, std::span<const Pose> poses, const Decide
   settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
 }
 
-// Step 4: the same interval on finer triangles of both faces.
-void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p,
-                  const CollideOptions& o, CollideCounters& c) {
-  const RefinedSurface& ra = cache[t.sa];
-  const RefinedSurface& rb = cache[t.sb];
-  if (!ra.ok || !rb.ok) return;
-  const double band = ra.surface.deflection + rb.surface.deflection + t.roundoff;
+bool bounds_by_shape(const Surface& s) {
+  return s.analytic.shape == SurfaceShape::Plane || s.analytic.shape == SurfaceShape::Cylinder ||
+         s.analytic.shape == SurfaceShape::Sphere;
+}
+
+std::vector<SurfaceId> faces_to_refine(const Model& m, const DecideTask& t) {
+  const bool a = bounds_by_shape(m.surfaces[t.sa]), b = bounds_by_shape(m.surfaces[t.sb]);
+  if (a && !b) return {t.sb};
+  if (b && !a) return {t.sa};
+  return {t.sa, t.sb};
+}
+
+bool refinement_can_separate(const Model& m, const DecideTask& t, const Pending& p) {
+  if (t.outcome == nullptr || t.outcome->intersecting) return false;
+  double band = t.roundoff;
+  for (SurfaceId s : faces_to_refine(m, t)) band += refinement_deflection(m.surfaces[s]);
+  return t.outcome->distance > p.threshold + band;
+}
+
+FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::vector<RefinedSurface>& cache,
+                    SurfaceId s) {
+  if (s < cache.size() && cache[s].ok) return FaceView{cache[s].surface, cache[s].bvh};
+  return FaceView{m.surfaces[s], bvh[s]};
+}
+
+namespace {
+
+// The interval of two faces' triangles (finer ones), tightened by the plane, cylinder or sphere of
+// either side: a part standing off a flat face by more than the other face's band is proved apart.
+Interval finer_interval(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+                        const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band) {
+  band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
   const double reach = p.threshold + band;
-  p.fine = pair_outcome(ra.surface, ra.bvh, rb.surface, rb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
-  const PairOutcome& out = *p.fine;
-  const Interval d = mesh_interval(out, band, reach);
-  p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
+  out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  Interval d = mesh_interval(out, band, reach);
+  if (!out.intersecting)
+    d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, eps[t.sa], eps[t.sb], t, p.threshold));
+  d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
+  if (d.lo > d.hi) d.lo = d.hi;  // cannot happen for sound bounds; keep the interval ordered
+  return d;
+}
+
+}  // namespace
+
+// Step 4: the same interval on finer triangles (of the faces faces_to_refine picked).
+void refined_step(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+                  const CollideOptions& o, CollideCounters& c) {
+  PairOutcome out;
+  double band = 0.0;
+  p.d = finer_interval(eps, t, fa, fb, p, o, c, out, band);
+  p.fine = std::move(out);
   p.band = band;
-  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;  // cannot happen for sound bounds; keep the interval ordered
-  settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &out, o.clearance);
+  settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &*p.fine, o.clearance);
   // A contact proved on finer triangles is penetrating only when they prove it.
-  if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(out, p.threshold, band))
+  if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(*p.fine, p.threshold, band))
     p.cls = ContactClass::Penetrating;
 }
 
@@ -316,18 +395,16 @@ bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t
 
 // Corroborates an exact value above T: the finer triangles' lower bound proves the pair apart, their
 // upper bound or a witness on them proves it in contact (BRepExtrema missed), else it stays open.
-void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t,
-                 const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o, CollideCounters& c) {
+void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                 Pending& p, const CollideOptions& o, CollideCounters& c) {
   // The surfaces' parameters first (exact mode has not asked them yet): a lower bound for free.
   if (t.outcome != nullptr) analytic(m, eps, t, p, o);
-  if (!p.settled && !p.fine) refined_step(t, cache, p, o, c);
+  if (!p.settled && !p.fine) refined_step(eps, t, fa, fb, p, o, c);
   // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
   // its corroboration; it is reported as decided by the exact faces.
   if (p.settled && p.exact) p.by = DecidedBy::Exact;
   if (p.settled || !p.fine) return;
-  const RefinedSurface& ra = cache[t.sa];
-  const RefinedSurface& rb = cache[t.sb];
-  witness_step(m, eps, t, {ra.surface, ra.bvh}, {rb.surface, rb.bvh}, &*p.fine, p.band, p, o, c);
+  witness_step(m, eps, t, fa, fb, &*p.fine, p.band, p, o, c);
   if (p.settled || !p.exact) return;
   // Deeper, for this pair alone: a band below half the exact value's margin over T proves it apart
   // if OCCT's value is right (and shows the contact if OCCT missed it). Not below a hundredth of the
@@ -336,17 +413,21 @@ void corroborate(const Model& m, std::span<const double> eps, const DecideTask& 
   const double margin = *p.exact - p.threshold - t.roundoff;
   const double target = 0.25 * margin;
   const double floor = 1e-2 * std::max(m.surfaces[t.sa].deflection, m.surfaces[t.sb].deflection);
-  if (!(target > floor) || !(target < std::max(ra.surface.deflection, rb.surface.deflection))) return;
-  const RefinedSurface fa = refine_to(m, t.sa, target), fb = refine_to(m, t.sb, target);
-  if (!fa.ok || !fb.ok) return;
-  const double band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
-  const double reach = p.threshold + band;
-  const PairOutcome out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
-  const Interval d = mesh_interval(out, band, reach);
-  p.d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
-  if (p.d.lo > p.d.hi) p.d.lo = p.d.hi;
+  if (!(target > floor) || !(target < std::max(fa.surface.deflection, fb.surface.deflection))) return;
+  // Only the faces refinement helps (faces_to_refine); a plane, cylinder or sphere keeps its own.
+  const std::vector<SurfaceId> which = faces_to_refine(m, t);
+  auto deeper = [&](SurfaceId s, FaceView view, std::optional<RefinedSurface>& keep) {
+    if (std::find(which.begin(), which.end(), s) == which.end()) return view;
+    keep = refine_to(m, s, target);
+    return keep->ok ? FaceView{keep->surface, keep->bvh} : view;
+  };
+  std::optional<RefinedSurface> ka, kb;
+  const FaceView da = deeper(t.sa, fa, ka), db = deeper(t.sb, fb, kb);
+  PairOutcome out;
+  double band = 0.0;
+  p.d = finer_interval(eps, t, da, db, p, o, c, out, band);
   settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
-  if (!p.settled) witness_step(m, eps, t, {fa.surface, fa.bvh}, {fb.surface, fb.bvh}, &out, band, p, o, c);
+  if (!p.settled) witness_step(m, eps, t, da, db, &out, band, p, o, c);
 }
 
 void count(CollideCounters& c, DecidedBy by) {

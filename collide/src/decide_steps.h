@@ -52,6 +52,19 @@ void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, 
 void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                       const CollideOptions& o);
 
+// True when `x`, a point of face `f`'s exact surface (its part frame), lies inside the face by its
+// triangles: within the face's deflection of them and clear of their outline by twice that (plus
+// `slack` each). `on_triangles`: x is known to lie on the face's triangles (the first test is moot).
+// False when the view has no outline.
+bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = false);
+
+// Step 2c: where the faces cross a plane of the other (intersecting triangles; sunk or press-fitted
+// parts), a point of one face on the other's plane, inside both faces (contact): on a planar face the
+// crossing of its triangles with the plane; on a curved one Newton (SurfaceSource::surface_point)
+// from there onto the curve where its surface meets the plane.
+void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+                   Pending& p, const CollideOptions& o, CollideCounters& c);
+
 // Step 3: witness vertices (contact): vertices of each face near the other face's triangles, asked
 // of the other exact face (SurfaceSource::point_distance), nearest first. `a`, `b` are the model's
 // faces or finer ones (same part and index); `out` their outcome, `band` its band.
@@ -64,17 +77,31 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
 void edge_witness_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, FaceView a, FaceView b,
                        Pending& p, const CollideOptions& o, CollideCounters& c);
 
-// Step 4: the same interval on finer triangles of both faces.
-void refined_step(const DecideTask& t, const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o,
-                  CollideCounters& c);
+// Step 4 and 6 helpers. A plane, cylinder or sphere bounds the distance to the other face's
+// triangles by that face's band alone (analytic_gap), so only the other face is refined then.
+bool bounds_by_shape(const Surface& s);
+std::vector<SurfaceId> faces_to_refine(const Model& m, const DecideTask& t);
+// True when finer triangles (faces_to_refine at refinement_deflection) could prove the pair apart:
+// its triangles stay apart by more than T plus the finer band. Pairs closer than that (contacts
+// the witnesses missed) go to the exact step first. Only what it costs depends on this.
+bool refinement_can_separate(const Model& m, const DecideTask& t, const Pending& p);
+// The finer copy of face `s` when refinement made one, else the model's face.
+FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::vector<RefinedSurface>& cache,
+                    SurfaceId s);
+
+// Step 4: the interval on finer triangles `a`, `b` (finer_view), tightened by either face's plane,
+// cylinder or sphere against the other's triangles.
+void refined_step(std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b, Pending& p,
+                  const CollideOptions& o, CollideCounters& c);
 
 // Step 5: the exact faces' distance (SurfaceSource::exact_distance). False when they have none.
 bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, Pending& p, const CollideOptions& o,
                 CollideCounters& c);
 
-// Step 6: an exact value above T corroborated (apart) or contradicted (contact) by finer triangles.
-void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t,
-                 const std::vector<RefinedSurface>& cache, Pending& p, const CollideOptions& o, CollideCounters& c);
+// Step 6: an exact value above T corroborated (apart) or contradicted (contact) by finer triangles
+// `a`, `b` (finer_view), and for this pair alone by triangles finer still.
+void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+                 Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // Settles `p` when `v` decides, with the class it implies (penetrating only when `o` proves it).
 void settle(Pending& p, Verdict v, DecidedBy by, const PairOutcome* o, double clearance);

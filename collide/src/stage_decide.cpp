@@ -28,6 +28,19 @@ std::vector<SurfaceId> faces_of(std::span<const DecideTask> tasks, const std::ve
   return faces;
 }
 
+// The faces refinement helps for the listed tasks (faces_to_refine), each once, ascending.
+std::vector<SurfaceId> refinable_faces(const Model& model, std::span<const DecideTask> tasks,
+                                       const std::vector<std::size_t>& ks) {
+  std::vector<SurfaceId> faces;
+  for (std::size_t k : ks) {
+    const std::vector<SurfaceId> which = faces_to_refine(model, tasks[k]);
+    faces.insert(faces.end(), which.begin(), which.end());
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
 // Runs step(k) for the listed tasks on the threads, one task at a time (a step may cost OCCT work);
 // each answer depends on its task alone. Past the deadline the rest are marked cut.
 template <class Step>
@@ -60,6 +73,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   std::vector<CollideCounters> task_counters(tasks.size());
   auto meshed = [&](std::size_t k) { return tasks[k].outcome != nullptr; };
   Outlines outlines(model.surfaces.size());  // made for the surfaces of the open pairs (step 2b)
+  auto finer = [&](SurfaceId f) { return finer_view(model, bvh, refined, f); };
   auto view = [&](SurfaceId f) { return FaceView{model.surfaces[f], bvh[f], outlines[f].empty() ? nullptr : &outlines[f]}; };
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
 #pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
@@ -82,6 +96,11 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     }
     run_step(open, pending, threads, deadline,
              [&](std::size_t k) { analytic_contact(eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o); });
+    // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
+    run_step(select(pending, [&](std::size_t k) { return meshed(k) && tasks[k].outcome->intersecting; }), pending,
+             threads, deadline, [&](std::size_t k) {
+               crossing_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
+             });
     // Step 3: witness vertices near the other face (a few exact point queries each).
     run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
       witness_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), tasks[k].outcome, pending[k].band,
@@ -94,13 +113,15 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see
     // (apart), not a contact within T (far below any band): crossing or touching triangles go on.
     const std::vector<std::size_t> gaps = select(pending, [&](std::size_t k) {
-      return meshed(k) && !tasks[k].outcome->intersecting && tasks[k].outcome->distance > pending[k].threshold &&
-             (can_refine(model, tasks[k].sa) || can_refine(model, tasks[k].sb));
+      if (!meshed(k) || !refinement_can_separate(model, tasks[k], pending[k])) return false;
+      const std::vector<SurfaceId> which = faces_to_refine(model, tasks[k]);
+      return std::any_of(which.begin(), which.end(), [&](SurfaceId s) { return can_refine(model, s); });
     });
     if (!gaps.empty() && !deadline.expired())
-      counters.refined_surfaces += refine_surfaces(model, faces_of(tasks, gaps), refined, threads);
-    run_step(gaps, pending, threads, deadline,
-             [&](std::size_t k) { refined_step(tasks[k], refined, pending[k], o, task_counters[k]); });
+      counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, gaps), refined, threads);
+    run_step(gaps, pending, threads, deadline, [&](std::size_t k) {
+      refined_step(eps, tasks[k], finer(tasks[k].sa), finer(tasks[k].sb), pending[k], o, task_counters[k]);
+    });
   }
 
   // Step 5: the exact faces, for what is still open.
@@ -116,9 +137,10 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   const std::vector<std::size_t> check =
       select(pending, [&](std::size_t k) { return pending[k].needs_lower && meshed(k); });
   if (!check.empty() && !deadline.expired())
-    counters.refined_surfaces += refine_surfaces(model, faces_of(tasks, check), refined, threads);
-  run_step(check, pending, threads, deadline,
-           [&](std::size_t k) { corroborate(model, eps, tasks[k], refined, pending[k], o, task_counters[k]); });
+    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, check), refined, threads);
+  run_step(check, pending, threads, deadline, [&](std::size_t k) {
+    corroborate(model, eps, tasks[k], finer(tasks[k].sa), finer(tasks[k].sb), pending[k], o, task_counters[k]);
+  });
 
   for (std::size_t k = 0; k < tasks.size(); ++k) {
     const DecideTask& t = tasks[k];

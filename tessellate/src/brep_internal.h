@@ -107,6 +107,16 @@ void describe_face(const TopoDS_Face& face, Surface& out);
 std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
                                          const gp_Pnt& p);
 
+// An upper bound on the distance from `p` to the face's boundary: the nearest point found on its edge
+// curves (ShapeAnalysis_Curve, nearest edge box first), the evaluation's rounding added. May throw.
+std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p);
+
+// The foot point of `p` on the face's surface by the same Newton, with the unit normal there and the
+// evaluation's rounding; not classified (it may lie outside the face). nullopt when Newton fails or
+// the surface is singular there. Reads the face only. May throw Standard_Failure.
+std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
+                                                              const gp_Pnt& p);
+
 // An upper bound on the distance between two placed faces realised by a point on an edge of each:
 // the edges of `a` and `b` nearest `near_a` / `near_b` (part frames), Newton (Extrema_LocateExtCC)
 // from the projections of those points, the curves placed by `place_a` / `place_b`; the nearer of

@@ -1,11 +1,15 @@
 // add_brep_parts: B-rep shapes into parts and surfaces (healing, exact boxes, eager tessellation).
 #include "brep_internal.h"
 
+#include <BRepAdaptor_Surface.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepLib.hxx>
 #include <BRep_Builder.hxx>
 #include <ShapeFix_Face.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
@@ -57,6 +61,27 @@ std::string failure_message(const BrepSource::Impl& impl, std::size_t face, cons
 
 }  // namespace
 
+namespace {
+
+// STEP files carry no parameter curves for edges on planes: OCCT projects the edge onto the plane
+// every time one is asked for (BRep_Tool::CurveOnPlane), and the face classifier behind the witness
+// queries asks on every call near an edge. Stored once here, before anything reads the faces in
+// parallel, they are the same curves OCCT would compute (and BRepMesh reads the same ones).
+void store_plane_pcurves(const std::vector<TopoDS_Face>& faces) {
+  for (const TopoDS_Face& face : faces) {
+    try {
+      if (BRepAdaptor_Surface(face, Standard_False).GetType() != GeomAbs_Plane) continue;
+      TopTools_ListOfShape edges;
+      for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) edges.Append(e.Current());
+      BRepLib::BuildPCurveForEdgesOnPlane(edges, face);
+    } catch (const Standard_Failure&) {
+      // Left as it was: OCCT computes the curves on demand, as before.
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
                                    std::vector<Diagnostic>& diagnostics, bool& complete) {
@@ -97,6 +122,8 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
                                          heal_message(in.name, i, healed[i] != 0, fixed)});
       }
     }
+
+    store_plane_pcurves(impl->faces);
 
     impl->boxes.resize(n);
     Aabb part_box;

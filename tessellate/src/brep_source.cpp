@@ -109,6 +109,30 @@ std::optional<double> BrepSource::point_distance(std::uint32_t local_index, cons
   }
 }
 
+std::optional<SurfaceSource::SurfacePoint> BrepSource::surface_point(std::uint32_t local_index,
+                                                                     const Vec3& point) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    return detail::face_surface_point(a.faces[local_index], a.boxes[local_index], gp_Pnt(point.x(), point.y(), point.z()));
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
+std::optional<double> BrepSource::boundary_distance(std::uint32_t local_index, const Vec3& point) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    return detail::face_boundary_witness(a.locator(local_index), a.boxes[local_index],
+                                         gp_Pnt(point.x(), point.y(), point.z()));
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<double> BrepSource::edge_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,
                                                 std::uint32_t local_b, const Pose& pose_b, const Vec3& near_a,
                                                 const Vec3& near_b) const {

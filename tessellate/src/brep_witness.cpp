@@ -36,6 +36,12 @@ namespace {
 // 2^-40 covers 8,000 such roundings.
 constexpr double kEvaluationRounding = 0x1p-40;
 
+// The largest distance of a box corner from the origin: bounds every point and control point the
+// face's evaluation combines.
+double box_norm(const Aabb& box) {
+  return box.isEmpty() ? 0.0 : box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
+}
+
 // The parameters of the face's triangulation node nearest to `p`: a node lies on the surface, so
 // Newton started there reaches the foot point of any point within a triangle's size of the face.
 std::optional<gp_Pnt2d> nearest_node_parameters(const TopoDS_Face& face, const gp_Pnt& p) {
@@ -135,29 +141,68 @@ FaceLocator::FaceLocator(const TopoDS_Face& face)
 
 FaceLocator::~FaceLocator() = default;
 
-std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
-                                         const gp_Pnt& p) {
+namespace {
+
+// The local foot point of `p` on the face's surface by Newton from the nearest triangulation node:
+// its parameters and the rounding bound of evaluating there.
+struct Foot {
+  double u = 0.0, v = 0.0;
+  double magnitude = 0.0;
+};
+
+std::optional<Foot> newton_foot(const BRepAdaptor_Surface& surface, const TopoDS_Face& face, const Aabb& face_box,
+                                const gp_Pnt& p) {
   const std::optional<gp_Pnt2d> start = nearest_node_parameters(face, p);
   if (!start) return std::nullopt;
-  const BRepAdaptor_Surface surface(face, Standard_False);
   Extrema_GenLocateExtPS foot(surface);
   foot.Perform(p, start->X(), start->Y());
   if (!foot.IsDone()) return std::nullopt;
-  double u = 0.0, v = 0.0;
-  foot.Point().Parameter(u, v);
+  Foot f;
+  foot.Point().Parameter(f.u, f.v);
   // Every evaluated point and the control points stay within the face box's reach of the origin.
-  const double magnitude =
-      gp_Vec(p.XYZ()).Magnitude() +
-      (face_box.isEmpty() ? 0.0 : face_box.min().cwiseAbs().cwiseMax(face_box.max().cwiseAbs()).norm());
+  f.magnitude = gp_Vec(p.XYZ()).Magnitude() + box_norm(face_box);
+  return f;
+}
+
+}  // namespace
+
+std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
+                                         const gp_Pnt& p) {
+  const BRepAdaptor_Surface surface(face, Standard_False);
+  const std::optional<Foot> f = newton_foot(surface, face, face_box, p);
+  if (!f) return std::nullopt;
   // Parameters the classifier puts inside name a point of the face. A foot on or past the boundary
   // means the face's nearest points are on its edges.
   TopAbs_State state = TopAbs_UNKNOWN;
   {
     std::lock_guard<std::mutex> lock(where.domain_mutex);
-    state = where.domain->Perform(gp_Pnt2d(u, v));
+    state = where.domain->Perform(gp_Pnt2d(f->u, f->v));
   }
-  if (state != TopAbs_IN) return edge_witness(where, p, magnitude);
-  return p.Distance(surface.Value(u, v)) + kEvaluationRounding * magnitude;
+  if (state != TopAbs_IN) return edge_witness(where, p, f->magnitude);
+  return p.Distance(surface.Value(f->u, f->v)) + kEvaluationRounding * f->magnitude;
+}
+
+std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p) {
+  const double magnitude = gp_Vec(p.XYZ()).Magnitude() + box_norm(face_box);
+  return edge_witness(where, p, magnitude);
+}
+
+std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
+                                                              const gp_Pnt& p) {
+  const BRepAdaptor_Surface surface(face, Standard_False);
+  const std::optional<Foot> f = newton_foot(surface, face, face_box, p);
+  if (!f) return std::nullopt;
+  gp_Pnt s;
+  gp_Vec du, dv;
+  surface.D1(f->u, f->v, s, du, dv);
+  const gp_Vec n = du.Crossed(dv);
+  if (!(n.Magnitude() > 0.0)) return std::nullopt;  // a singular point (apex, pole): no normal
+  SurfaceSource::SurfacePoint out;
+  out.point = Vec3(s.X(), s.Y(), s.Z());
+  const gp_Vec nu = n.Normalized();
+  out.normal = Vec3(nu.X(), nu.Y(), nu.Z());
+  out.rounding = kEvaluationRounding * f->magnitude;
+  return out;
 }
 
 }  // namespace cadclash::detail

@@ -182,6 +182,32 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // A point of the surface that face `local_index` lies on, near `point` (this part's local frame):
+  // the local foot point of `point`, found by Newton from the face's nearest triangulation node, with
+  // the unit surface normal there (either orientation) and a bound on the rounding of its evaluation.
+  // It may lie outside the face's boundary: the caller decides that (the certified decision checks
+  // it against the face's triangles, which is cheaper than an exact face classifier). nullopt when
+  // there is no exact geometry or Newton failed. Thread-safe like exact_distance.
+  struct SurfacePoint {
+    Vec3 point = Vec3::Zero();
+    Vec3 normal = Vec3::UnitZ();
+    double rounding = 0.0;  // |point - the surface's true point at its parameters| is below this
+  };
+  virtual std::optional<SurfacePoint> surface_point(std::uint32_t local_index, const Vec3& point) const {
+    (void)local_index, (void)point;
+    return std::nullopt;
+  }
+
+  // An upper bound on the distance from `point` (part-local) to face `local_index`'s boundary, realised
+  // by a point of one of its edge curves (so a point of the face): what point_distance falls back to
+  // for a foot point outside the face, without the foot point and the face classifier before it.
+  // Cheaper when the caller knows the point lies on or next to the boundary. nullopt when there is
+  // no exact geometry or no edge point was found. Thread-safe like exact_distance.
+  virtual std::optional<double> boundary_distance(std::uint32_t local_index, const Vec3& point) const {
+    (void)local_index, (void)point;
+    return std::nullopt;
+  }
+
   // An upper bound on the distance between this part's surface `local_a` placed by `pose_a` and
   // `other`'s surface `local_b` placed by `pose_b`, realised by a point on an edge of each: the local
   // extremum of the two edges nearest `near_a` and `near_b` (each in its own part frame; typically

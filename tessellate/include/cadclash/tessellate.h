@@ -132,6 +132,13 @@ class BrepSource final : public SurfaceSource {
   // between a vertex at `point` and the face.
   std::optional<double> point_distance(std::uint32_t local_index, const Vec3& point) const override;
 
+  // Extrema_GenLocateExtPS (Newton) from the nearest node of the face's triangles, no classifier;
+  // the normal from the surface's first derivatives.
+  std::optional<SurfacePoint> surface_point(std::uint32_t local_index, const Vec3& point) const override;
+
+  // ShapeAnalysis_Curve's projection onto the face's edges, nearest edge box first.
+  std::optional<double> boundary_distance(std::uint32_t local_index, const Vec3& point) const override;
+
   // Extrema_LocateExtCC between the edge of each face nearest its given point, started at their
   // projections (ShapeAnalysis_Curve); `other` must be a BrepSource, else nullopt.
   std::optional<double> edge_distance(std::uint32_t local_a, const Pose& pose_a, const SurfaceSource& other,

@@ -1,0 +1,142 @@
+// Step 2c of the certified decision (decide_steps.h): faces that cross a plane of the other face.
+// A part sunk into a flat face or pressed through it has faces whose vertices all lie a crossing
+// depth away from the flat face, so no vertex witnesses the contact; a point of the crossing does.
+#include "decide_steps.h"
+
+#include "box_util.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cadclash::detail {
+namespace {
+
+// At most this many crossing points are tried per side; Newton ones cost a few point queries each.
+constexpr std::size_t kMaxPlanarTrials = 8;
+constexpr std::size_t kMaxNewtonTrials = 4;
+constexpr std::size_t kMaxClassifierTrials = 2;
+constexpr int kMaxNewtonSteps = 6;
+// cos 0.5°: triangles closer to parallel than this do not start a crossing.
+constexpr double kParallel = 0.99996;
+
+// The midpoints of the segments where the triangles of `mesh` inside `region` cross the plane
+// (unit normal n through o), in triangle order: each is a point of a triangle on the plane.
+std::vector<Vec3> plane_crossings(const TriangleMesh& mesh, const Vec3& n, const Vec3& o, const Aabb& region) {
+  std::vector<Vec3> out;
+  for (const auto& tri : mesh.triangles) {
+    const Vec3* v[3] = {&mesh.vertices[tri[0]], &mesh.vertices[tri[1]], &mesh.vertices[tri[2]]};
+    Aabb box;
+    for (const Vec3* p : v) box.extend(*p);
+    if (!box.intersects(region)) continue;
+    double h[3];
+    for (int k = 0; k < 3; ++k) h[k] = n.dot(*v[k] - o);
+    if (!(std::min({h[0], h[1], h[2]}) < 0.0 && std::max({h[0], h[1], h[2]}) > 0.0)) continue;
+    // A triangle (nearly) parallel to the plane crosses it by round-off or by its chord's sag: faces
+    // lying on the plane or tangent to it, which the witness steps prove; no crossing curve to follow.
+    const Vec3 normal = (*v[1] - *v[0]).cross(*v[2] - *v[0]);
+    if (!(std::abs(normal.dot(n)) < kParallel * normal.norm())) continue;
+    Vec3 ends[2];
+    int found = 0;
+    for (int k = 0; k < 3 && found < 2; ++k) {
+      const int l = (k + 1) % 3;
+      if ((h[k] < 0.0) == (h[l] < 0.0)) continue;  // this edge stays on one side (or ends on the plane)
+      const double s = h[k] / (h[k] - h[l]);
+      ends[found++] = *v[k] + s * (*v[l] - *v[k]);
+    }
+    if (found == 2) out.push_back(0.5 * (ends[0] + ends[1]));
+  }
+  return out;
+}
+
+// One side: P's face lies on a plane, Q's face crosses it. `to_q` maps P's frame into Q's,
+// `to_p` back. Returns the bound on d* it proved (<= T), or nothing.
+struct Proof {
+  double hi;
+  DecidedBy by;
+};
+
+std::optional<Proof> cross_plane(const Part& part_q, SurfaceId sq, FaceView fp, FaceView fq, double eps_q,
+                                 const Pose& to_q, const Pose& to_p, double r, double threshold, CollideCounters& c) {
+  const Surface& P = fp.surface;
+  const Surface& Q = fq.surface;
+  const AnalyticSurface plane = transform_analytic(P.analytic, to_q);
+  const Vec3 n = plane.axis.normalized();
+  const Aabb region =
+      pad_box(Q.aabb.isEmpty() ? mesh_aabb(Q.mesh) : Q.aabb, Q.deflection)
+          .intersection(pad_box(transform_box(P.aabb.isEmpty() ? mesh_aabb(P.mesh) : P.aabb, to_q), threshold));
+  if (region.isEmpty()) return std::nullopt;
+  const std::vector<Vec3> xs = plane_crossings(Q.mesh, n, plane.origin, region);
+  // The plane's foot of a point of Q, inside P's face: then |height| bounds the point's distance to it.
+  auto on_p = [&](const Vec3& y, double h) { return inside_face(fp, to_p * (y - h * n), r); };
+  const double headroom = threshold - eps_q - r;
+  if (!(headroom > 0.0)) return std::nullopt;
+  const std::uint32_t local = part_q.source ? sq - part_q.first_surface : 0;
+  // A point y of Q's surface (within `rounding`) whose foot on P's plane is inside P: its distance to
+  // face Q is 0 when Q's triangles put it inside, else what Q's exact classifier measures (a point
+  // near Q's boundary, as where a sunk part's side meets its seat: one query).
+  std::size_t asked = 0;
+  auto bound = [&](const Vec3& y, double h, double rounding, bool on_triangles) -> std::optional<double> {
+    if (!(std::abs(h) + rounding <= headroom) || !on_p(y, h)) return std::nullopt;
+    if (inside_face(fq, y, rounding + r, on_triangles)) return eps_q + std::abs(h) + rounding + r;
+    if (!part_q.source || ++asked > kMaxClassifierTrials) return std::nullopt;
+    ++c.witness_queries;
+    const std::optional<double> d = part_q.source->point_distance(local, y);
+    if (!d) return std::nullopt;
+    return eps_q + *d + std::abs(h) + rounding + r;
+  };
+  // A planar face's triangles lie on its plane: a crossing point is a point of that face's surface.
+  if (Q.analytic.shape == SurfaceShape::Plane || Q.exact_triangles) {
+    std::size_t trials = 0;
+    for (const Vec3& x : xs) {
+      if (++trials > kMaxPlanarTrials) break;
+      if (auto hi = bound(x, n.dot(x - plane.origin), 0.0, true); hi && *hi <= threshold)
+        return Proof{*hi, asked > 0 ? DecidedBy::Exact : DecidedBy::Analytic};
+    }
+    return std::nullopt;
+  }
+  if (!part_q.source) return std::nullopt;
+  std::size_t trials = 0;
+  for (const Vec3& x : xs) {
+    // Only crossings whose foot lies well inside P start a Newton run (one on P's boundary is an edge
+    // contact, the witness steps' case).
+    if (!on_p(x, n.dot(x - plane.origin))) continue;
+    if (++trials > kMaxNewtonTrials) break;
+    // Newton on the curve where Q's surface meets the plane: from each foot point, to the point of
+    // the line (plane ∩ tangent plane there) nearest it, and its foot again.
+    Vec3 y = x;
+    for (int step = 0; step < kMaxNewtonSteps; ++step) {
+      ++c.witness_queries;
+      const auto sp = part_q.source->surface_point(local, y);
+      if (!sp) break;
+      const double h = n.dot(sp->point - plane.origin);
+      if (std::abs(h) + sp->rounding <= 0.5 * headroom) {
+        if (auto hi = bound(sp->point, h, sp->rounding, false); hi && *hi <= threshold) return Proof{*hi, DecidedBy::Exact};
+        break;
+      }
+      const double cn = n.dot(sp->normal);
+      const double den = 1.0 - cn * cn;
+      if (!(den > 1e-6)) break;  // the surfaces are tangent there: no crossing curve to follow
+      const double alpha = -h / den;
+      y = sp->point + alpha * n - alpha * cn * sp->normal;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                   Pending& p, const CollideOptions& o, CollideCounters& c) {
+  if (t.outcome == nullptr || !t.outcome->intersecting) return;
+  if (!fa.surface.has_triangles || !fb.surface.has_triangles) return;
+  std::optional<Proof> proof;
+  if (fa.surface.analytic.shape == SurfaceShape::Plane)
+    proof = cross_plane(m.parts[fb.surface.part], t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
+  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane)
+    proof = cross_plane(m.parts[fa.surface.part], t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
+  if (!proof || !(proof->hi <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, proof->hi);
+  settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
+}
+
+}  // namespace cadclash::detail
