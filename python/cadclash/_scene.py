@@ -161,9 +161,27 @@ def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[
             text = f.read()
     except OSError as e:
         raise InputError(f"{path}: error: cannot open trajectory ({e.strerror})", []) from e
-    parse_raw, steps_raw, run_raw = scene._core.replay(text, path, o)
+    parse_raw, steps_raw, run_raw, distinct_steps = scene._core.replay(text, path, o)
     parse = _diagnostics(parse_raw)
     if any(d.is_error for d in parse):
         raise InputError(f"{path}: the trajectory has errors; nothing checked", parse)
     steps = [StepResult(step, _report(scene.model, raw)) for step, raw in steps_raw]
-    return Replay(steps, parse + _diagnostics(run_raw))
+    replay_diagnostics = _diagnostics(run_raw)
+    return Replay(steps, parse + replay_diagnostics,
+                  _replay_document(scene, o, path, steps, steps_raw, distinct_steps, replay_diagnostics))
+
+
+def _replay_document(scene: Scene, o, path: str, steps, steps_raw, distinct_steps: int, replay_diagnostics):
+    """The `cadclash check --path` report of a replay, assembled as the CLI does."""
+    model = scene.model
+    not_checked = distinct_steps - len(steps)
+    stopped_by = next((s.report.stopped_by for s in steps if not s.report.complete), "")
+    if not stopped_by and not_checked > 0:
+        stopped_by = "time budget"
+    step_diagnostics = [d for s in steps for d in s.report.diagnostics]
+    diagnostics = [str(d) for d in replay_diagnostics + model.diagnostics + step_diagnostics]
+    complete = model.complete and not any(d.is_error for d in step_diagnostics) and not stopped_by
+    settings = _core.report_settings(o, model, *scene._given)
+    return _core.ReportDocument.trajectory(list(model.files), settings, path,
+                                           [(step, raw[8]) for step, raw in steps_raw], not_checked, stopped_by,
+                                           diagnostics, complete)

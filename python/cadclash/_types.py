@@ -263,6 +263,16 @@ class Replay:
 
     steps: List[StepResult]
     diagnostics: List[Diagnostic]
+    # The `cadclash check --path` JSON report of this replay; None for a Replay made by hand.
+    _document: Optional["_core.ReportDocument"] = field(default=None, repr=False, compare=False)
+
+    def to_json(self, timings: bool = False) -> str:
+        """The JSON report of the replay, byte for byte what ``cadclash check FILES --path CSV --json
+        OUT [--no-timings]`` writes for the same files, trajectory path (as given) and options (see
+        ``Report.to_json``). ValueError for a Replay built by hand."""
+        if self._document is None:
+            raise ValueError("this replay has no JSON document (only replay() results have one)")
+        return self._document.to_json(timings)
 
     def __iter__(self) -> Iterator[StepResult]:
         return iter(self.steps)

@@ -95,6 +95,25 @@ void bind_report(pyb::module_& m) {
              return r;
            }),
            pyb::arg("files"), pyb::arg("settings"), pyb::arg("query"), pyb::arg("diagnostics"), pyb::arg("complete"))
+      .def_static(
+          "trajectory",
+          [](std::vector<std::string> files, ReportSettings settings, std::string trajectory,
+             std::vector<std::pair<std::int64_t, QueryReport>> steps, std::uint64_t steps_not_checked,
+             std::string stopped_by, std::vector<std::string> diagnostics, bool complete) {
+            CheckReport r;
+            r.files = std::move(files);
+            r.settings = std::move(settings);
+            r.trajectory = std::move(trajectory);
+            for (auto& [step, query] : steps) r.steps.push_back({step, std::move(query)});
+            r.steps_not_checked = steps_not_checked;
+            r.stopped_by = std::move(stopped_by);
+            r.diagnostics = std::move(diagnostics);
+            r.complete = complete;
+            return r;
+          },
+          pyb::arg("files"), pyb::arg("settings"), pyb::arg("trajectory"), pyb::arg("steps"),
+          pyb::arg("steps_not_checked"), pyb::arg("stopped_by"), pyb::arg("diagnostics"), pyb::arg("complete"),
+          "A `cadclash check --path` report: one (step, QueryRecord) per step checked.")
       .def(
           "to_json",
           [](const CheckReport& r, bool with_timings) { return check_report_text(r, {.timings = with_timings}); },

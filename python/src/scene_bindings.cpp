@@ -140,9 +140,11 @@ void bind_scene(pyb::module_& m) {
         std::vector<Diagnostic> parse_diags, run_diags;
         std::vector<StepResult> steps;
         std::vector<QueryReport> records;
+        std::size_t distinct_steps = 0;  // of the rows: steps_not_checked = distinct_steps - steps
         {
           ModelLock lock(*c.state);
           const std::vector<TrajectoryRow> rows = parse_trajectory(csv_text, file, parse_diags);
+          for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
           if (!has_error(parse_diags)) {  // like `cadclash check --path`: a bad row means nothing is run
             Running running(c.running);
             steps = replay_trajectory(*c.scene, rows, o, run_diags, file);
@@ -152,7 +154,7 @@ void bind_scene(pyb::module_& m) {
         pyb::list out;
         for (std::size_t k = 0; k < steps.size(); ++k)
           out.append(pyb::make_tuple(steps[k].step, report_to_tuple(steps[k].report, std::move(records[k]))));
-        return pyb::make_tuple(diagnostics_to_list(parse_diags), out, diagnostics_to_list(run_diags));
+        return pyb::make_tuple(diagnostics_to_list(parse_diags), out, diagnostics_to_list(run_diags), distinct_steps);
       });
 
   m.def("collide", [](ModelCore& model, std::int64_t a, std::int64_t b, const CollideOptions& o) {

@@ -131,3 +131,12 @@ def test_names_come_from_the_library():
         "pairs": 0, "penetrating": 0, "touching": 0, "clearance": 0, "containment": 0, "undecided": 0,
         "decided_by": {"mesh": 0, "mesh-exact": 0, "analytic": 0, "refined": 0, "exact": 0, "undecided": 0}}
     assert len(vars(cadclash.Counters())) == 24
+
+
+def test_replay_is_byte_identical_to_check_path(boxes, data_dir, cli_text):
+    csv = str(data_dir / "collide" / "path_ok.csv")
+    scene = cadclash.Scene(cadclash.load([str(b) for b in boxes]))
+    replayed = cadclash.replay(scene, csv, clearance=0.2)
+    text = cli_text(boxes, "--path", csv, "--clearance", "0.2")
+    assert '"steps"' in text and len(replayed) > 1
+    _same_text(replayed.to_json(), text)
