@@ -204,11 +204,12 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   // A vertex farther than this from the other face's triangles is beyond reach of its exact face.
   const double limit_a = o.tolerance + eps[t.sb] + band;  // A's vertices, asked of B
   const double limit_b = o.tolerance + eps[t.sa] + band;
-  std::vector<Candidate> cs;
-  near_vertices(a, t.t_ba, fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
-  near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
-  order_trials(cs, fa, fb);
-  for (const Candidate& cand : cs) {
+  std::vector<Candidate> tried;
+  // One trial: the candidate's distance to the other exact face, bounded by a point of that face.
+  auto proves = [&](const Candidate& cand) {
+    for (const Candidate& x : tried)
+      if (x.of_a == cand.of_a && x.point == cand.point) return false;
+    tried.push_back(cand);
     const Part& asked = cand.of_a ? pb : pa;
     const FaceView& face = cand.of_a ? fb : fa;
     const std::uint32_t local = (cand.of_a ? t.sb : t.sa) - asked.first_surface;
@@ -229,14 +230,33 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
         d = asked.source->point_distance(local, cand.point);
       }
     }
-    if (!d) continue;
-    const double hi = own + *d;
-    if (hi <= p.threshold) {
-      p.d.hi = std::min(p.d.hi, hi);
-      settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
-      return;
+    if (!d || !(own + *d <= p.threshold)) return false;
+    p.d.hi = std::min(p.d.hi, own + *d);
+    settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+    return true;
+  };
+  // First the vertices of the triangle pair that decided the triangles' outcome (found already: six
+  // tree queries), then every vertex near the other face.
+  std::vector<Candidate> cs;
+  if (out->witness[0] != kInvalidId && out->witness[1] != kInvalidId) {
+    for (std::uint32_t v : a.mesh.triangles[out->witness[0]]) {
+      const Vec3 w = t.t_ba * a.mesh.vertices[v];
+      if (const double d = point_mesh_distance(fb.bvh, b.mesh, w, limit_a); d <= limit_a) cs.push_back({d, true, w});
     }
+    for (std::uint32_t v : b.mesh.triangles[out->witness[1]]) {
+      const Vec3 w = t.t_ab * b.mesh.vertices[v];
+      if (const double d = point_mesh_distance(fa.bvh, a.mesh, w, limit_b); d <= limit_b) cs.push_back({d, false, w});
+    }
+    order_trials(cs, fa, fb);
+    for (const Candidate& cand : cs)
+      if (proves(cand)) return;
+    cs.clear();
   }
+  near_vertices(a, t.t_ba, fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
+  near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
+  order_trials(cs, fa, fb);
+  for (const Candidate& cand : cs)
+    if (proves(cand)) return;
 }
 
 namespace {

@@ -97,7 +97,11 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     run_step(open, pending, threads, deadline,
              [&](std::size_t k) { analytic_contact(eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o); });
     // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
-    run_step(select(pending, [&](std::size_t k) { return meshed(k) && tasks[k].outcome->intersecting; }), pending,
+    // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
+    // cross by round-off only, and the vertex witnesses prove those.
+    run_step(select(pending, [&](std::size_t k) {
+               return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->penetration > pending[k].threshold;
+             }), pending,
              threads, deadline, [&](std::size_t k) {
                crossing_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
              });

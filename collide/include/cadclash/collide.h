@@ -82,16 +82,27 @@ namespace cadclash {
 //             by more than T + its deflection: a lower bound on d* (proves "apart"); or a vertex of
 //             one face whose foot point on the other's plane, cylinder or sphere is provably inside
 //             that face, within T (proves contact);
+//   crossing  triangles crossing deeper than T where one face lies on a plane (a part sunk into or
+//             pressed through a flat face): a point of the other face on that plane, inside both
+//             faces — on a planar face the crossing of its triangles (decided_by Analytic), on a
+//             curved one Newton on the curve where its surface meets the plane
+//             (SurfaceSource::surface_point; decided_by Exact) — proves contact;
 //   witness   a vertex of one face's triangles (a point of that exact face, within its ε) near the
 //             other face's triangles, whose distance to the other exact face is within tolerance + ε
-//             of that face: SurfaceSource::point_distance gives an upper bound realised by a point of
-//             that face (B-rep: a Newton foot point inside the face, or a point of its edges), so
-//             contact is proved (decided_by Exact: measured on the exact face); nearest vertices
-//             first, at most 8 per pair; then, where the outlines come closest, a point on an edge of
-//             each face (SurfaceSource::edge_distance: Newton on the two edge curves) — faces meeting
-//             edge to edge, as a curved edge tangent to a straight one;
-//   refined   both faces re-tessellated at a tenth of their deflection by their SurfaceSource (cached
-//             in the Scene) and the interval taken again;
+//             of that face, bounded by a point of that face: its foot point on the surface
+//             (SurfaceSource::surface_point) when the face's triangles put the foot inside the face
+//             (within its deflection of them, clear of their outline by twice that), else a point of
+//             its edge curves (SurfaceSource::boundary_distance), else SurfaceSource::point_distance
+//             (B-rep: OCCT's face classifier). Contact is proved (decided_by Exact: measured on the
+//             exact face); the vertices of the triangle pair that decided the triangles' outcome
+//             first, then the nearest vertices, at most 8 per pair; then, where the outlines come
+//             closest, a point on an edge of each face (SurfaceSource::edge_distance: Newton on the
+//             two edge curves) — faces meeting edge to edge, as a curved edge tangent to a straight one;
+//   refined   where finer triangles could show a gap (the triangles stay apart by more than T plus
+//             the finer band), the faces re-tessellated at a tenth of their deflection by their
+//             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
+//             cylinder or sphere of either face against the other's finer triangles; a face of those
+//             shapes is not refined when the other face is not one (its surface bounds the gap);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
@@ -196,7 +207,8 @@ struct CollideCounters {
   std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
   std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
   std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
-  std::uint64_t witness_queries = 0;    // SurfaceSource::point_distance and edge_distance calls (witnesses)
+  std::uint64_t witness_queries = 0;    // SurfaceSource surface_point, boundary_distance, point_distance and
+                                        // edge_distance calls (witnesses and crossings)
   std::uint64_t dismissed_pairs = 0;    // candidate pairs the triangles' band would call touching
                                         // (fast mode's answer) that a certificate proved apart
 };
