@@ -1,6 +1,8 @@
-// Step 2c of the certified decision (decide_steps.h): faces that cross a plane of the other face.
-// A part sunk into a flat face or pressed through it has faces whose vertices all lie a crossing
-// depth away from the flat face, so no vertex witnesses the contact; a point of the crossing does.
+// Steps 2c and 2d of the certified decision (decide_steps.h): contacts with a face's plane that no
+// vertex witnesses. A part sunk into a flat face or pressed through it has faces whose vertices all
+// lie a crossing depth away from the flat face; a point of the crossing proves the contact. A
+// cylinder, cone or sphere tangent to a flat face touches it along a line or at a point where no
+// vertex need lie; its support point toward the plane proves it.
 #include "decide_steps.h"
 
 #include "box_util.h"
@@ -123,7 +125,96 @@ std::optional<Proof> cross_plane(const Part& part_q, SurfaceId sq, FaceView fp, 
   return std::nullopt;
 }
 
+// The point of Q's cylinder, cone or sphere farthest along `d` (a unit vector) near the point `v`
+// (for a cylinder on v's cross-section, for a cone on v's distance along the generatrix): where a
+// surface tangent to a plane touches it. nullopt where that is not unique (axis along d).
+std::optional<Vec3> support_point(const AnalyticSurface& q, const Vec3& d, const Vec3& v) {
+  const Vec3 a = q.axis.normalized();
+  switch (q.shape) {
+    case SurfaceShape::Sphere: return q.origin + q.radius * d;
+    case SurfaceShape::Cylinder: {
+      const Vec3 w = d - d.dot(a) * a;
+      if (!(w.norm() > 1e-9)) return std::nullopt;
+      return q.origin + (v - q.origin).dot(a) * a + q.radius * w.normalized();
+    }
+    case SurfaceShape::Cone: {
+      const Vec3 w = d - d.dot(a) * a;
+      if (!(w.norm() > 1e-9)) return std::nullopt;
+      const double side = (v - q.origin).dot(a) < 0.0 ? -1.0 : 1.0;  // the nappe v lies on
+      const Vec3 g = std::cos(q.radius2) * side * a + std::sin(q.radius2) * w.normalized();
+      const double s = (v - q.origin).dot(g);
+      if (!(s > 0.0)) return std::nullopt;
+      return q.origin + s * g;
+    }
+    default: return std::nullopt;
+  }
+}
+
+// P's face lies on a plane, Q's on a cylinder, cone or sphere that may touch it (tangent). The
+// support point toward the plane near Q's lowest vertices, inside both faces, bounds d*.
+std::optional<Proof> touch_plane(const Part& part_p, SurfaceId sp, const Part& part_q, SurfaceId sq, FaceView fp,
+                                 FaceView fq, double eps_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
+                                 CollideCounters& c) {
+  const Surface& Q = fq.surface;
+  const AnalyticSurface plane = transform_analytic(fp.surface.analytic, to_q);
+  const Vec3 n = plane.axis.normalized();
+  const double headroom = threshold - eps_q - r;
+  if (!(headroom > 0.0) || Q.mesh.vertices.empty()) return std::nullopt;
+  // Q's vertices nearest the plane (by |height|), a few.
+  std::vector<std::pair<double, std::uint32_t>> low;
+  for (std::uint32_t i = 0; i < Q.mesh.vertices.size(); ++i)
+    low.emplace_back(std::abs(n.dot(Q.mesh.vertices[i] - plane.origin)), i);
+  const std::size_t keep = std::min<std::size_t>(low.size(), kMaxNewtonTrials);
+  std::partial_sort(low.begin(), low.begin() + static_cast<std::ptrdiff_t>(keep), low.end());
+  std::size_t asked = 0;
+  for (std::size_t k = 0; k < keep; ++k) {
+    const Vec3& v = Q.mesh.vertices[low[k].second];
+    const Vec3 d = n.dot(v - plane.origin) > 0.0 ? Vec3(-n) : n;  // toward the plane
+    const std::optional<Vec3> x = support_point(Q.analytic, d, v);
+    if (!x) continue;
+    const double h = n.dot(*x - plane.origin);
+    if (!(std::abs(h) <= headroom)) continue;
+    // x's distance to face Q (0 inside it) and to face P (|h| when its foot is inside P); a point on
+    // either face's boundary (a shaft lying across the board's edge) is asked of the source.
+    bool exact = false;
+    auto ask = [&](const Part& part, SurfaceId s, const Vec3& y) -> std::optional<double> {
+      if (!part.source || ++asked > kMaxClassifierTrials) return std::nullopt;
+      ++c.witness_queries;
+      exact = true;
+      return part.source->point_distance(s - part.first_surface, y);
+    };
+    std::optional<double> off_q = 0.0, to_face_p = std::abs(h);
+    if (!inside_face(fq, *x, r)) off_q = ask(part_q, sq, *x);
+    if (!off_q) continue;
+    if (!inside_face(fp, to_p * (*x - h * n), r)) to_face_p = ask(part_p, sp, to_p * *x);
+    if (!to_face_p) continue;
+    const double hi = eps_q + *off_q + *to_face_p + r;
+    if (hi <= threshold) return Proof{hi, exact ? DecidedBy::Exact : DecidedBy::Analytic};
+  }
+  return std::nullopt;
+}
+
+bool touches_plane(const Surface& s) {
+  return s.analytic.shape == SurfaceShape::Cylinder || s.analytic.shape == SurfaceShape::Cone ||
+         s.analytic.shape == SurfaceShape::Sphere;
+}
+
 }  // namespace
+
+void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                  Pending& p, const CollideOptions& o, CollideCounters& c) {
+  if (t.outcome == nullptr || !fa.surface.has_triangles || !fb.surface.has_triangles) return;
+  std::optional<Proof> proof;
+  if (fa.surface.analytic.shape == SurfaceShape::Plane && touches_plane(fb.surface))
+    proof = touch_plane(m.parts[fa.surface.part], t.sa, m.parts[fb.surface.part], t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab,
+                        t.roundoff, p.threshold, c);
+  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && touches_plane(fa.surface))
+    proof = touch_plane(m.parts[fb.surface.part], t.sb, m.parts[fa.surface.part], t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba,
+                        t.roundoff, p.threshold, c);
+  if (!proof || !(proof->hi <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, proof->hi);
+  settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
+}
 
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
                    Pending& p, const CollideOptions& o, CollideCounters& c) {

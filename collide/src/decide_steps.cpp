@@ -91,11 +91,32 @@ double analytic_bound(const Surface& a, const Surface& b, double eps_a, double e
   return lb;
 }
 
+// A plane against a face whose surface has a hull (SurfaceSource::height_range: a B-spline's control
+// points): the hull's height over the plane bounds the face's distance to the plane, whatever the
+// face's triangles, with no band at all. A part standing off a flat face by less than its triangles'
+// deflection is proved apart without refining it.
+double hull_bound(const Model& m, std::span<const double> eps, const DecideTask& t) {
+  double lb = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    const SurfaceId sp = side == 0 ? t.sa : t.sb, sq = side == 0 ? t.sb : t.sa;
+    const Surface& plane_face = m.surfaces[sp];
+    const Part& part_q = m.parts[m.surfaces[sq].part];
+    if (plane_face.analytic.shape != SurfaceShape::Plane || !part_q.source) continue;
+    const AnalyticSurface plane = transform_analytic(plane_face.analytic, side == 0 ? t.t_ba : t.t_ab);
+    const auto range = part_q.source->height_range(sq - part_q.first_surface, plane.origin, plane.axis.normalized());
+    if (!range) continue;
+    const double gap = (*range)[0] > 0.0 ? (*range)[0] : (*range)[1] < 0.0 ? -(*range)[1] : 0.0;
+    lb = std::max(lb, gap - eps[t.sa] - eps[t.sb] - t.roundoff);
+  }
+  return lb;
+}
+
 }  // namespace
 
 // Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
 void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
-  const double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], eps[t.sa], eps[t.sb], t, p.threshold);
+  double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], eps[t.sa], eps[t.sb], t, p.threshold);
+  if (!(lb > p.threshold)) lb = std::max(lb, hull_bound(m, eps, t));
   if (!(lb > p.threshold)) return;
   p.d.lo = std::max(p.d.lo, lb);
   settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);

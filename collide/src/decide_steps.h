@@ -65,6 +65,11 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = fa
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                    Pending& p, const CollideOptions& o, CollideCounters& c);
 
+// Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface
+// nearest the plane (closed form, near its lowest vertices), inside both faces, proves contact.
+void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+                  Pending& p, const CollideOptions& o, CollideCounters& c);
+
 // Step 3: witness vertices (contact): vertices of each face near the other face's triangles, asked
 // of the other exact face (SurfaceSource::point_distance), nearest first. `a`, `b` are the model's
 // faces or finer ones (same part and index); `out` their outcome, `band` its band.

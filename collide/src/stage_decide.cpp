@@ -105,6 +105,10 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
              threads, deadline, [&](std::size_t k) {
                crossing_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
              });
+    // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
+    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
+      tangent_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
+    });
     // Step 3: witness vertices near the other face (a few exact point queries each).
     run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
       witness_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), tasks[k].outcome, pending[k].band,

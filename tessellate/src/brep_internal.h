@@ -111,6 +111,11 @@ std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLoca
 // curves (ShapeAnalysis_Curve, nearest edge box first), the evaluation's rounding added. May throw.
 std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p);
 
+// Bounds of n·(x - o) over the face from the control points of its B-spline or Bézier surface (the
+// surface lies in their convex hull when the weights are positive), rounding included; nullopt for
+// other surfaces. Reads the face only. May throw Standard_Failure.
+std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n);
+
 // The foot point of `p` on the face's surface by the same Newton, with the unit normal there and the
 // evaluation's rounding; not classified (it may lie outside the face). nullopt when Newton fails or
 // the surface is singular there. Reads the face only. May throw Standard_Failure.

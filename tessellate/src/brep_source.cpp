@@ -121,6 +121,18 @@ std::optional<SurfaceSource::SurfacePoint> BrepSource::surface_point(std::uint32
   }
 }
 
+std::optional<std::array<double, 2>> BrepSource::height_range(std::uint32_t local_index, const Vec3& origin,
+                                                              const Vec3& normal) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    return detail::face_height_range(a.faces[local_index], origin, normal);
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<double> BrepSource::boundary_distance(std::uint32_t local_index, const Vec3& point) const {
   const Impl& a = *impl_;
   assert(local_index < a.faces.size());

@@ -10,6 +10,11 @@
 #include <Bnd_Box.hxx>
 #include <BRep_Tool.hxx>
 #include <Extrema_GenLocateExtPS.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_BezierSurface.hxx>
+#include <Geom_RectangularTrimmedSurface.hxx>
+#include <TColStd_Array2OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
 #include <Extrema_LocateExtCC.hxx>
 #include <Extrema_POnCurv.hxx>
 #include <Poly_Triangulation.hxx>
@@ -203,6 +208,55 @@ std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face&
   out.normal = Vec3(nu.X(), nu.Y(), nu.Z());
   out.rounding = kEvaluationRounding * f->magnitude;
   return out;
+}
+
+namespace {
+
+// The heights of `poles` (placed by `place`) over the plane, widened by their evaluation's rounding.
+std::array<double, 2> pole_heights(const TColgp_Array2OfPnt& poles, const gp_Trsf& place, const Vec3& o, const Vec3& n) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, magnitude = o.norm();
+  for (int i = poles.LowerRow(); i <= poles.UpperRow(); ++i)
+    for (int j = poles.LowerCol(); j <= poles.UpperCol(); ++j) {
+      const gp_Pnt p = poles(i, j).Transformed(place);
+      const Vec3 v(p.X(), p.Y(), p.Z());
+      const double h = n.dot(v - o);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+      magnitude = std::max(magnitude, v.norm() + o.norm());
+    }
+  const double r = kEvaluationRounding * magnitude;
+  return {lo - r, hi + r};
+}
+
+bool positive(const TColStd_Array2OfReal* weights) {
+  if (weights == nullptr) return true;
+  for (int i = weights->LowerRow(); i <= weights->UpperRow(); ++i)
+    for (int j = weights->LowerCol(); j <= weights->UpperCol(); ++j)
+      if (!((*weights)(i, j) > 0.0)) return false;
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n) {
+  TopLoc_Location loc;
+  Handle(Geom_Surface) surface = BRep_Tool::Surface(face, loc);
+  while (!surface.IsNull()) {  // a trimmed surface lies on its basis surface
+    const Handle(Geom_RectangularTrimmedSurface) trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface);
+    if (trimmed.IsNull()) break;
+    surface = trimmed->BasisSurface();
+  }
+  if (surface.IsNull()) return std::nullopt;
+  const gp_Trsf place = loc.Transformation();
+  if (const Handle(Geom_BSplineSurface) b = Handle(Geom_BSplineSurface)::DownCast(surface); !b.IsNull()) {
+    if (!positive(b->Weights())) return std::nullopt;
+    return pole_heights(b->Poles(), place, o, n);
+  }
+  if (const Handle(Geom_BezierSurface) z = Handle(Geom_BezierSurface)::DownCast(surface); !z.IsNull()) {
+    if (!positive(z->Weights())) return std::nullopt;
+    return pole_heights(z->Poles(), place, o, n);
+  }
+  return std::nullopt;
 }
 
 }  // namespace cadclash::detail

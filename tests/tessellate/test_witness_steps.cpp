@@ -1,6 +1,8 @@
 // The cheap certificates of the certified decision on B-rep parts built here: the source's surface
 // and boundary points (SurfaceSource::surface_point, boundary_distance), the crossing witness for
-// parts sunk into a flat face, and refinement of only the face that is not a plane. Each case is
+// parts sunk into a flat face, the tangent witness for cylinders and spheres lying on one, the
+// control-point hull of a B-spline face over a plane, and refinement of only the face that is not a
+// plane. Each case is
 // checked for its verdict first and then for what it cost (no OCCT face-face query where the
 // geometry gives a cheaper proof): a wrong verdict fails, and so does a proof that silently falls
 // back to the expensive path.
@@ -9,9 +11,11 @@
 #include "cadclash/tessellate.h"
 
 #include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
 #include <TopoDS_Shape.hxx>
 
@@ -140,6 +144,94 @@ TEST(RefinedAnalytic, StandOffOverAPlaneIsProvedByRefiningTheOtherFaceOnly) {
   EXPECT_EQ(apart.report.counters.undecided, 0u);
   const Outcome touching = check_pair(m, 0.03);
   EXPECT_TRUE(touching.contact);
+}
+
+// Tangent to a flat face: a cylinder lying on its side and a sphere resting on it touch along a line
+// or at a point where no vertex of theirs need lie. Their support point toward the plane proves it
+// (no OCCT query); lifted by 0.01 mm they are apart.
+TEST(TangentWitness, CylinderAndSphereOnAPlaneTouchWithoutTheExactFaceDistance) {
+  for (bool sphere : {false, true}) {
+    for (double lift : {0.0, 0.01}) {
+      Model m = build({BRepPrimAPI_MakeBox(40, 40, 2).Shape(),
+                       sphere ? BRepPrimAPI_MakeSphere(4).Shape() : BRepPrimAPI_MakeCylinder(3, 12).Shape()},
+                      0.1);
+      place(m, 0, "/board", Pose::Identity());
+      Pose pose = Pose::Identity();
+      pose.translate(Vec3(14, 15, 2 + (sphere ? 4.0 : 3.0) + lift));
+      pose.rotate(Eigen::AngleAxisd(0.37, Vec3::UnitZ()));
+      if (!sphere) pose.rotate(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()));  // the axis along the board
+      place(m, 1, "/part", pose);
+      const Outcome r = check_pair(m, 1e-4);
+      const std::string what = std::string(sphere ? "sphere" : "cylinder") + " lifted " + std::to_string(lift);
+      EXPECT_EQ(r.contact, lift == 0.0) << what;
+      EXPECT_EQ(r.report.counters.undecided, 0u) << what;
+      // The curved face's contact is proved without OCCT (the cylinder's end disks touch the board at
+      // one point of their rims: plane against plane at an edge, which still asks OCCT).
+      int curved_contacts = 0;
+      for (const SurfacePairResult& p : r.report.pairs) {
+        const SurfaceShape sa = m.surfaces[p.surface_a].analytic.shape, sb = m.surfaces[p.surface_b].analytic.shape;
+        if (sa != SurfaceShape::Plane || sb == SurfaceShape::Plane) continue;
+        ++curved_contacts;
+        EXPECT_FALSE(p.exact_distance.has_value()) << what;
+      }
+      EXPECT_EQ(curved_contacts, lift == 0.0 ? 1 : 0) << what;
+      if (sphere) EXPECT_EQ(r.report.counters.exact_queries, 0u) << what;
+    }
+  }
+}
+
+// A NURBS cylinder (BRepBuilderAPI_NurbsConvert: B-spline faces, no analytic certificate) lying
+// 0.005 mm above a flat face, meshed at 0.1 mm, turned about its axis so that its triangles cannot
+// tell (a vertex row within a deflection of the board) while the hull of its control points stays
+// above the board: the hull proves it apart, without refining anything or asking OCCT.
+TEST(HullBound, BSplineStandingOffAPlaneIsApartWithoutRefinement) {
+  const TopoDS_Shape nurbs = BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeCylinder(3, 12).Shape()).Shape();
+  const double gap = 0.005;
+  Model m = build({BRepPrimAPI_MakeBox(40, 40, 2).Shape(), nurbs}, 0.1);
+  const auto* src = m.parts[1].source.get();
+  ASSERT_NE(src, nullptr);
+  // The lateral face: the one whose box spans the length.
+  std::uint32_t side = kInvalidId;
+  for (std::uint32_t i = 0; i < m.parts[1].surface_count; ++i)
+    if (m.surfaces[m.parts[1].first_surface + i].aabb.sizes().z() > 11.0) side = i;
+  ASSERT_NE(side, kInvalidId);
+  const Surface& lateral = m.surfaces[m.parts[1].first_surface + side];
+  ASSERT_EQ(lateral.analytic.shape, SurfaceShape::Other);
+  // Turned by `angle` about its axis (z), the axis then laid along the board: heights over the board.
+  auto pose_at = [&](double angle) {
+    Pose p = Pose::Identity();
+    p.translate(Vec3(14, 15, 2 + 3.0 + gap));
+    p.rotate(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()));
+    p.rotate(Eigen::AngleAxisd(angle, Vec3::UnitZ()));
+    return p;
+  };
+  double chosen = -1.0;
+  for (int k = 0; k < 360 && chosen < 0.0; ++k) {
+    const double angle = k * M_PI / 180.0;
+    const Pose p = pose_at(angle);
+    double lowest = 1e9;
+    for (const Vec3& v : lateral.mesh.vertices) lowest = std::min(lowest, (p * v).z() - 2.0);
+    // The board's plane z = 2 in the rod's frame.
+    const Pose inv = p.inverse(Eigen::Isometry);
+    bool clear = true;  // every face's hull (the end disks are B-splines too) above the board
+    for (std::uint32_t f = 0; f < m.parts[1].surface_count; ++f) {
+      const auto range = src->height_range(f, inv * Vec3(0, 0, 2), (inv.linear() * Vec3::UnitZ()).normalized());
+      ASSERT_TRUE(range.has_value());
+      clear = clear && (*range)[0] > 2e-4;
+    }
+    if (lowest - lateral.deflection <= 1e-4 && clear) chosen = angle;
+  }
+  ASSERT_GE(chosen, 0.0) << "no turn where the triangles are ambiguous and the hull clears the board";
+  place(m, 0, "/board", Pose::Identity());
+  place(m, 1, "/rod", pose_at(chosen));
+  const Outcome r = check_pair(m, 1e-4);
+  EXPECT_FALSE(r.contact);
+  // Fast mode (the band alone) would call the lateral face touching: dismissed, by the hull.
+  EXPECT_GE(r.report.counters.dismissed_pairs, 1u);
+  EXPECT_EQ(r.report.counters.decided_analytic, r.report.counters.dismissed_pairs);
+  EXPECT_EQ(r.report.counters.refined_surfaces, 0u);
+  EXPECT_EQ(r.report.counters.exact_queries, 0u);
+  EXPECT_EQ(r.report.counters.undecided, 0u);
 }
 
 }  // namespace

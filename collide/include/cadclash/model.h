@@ -198,6 +198,17 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // Bounds [lo, hi] on the signed height n·(x - origin) over every point x of face `local_index`
+  // (part-local; `normal` a unit vector), from a hull the face lies in: for B-spline and Bézier
+  // surfaces the convex hull of their control points (positive weights), rounding included. A
+  // lower bound on the face's distance to the plane (origin, normal) when lo > 0 or hi < 0. nullopt
+  // when the source knows no such hull for the face. Thread-safe like exact_distance.
+  virtual std::optional<std::array<double, 2>> height_range(std::uint32_t local_index, const Vec3& origin,
+                                                            const Vec3& normal) const {
+    (void)local_index, (void)origin, (void)normal;
+    return std::nullopt;
+  }
+
   // An upper bound on the distance from `point` (part-local) to face `local_index`'s boundary, realised
   // by a point of one of its edge curves (so a point of the face): what point_distance falls back to
   // for a foot point outside the face, without the foot point and the face classifier before it.

@@ -136,6 +136,11 @@ class BrepSource final : public SurfaceSource {
   // the normal from the surface's first derivatives.
   std::optional<SurfacePoint> surface_point(std::uint32_t local_index, const Vec3& point) const override;
 
+  // The control points of the face's B-spline or Bézier surface (unwrapping trimmed surfaces), placed
+  // by the face's location; nullopt for other surfaces and for non-positive weights.
+  std::optional<std::array<double, 2>> height_range(std::uint32_t local_index, const Vec3& origin,
+                                                    const Vec3& normal) const override;
+
   // ShapeAnalysis_Curve's projection onto the face's edges, nearest edge box first.
   std::optional<double> boundary_distance(std::uint32_t local_index, const Vec3& point) const override;
 
