@@ -17,6 +17,7 @@ namespace {
 constexpr std::size_t kMaxPlanarTrials = 8;
 constexpr std::size_t kMaxNewtonTrials = 4;
 constexpr std::size_t kMaxClassifierTrials = 2;
+constexpr std::size_t kMaxEdgeTrials = 4;  // outline vertices (each shared by two segments: two points)
 constexpr int kMaxNewtonSteps = 6;
 // cos 0.5°: triangles closer to parallel than this do not start a crossing.
 constexpr double kParallel = 0.99996;
@@ -194,6 +195,46 @@ std::optional<Proof> touch_plane(const Part& part_p, SurfaceId sp, const Part& p
   return std::nullopt;
 }
 
+// P's face lies on a plane; Q's face may touch it at one point of a curved edge (a disk or a bolt's
+// flat lying on its rim). The extremum toward the plane of Q's edge near its lowest outline points,
+// whose foot lies inside P, bounds d*.
+std::optional<Proof> edge_on_plane(const Part& part_p, SurfaceId sp, const Part& part_q, SurfaceId sq, FaceView fp,
+                                   FaceView fq, double eps_q, const Pose& to_q, const Pose& to_p, double r,
+                                   double threshold, CollideCounters& c) {
+  if (!part_q.source || fq.outline == nullptr || fq.outline->empty()) return std::nullopt;
+  const AnalyticSurface plane = transform_analytic(fp.surface.analytic, to_q);
+  const Vec3 n = plane.axis.normalized();
+  const double headroom = threshold - eps_q - r;
+  if (!(headroom > 0.0)) return std::nullopt;
+  std::vector<std::pair<double, Vec3>> low;
+  for (const auto& e : *fq.outline)
+    for (const Vec3& v : e) low.emplace_back(std::abs(n.dot(v - plane.origin)), v);
+  const std::size_t keep = std::min<std::size_t>(low.size(), kMaxEdgeTrials);
+  std::partial_sort(low.begin(), low.begin() + static_cast<std::ptrdiff_t>(keep), low.end(),
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (std::size_t k = 0; k < keep; ++k) {
+    if (k > 0 && low[k].second == low[k - 1].second) continue;  // an outline vertex ends two segments
+    const Vec3& v = low[k].second;
+    const Vec3 d = n.dot(v - plane.origin) > 0.0 ? Vec3(-n) : n;  // toward the plane
+    ++c.witness_queries;
+    const auto x = part_q.source->edge_support(sq - part_q.first_surface, d, v);
+    if (!x) continue;
+    const double h = n.dot(x->point - plane.origin);
+    if (!(std::abs(h) + x->rounding <= headroom)) continue;
+    // x is a point of face Q (on its edge); its distance to face P is |h| when its foot is inside P.
+    std::optional<double> to_face_p = std::abs(h);
+    if (!inside_face(fp, to_p * (x->point - h * n), r)) {
+      if (!part_p.source) continue;
+      ++c.witness_queries;
+      to_face_p = part_p.source->point_distance(sp - part_p.first_surface, to_p * x->point);
+      if (!to_face_p) continue;
+    }
+    const double hi = eps_q + *to_face_p + x->rounding + r;
+    if (hi <= threshold) return Proof{hi, DecidedBy::Exact};
+  }
+  return std::nullopt;
+}
+
 bool touches_plane(const Surface& s) {
   return s.analytic.shape == SurfaceShape::Cylinder || s.analytic.shape == SurfaceShape::Cone ||
          s.analytic.shape == SurfaceShape::Sphere;
@@ -211,6 +252,21 @@ void tangent_step(const Model& m, std::span<const double> eps, const DecideTask&
   if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && touches_plane(fa.surface))
     proof = touch_plane(m.parts[fb.surface.part], t.sb, m.parts[fa.surface.part], t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba,
                         t.roundoff, p.threshold, c);
+  if (!proof || !(proof->hi <= p.threshold)) return;
+  p.d.hi = std::min(p.d.hi, proof->hi);
+  settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
+}
+
+void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                       Pending& p, const CollideOptions& o, CollideCounters& c) {
+  if (t.outcome == nullptr || !fa.surface.has_triangles || !fb.surface.has_triangles) return;
+  const Part& pa = m.parts[fa.surface.part];
+  const Part& pb = m.parts[fb.surface.part];
+  std::optional<Proof> proof;
+  if (fa.surface.analytic.shape == SurfaceShape::Plane)
+    proof = edge_on_plane(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
+  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane)
+    proof = edge_on_plane(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
   if (!proof || !(proof->hi <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, proof->hi);
   settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);

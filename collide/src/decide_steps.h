@@ -82,6 +82,12 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
 void edge_witness_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, FaceView a, FaceView b,
                        Pending& p, const CollideOptions& o, CollideCounters& c);
 
+// Step 3c: a face touching the other face's plane at one point of a curved edge: that edge's
+// extremum toward the plane (SurfaceSource::edge_support), its foot inside the plane's face,
+// proves contact.
+void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+                       Pending& p, const CollideOptions& o, CollideCounters& c);
+
 // Step 4 and 6 helpers. A plane, cylinder or sphere bounds the distance to the other face's
 // triangles by that face's band alone (analytic_gap), so only the other face is refined then.
 bool bounds_by_shape(const Surface& s);

@@ -118,6 +118,10 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
       edge_witness_step(model, poses, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
     });
+    // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
+    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
+      edge_support_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
+    });
     // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see
     // (apart), not a contact within T (far below any band): crossing or touching triangles go on.
     const std::vector<std::size_t> gaps = select(pending, [&](std::size_t k) {

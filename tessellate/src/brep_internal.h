@@ -116,6 +116,11 @@ std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb
 // other surfaces. Reads the face only. May throw Standard_Failure.
 std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n);
 
+// The extremum along `d` of the face's edge nearest `near` (Newton on d·C(t), clamped to the edge's
+// ends), with the evaluation's rounding. May throw Standard_Failure.
+std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& where, const Aabb& face_box,
+                                                             const Vec3& d, const gp_Pnt& near);
+
 // The foot point of `p` on the face's surface by the same Newton, with the unit normal there and the
 // evaluation's rounding; not classified (it may lie outside the face). nullopt when Newton fails or
 // the surface is singular there. Reads the face only. May throw Standard_Failure.

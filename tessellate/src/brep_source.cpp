@@ -133,6 +133,19 @@ std::optional<std::array<double, 2>> BrepSource::height_range(std::uint32_t loca
   }
 }
 
+std::optional<SurfaceSource::SurfacePoint> BrepSource::edge_support(std::uint32_t local_index, const Vec3& direction,
+                                                                    const Vec3& near) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    return detail::face_edge_support(a.locator(local_index), a.boxes[local_index], direction,
+                                     gp_Pnt(near.x(), near.y(), near.z()));
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<double> BrepSource::boundary_distance(std::uint32_t local_index, const Vec3& point) const {
   const Impl& a = *impl_;
   assert(local_index < a.faces.size());

@@ -192,6 +192,33 @@ std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb
   return edge_witness(where, p, magnitude);
 }
 
+std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& where, const Aabb& face_box,
+                                                             const Vec3& d, const gp_Pnt& near) {
+  const std::optional<EdgePoint> e = nearest_edge_point(where, near);
+  if (!e) return std::nullopt;
+  const BRepAdaptor_Curve curve(where.edges[e->edge].first);
+  const double t0 = curve.FirstParameter(), t1 = curve.LastParameter();
+  const gp_Vec dir(d.x(), d.y(), d.z());
+  double t = e->t;
+  for (int step = 0; step < 12; ++step) {
+    gp_Pnt p;
+    gp_Vec d1, d2;
+    curve.D2(t, p, d1, d2);
+    const double g1 = dir.Dot(d1), g2 = dir.Dot(d2);
+    // A maximum of d·C needs g2 < 0; elsewhere step along the slope to the end it rises towards.
+    double next = g2 < 0.0 ? t - g1 / g2 : (g1 > 0.0 ? t1 : t0);
+    next = std::clamp(next, t0, t1);
+    if (std::abs(next - t) <= 1e-15 * (1.0 + std::abs(t))) break;
+    t = next;
+  }
+  const gp_Pnt p = curve.Value(t);
+  SurfaceSource::SurfacePoint out;
+  out.point = Vec3(p.X(), p.Y(), p.Z());
+  out.normal = d;
+  out.rounding = kEvaluationRounding * (box_norm(face_box) + out.point.norm());
+  return out;
+}
+
 std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
                                                               const gp_Pnt& p) {
   const BRepAdaptor_Surface surface(face, Standard_False);

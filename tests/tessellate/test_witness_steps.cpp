@@ -147,8 +147,9 @@ TEST(RefinedAnalytic, StandOffOverAPlaneIsProvedByRefiningTheOtherFaceOnly) {
 }
 
 // Tangent to a flat face: a cylinder lying on its side and a sphere resting on it touch along a line
-// or at a point where no vertex of theirs need lie. Their support point toward the plane proves it
-// (no OCCT query); lifted by 0.01 mm they are apart.
+// or at a point where no vertex of theirs need lie, and the cylinder's end disks touch it at one
+// point of their rims. The support point of the surface, and the extremum of the rim, toward the
+// plane prove it (no OCCT query); lifted by 0.01 mm they are apart.
 TEST(TangentWitness, CylinderAndSphereOnAPlaneTouchWithoutTheExactFaceDistance) {
   for (bool sphere : {false, true}) {
     for (double lift : {0.0, 0.01}) {
@@ -165,17 +166,19 @@ TEST(TangentWitness, CylinderAndSphereOnAPlaneTouchWithoutTheExactFaceDistance) 
       const std::string what = std::string(sphere ? "sphere" : "cylinder") + " lifted " + std::to_string(lift);
       EXPECT_EQ(r.contact, lift == 0.0) << what;
       EXPECT_EQ(r.report.counters.undecided, 0u) << what;
-      // The curved face's contact is proved without OCCT (the cylinder's end disks touch the board at
-      // one point of their rims: plane against plane at an edge, which still asks OCCT).
-      int curved_contacts = 0;
+      // Every contact is proved without OCCT's face-face distance: the curved face by its support
+      // point, the cylinder's end disks (touching the board at one point of their rims) by the
+      // extremum of the rim toward the board (SurfaceSource::edge_support).
+      int curved_contacts = 0, rim_contacts = 0;
       for (const SurfacePairResult& p : r.report.pairs) {
         const SurfaceShape sa = m.surfaces[p.surface_a].analytic.shape, sb = m.surfaces[p.surface_b].analytic.shape;
-        if (sa != SurfaceShape::Plane || sb == SurfaceShape::Plane) continue;
-        ++curved_contacts;
+        if (sa != SurfaceShape::Plane) continue;
+        ++(sb == SurfaceShape::Plane ? rim_contacts : curved_contacts);
         EXPECT_FALSE(p.exact_distance.has_value()) << what;
       }
       EXPECT_EQ(curved_contacts, lift == 0.0 ? 1 : 0) << what;
-      if (sphere) EXPECT_EQ(r.report.counters.exact_queries, 0u) << what;
+      EXPECT_EQ(rim_contacts, lift == 0.0 && !sphere ? 2 : 0) << what;
+      EXPECT_EQ(r.report.counters.exact_queries, 0u) << what;
     }
   }
 }

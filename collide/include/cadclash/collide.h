@@ -98,6 +98,8 @@ namespace cadclash {
 //             first, then the nearest vertices, at most 8 per pair; then, where the outlines come
 //             closest, a point on an edge of each face (SurfaceSource::edge_distance: Newton on the
 //             two edge curves) — faces meeting edge to edge, as a curved edge tangent to a straight one;
+//             then, against a plane, the extremum toward it of the other face's edge near its lowest
+//             outline points (SurfaceSource::edge_support) — a disk or a bolt's flat lying on its rim;
 //   refined   where finer triangles could show a gap (the triangles stay apart by more than T plus
 //             the finer band), the faces re-tessellated at a tenth of their deflection by their
 //             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
@@ -207,8 +209,8 @@ struct CollideCounters {
   std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
   std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
   std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
-  std::uint64_t witness_queries = 0;    // SurfaceSource surface_point, boundary_distance, point_distance and
-                                        // edge_distance calls (witnesses and crossings)
+  std::uint64_t witness_queries = 0;    // SurfaceSource surface_point, boundary_distance, point_distance,
+                                        // edge_distance and edge_support calls (witnesses, crossings)
   std::uint64_t dismissed_pairs = 0;    // candidate pairs the triangles' band would call touching
                                         // (fast mode's answer) that a certificate proved apart
 };

@@ -209,6 +209,17 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // The point of face `local_index`'s edges farthest along `direction` (a unit vector, part-local)
+  // near `near`: Newton on the edge curve nearest `near` for the extremum of direction·C(t), clamped
+  // to the edge's ends; the point, its rounding (normal unused). A point of the face: where a face
+  // touches a plane at one point of a curved edge, this is that point. nullopt when there is no
+  // exact geometry or no edge was found. Thread-safe like exact_distance.
+  virtual std::optional<SurfacePoint> edge_support(std::uint32_t local_index, const Vec3& direction,
+                                                   const Vec3& near) const {
+    (void)local_index, (void)direction, (void)near;
+    return std::nullopt;
+  }
+
   // An upper bound on the distance from `point` (part-local) to face `local_index`'s boundary, realised
   // by a point of one of its edge curves (so a point of the face): what point_distance falls back to
   // for a foot point outside the face, without the foot point and the face classifier before it.

@@ -141,6 +141,10 @@ class BrepSource final : public SurfaceSource {
   std::optional<std::array<double, 2>> height_range(std::uint32_t local_index, const Vec3& origin,
                                                     const Vec3& normal) const override;
 
+  // Newton (first and second derivatives of BRepAdaptor_Curve) on the edge nearest `near`.
+  std::optional<SurfacePoint> edge_support(std::uint32_t local_index, const Vec3& direction,
+                                           const Vec3& near) const override;
+
   // ShapeAnalysis_Curve's projection onto the face's edges, nearest edge box first.
   std::optional<double> boundary_distance(std::uint32_t local_index, const Vec3& point) const override;
 
