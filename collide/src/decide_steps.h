@@ -88,6 +88,12 @@ void edge_witness_step(const Model& m, std::span<const Pose> poses, const Decide
 void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                        Pending& p, const CollideOptions& o, CollideCounters& c);
 
+// A lower bound on d* from the faces' planes, cylinders and spheres: the two surfaces' parameters,
+// and each one's triangles kept off the other's surface (0 when none helps). `a`, `b` are the
+// model's faces or finer copies of them (same analytic surface and box).
+double analytic_bound(const Surface& a, const Surface& b, double eps_a, double eps_b, const DecideTask& t,
+                      double threshold);
+
 // Step 4 and 6 helpers. A plane, cylinder or sphere bounds the distance to the other face's
 // triangles by that face's band alone (analytic_gap), so only the other face is refined then.
 bool bounds_by_shape(const Surface& s);
