@@ -58,8 +58,9 @@ struct Proof {
   DecidedBy by;
 };
 
-std::optional<Proof> cross_plane(const Part& part_q, SurfaceId sq, FaceView fp, FaceView fq, double eps_q,
-                                 const Pose& to_q, const Pose& to_p, double r, double threshold, CollideCounters& c) {
+std::optional<Proof> cross_plane(const Part&, SurfaceId, const Part& part_q, SurfaceId sq, FaceView fp, FaceView fq,
+                                 double eps_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
+                                 CollideCounters& c) {
   const Surface& P = fp.surface;
   const Surface& Q = fq.surface;
   const AnalyticSurface plane = transform_analytic(P.analytic, to_q);
@@ -240,50 +241,43 @@ bool touches_plane(const Surface& s) {
          s.analytic.shape == SurfaceShape::Sphere;
 }
 
-}  // namespace
-
-void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
-                  Pending& p, const CollideOptions& o, CollideCounters& c) {
+// Runs `side` (one of the functions above) with A's face as the plane, then with B's, for the faces
+// `other_ok` accepts on the other side, and settles the pair in contact on the first proof.
+template <class Side>
+void prove_against_plane(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                         Pending& p, const CollideOptions& o, CollideCounters& c, bool (*other_ok)(const Surface&),
+                         Side side) {
   if (t.outcome == nullptr || !fa.surface.has_triangles || !fb.surface.has_triangles) return;
+  const Part& pa = m.parts[fa.surface.part];
+  const Part& pb = m.parts[fb.surface.part];
   std::optional<Proof> proof;
-  if (fa.surface.analytic.shape == SurfaceShape::Plane && touches_plane(fb.surface))
-    proof = touch_plane(m.parts[fa.surface.part], t.sa, m.parts[fb.surface.part], t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab,
-                        t.roundoff, p.threshold, c);
-  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && touches_plane(fa.surface))
-    proof = touch_plane(m.parts[fb.surface.part], t.sb, m.parts[fa.surface.part], t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba,
-                        t.roundoff, p.threshold, c);
+  if (fa.surface.analytic.shape == SurfaceShape::Plane && other_ok(fb.surface))
+    proof = side(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
+  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && other_ok(fa.surface))
+    proof = side(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
   if (!proof || !(proof->hi <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, proof->hi);
   settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
 }
 
+bool any_face(const Surface&) { return true; }
+
+}  // namespace
+
+void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+                  Pending& p, const CollideOptions& o, CollideCounters& c) {
+  prove_against_plane(m, eps, t, fa, fb, p, o, c, touches_plane, touch_plane);
+}
+
 void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
                        Pending& p, const CollideOptions& o, CollideCounters& c) {
-  if (t.outcome == nullptr || !fa.surface.has_triangles || !fb.surface.has_triangles) return;
-  const Part& pa = m.parts[fa.surface.part];
-  const Part& pb = m.parts[fb.surface.part];
-  std::optional<Proof> proof;
-  if (fa.surface.analytic.shape == SurfaceShape::Plane)
-    proof = edge_on_plane(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
-  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane)
-    proof = edge_on_plane(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
-  if (!proof || !(proof->hi <= p.threshold)) return;
-  p.d.hi = std::min(p.d.hi, proof->hi);
-  settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
+  prove_against_plane(m, eps, t, fa, fb, p, o, c, any_face, edge_on_plane);
 }
 
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
                    Pending& p, const CollideOptions& o, CollideCounters& c) {
   if (t.outcome == nullptr || !t.outcome->intersecting) return;
-  if (!fa.surface.has_triangles || !fb.surface.has_triangles) return;
-  std::optional<Proof> proof;
-  if (fa.surface.analytic.shape == SurfaceShape::Plane)
-    proof = cross_plane(m.parts[fb.surface.part], t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
-  if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane)
-    proof = cross_plane(m.parts[fa.surface.part], t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
-  if (!proof || !(proof->hi <= p.threshold)) return;
-  p.d.hi = std::min(p.d.hi, proof->hi);
-  settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
+  prove_against_plane(m, eps, t, fa, fb, p, o, c, any_face, cross_plane);
 }
 
 }  // namespace cadclash::detail
