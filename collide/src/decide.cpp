@@ -224,6 +224,43 @@ std::vector<std::array<Vec3, 2>> boundary_edges(const TriangleMesh& mesh) {
   return out;
 }
 
+Outline make_outline(const TriangleMesh& mesh) {
+  Outline out;
+  out.segments = boundary_edges(mesh);
+  std::vector<Aabb> boxes(out.segments.size());
+  for (std::size_t k = 0; k < boxes.size(); ++k) boxes[k].extend(out.segments[k][0]).extend(out.segments[k][1]);
+  out.tree = build_box_bvh(std::move(boxes));
+  return out;
+}
+
+bool near_outline(const Outline& outline, const Vec3& p, double margin) {
+  const SurfaceBvh& tree = outline.tree;
+  if (tree.nodes.empty() || !(margin >= 0.0)) return false;
+  // Both distances are a few roundings of the coordinates' magnitude M off (well within the slack
+  // the callers add to their margins); 2^-40 M covers them, so pruning never changes the answer.
+  const Aabb& root = tree.nodes[0].box;
+  const double mag = std::max({p.cwiseAbs().maxCoeff(), root.min().cwiseAbs().maxCoeff(), root.max().cwiseAbs().maxCoeff()});
+  const double prune = margin + 0x1p-40 * mag;
+  const double m2 = margin * margin;
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SurfaceBvh::Node& node = tree.nodes[stack[--top]];
+    if (node.box.exteriorDistance(p) > prune) continue;
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+      continue;
+    }
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+      const auto& [a, b] = outline.segments[tree.order[i]];
+      if ((closest_on_segment(p, a, b) - p).squaredNorm() <= m2) return true;
+    }
+  }
+  return false;
+}
+
 namespace {
 
 // The foot of p on the full surface (nullopt where it is not unique: on an axis or at a centre).
@@ -247,15 +284,14 @@ std::optional<Vec3> foot_point(const AnalyticSurface& an, const Vec3& p) {
   }
 }
 
-// Distance from p to the segment [a, b] by projection in plain doubles: a few roundings of the
-// coordinates' magnitude, well within the slack its caller adds (the pair's round-off bound, which
-// allows 64 of them for triangle_distance alone).
-double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) { return (closest_on_segment(p, a, b) - p).norm(); }
-
 }  // namespace
 
+// Candidates tried per side, nearest to the surface first: on as1 and the board no pair needed more
+// than the second, and each costs two tree queries; the witness steps take the rest.
+constexpr std::size_t kMaxAnalyticTrials = 4;
+
 std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
-                                       const SurfaceBvh& bvh_b, const std::vector<std::array<Vec3, 2>>& outline_b,
+                                       const SurfaceBvh& bvh_b, const Outline& outline_b,
                                        double delta_b,
                                        const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
                                        double limit, double slack) {
@@ -276,15 +312,10 @@ std::optional<double> analytic_witness(const AnalyticSurface& an_b, const Triang
     if (g <= limit) cs.push_back({g, *f});
   }
   std::stable_sort(cs.begin(), cs.end(), [](const Candidate& x, const Candidate& y) { return x.g < y.g; });
-  if (cs.size() > 16) cs.resize(16);
+  if (cs.size() > kMaxAnalyticTrials) cs.resize(kMaxAnalyticTrials);
   for (const Candidate& c : cs) {
     if (!(point_mesh_distance(bvh_b, mesh_b, c.foot, delta_b + slack) <= delta_b + slack)) continue;
-    double to_outline = std::numeric_limits<double>::infinity();
-    for (const auto& e : outline_b) {
-      to_outline = std::min(to_outline, point_segment(c.foot, e[0], e[1]));
-      if (to_outline <= 2.0 * delta_b + slack) break;
-    }
-    if (to_outline > 2.0 * delta_b + slack) return c.g;
+    if (!near_outline(outline_b, c.foot, 2.0 * delta_b + slack)) return c.g;
   }
   return std::nullopt;
 }

@@ -78,15 +78,29 @@ std::optional<double> analytic_pair_gap(const AnalyticSurface& a, const Analytic
 // The edges of a mesh that only one triangle uses: the outline of the region it covers.
 std::vector<std::array<Vec3, 2>> boundary_edges(const TriangleMesh& mesh);
 
+// A surface's outline (boundary_edges) with a tree over its segments: the inside-the-face tests ask
+// "is this point within m of the outline" for many points, a few box tests each instead of a scan.
+struct Outline {
+  std::vector<std::array<Vec3, 2>> segments;
+  SurfaceBvh tree;  // over the segments' boxes
+  bool empty() const { return segments.empty(); }
+};
+Outline make_outline(const TriangleMesh& mesh);
+
+// True when some segment of `outline` lies within `margin` of p, its distance measured by projection
+// in plain doubles (closest_on_segment): the answer of a scan over every segment, which the tree only
+// speeds up (it skips boxes farther than margin by more than any rounding of either distance).
+bool near_outline(const Outline& outline, const Vec3& p, double margin);
+
 // Contact certificate from a surface's parameters: the smallest distance g from a vertex of
 // `mesh_a` (mapped into B's frame by `to_b`, lying in `region` given in B's frame) to the full
 // surface `an_b`, over the vertices whose foot point on that surface is provably a point of face B:
 // within delta_b + slack of B's triangles and farther than 2·delta_b + slack from their outline
 // (`outline_b`), where the exact face's outline runs within delta_b of it. Only vertices with
-// g <= limit are tried (at most 16, nearest first). nullopt when no vertex qualifies or the shape
+// g <= limit are tried (at most 4, nearest first). nullopt when no vertex qualifies or the shape
 // has no foot point here (plane, cylinder and sphere do).
 std::optional<double> analytic_witness(const AnalyticSurface& an_b, const TriangleMesh& mesh_b,
-                                       const SurfaceBvh& bvh_b, const std::vector<std::array<Vec3, 2>>& outline_b,
+                                       const SurfaceBvh& bvh_b, const Outline& outline_b,
                                        double delta_b,
                                        const TriangleMesh& mesh_a, const Pose& to_b, const Aabb& region,
                                        double limit, double slack);

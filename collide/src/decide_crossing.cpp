@@ -17,6 +17,7 @@ namespace {
 constexpr std::size_t kMaxPlanarTrials = 8;
 constexpr std::size_t kMaxNewtonTrials = 4;
 constexpr std::size_t kMaxClassifierTrials = 2;
+constexpr std::size_t kMaxCrossingStarts = 32;  // crossings of a curved face whose foot is tried
 constexpr std::size_t kMaxEdgeTrials = 4;  // outline vertices (each shared by two segments: two points)
 constexpr int kMaxNewtonSteps = 6;
 // cos 0.5°: triangles closer to parallel than this do not start a crossing.
@@ -100,7 +101,11 @@ std::optional<Proof> cross_plane(const Part&, SurfaceId, const Part& part_q, Sur
   }
   if (!part_q.source) return std::nullopt;
   std::size_t trials = 0;
-  for (const Vec3& x : xs) {
+  // At most kMaxCrossingStarts crossings looked at, every stride-th in triangle order (spread over
+  // the face rather than the first few triangles').
+  const std::size_t stride = (xs.size() + kMaxCrossingStarts - 1) / kMaxCrossingStarts;
+  for (std::size_t k = 0; k < xs.size(); k += stride) {
+    const Vec3& x = xs[k];
     // Only crossings whose foot lies well inside P start a Newton run (one on P's boundary is an edge
     // contact, the witness steps' case).
     if (!on_p(x, n.dot(x - plane.origin))) continue;
@@ -208,7 +213,7 @@ std::optional<Proof> edge_on_plane(const Part& part_p, SurfaceId sp, const Part&
   const double headroom = threshold - eps_q - r;
   if (!(headroom > 0.0)) return std::nullopt;
   std::vector<std::pair<double, Vec3>> low;
-  for (const auto& e : *fq.outline)
+  for (const auto& e : fq.outline->segments)
     for (const Vec3& v : e) low.emplace_back(std::abs(n.dot(v - plane.origin)), v);
   const std::size_t keep = std::min<std::size_t>(low.size(), kMaxEdgeTrials);
   std::partial_sort(low.begin(), low.begin() + static_cast<std::ptrdiff_t>(keep), low.end(),

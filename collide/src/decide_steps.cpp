@@ -172,14 +172,6 @@ void near_vertices(const Surface& from, const Pose& to_other, FaceView other, co
 // At most this many exact point queries per pair and level: nearest first, the rest seldom help.
 constexpr std::size_t kMaxWitnessTrials = 8;
 
-// True when `p` is farther than `margin` from every segment of `outline` (plain doubles: it only
-// orders the trials, and proves nothing).
-bool clear_of(const std::vector<std::array<Vec3, 2>>& outline, const Vec3& p, double margin) {
-  const double m2 = margin * margin;
-  for (const auto& [a, b] : outline)
-    if ((closest_on_segment(p, a, b) - p).squaredNorm() <= m2) return false;
-  return true;
-}
 
 // Trial order: nearest first, but among the nearest a vertex whose foot lies well inside the other
 // face's outline first. A foot near the outline is the exact face classifier's slow case, and the
@@ -191,7 +183,7 @@ void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
   cs.resize(keep);
   auto inside = [&](const Candidate& c) {
     const FaceView& other = c.of_a ? b : a;
-    return other.outline != nullptr && clear_of(*other.outline, c.point, 2.0 * other.surface.deflection + c.near);
+    return other.outline != nullptr && !near_outline(*other.outline, c.point, 2.0 * other.surface.deflection + c.near);
   };
   std::stable_partition(cs.begin(), cs.end(), inside);
   if (cs.size() > kMaxWitnessTrials) cs.resize(kMaxWitnessTrials);
@@ -206,7 +198,7 @@ void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
 bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles) {
   if (f.outline == nullptr || f.outline->empty()) return false;
   const double delta = f.surface.deflection;
-  return clear_of(*f.outline, x, 2.0 * delta + slack) &&
+  return !near_outline(*f.outline, x, 2.0 * delta + slack) &&
          (on_triangles || point_mesh_distance(f.bvh, f.surface.mesh, x, delta + slack) <= delta + slack);
 }
 
@@ -300,10 +292,10 @@ void vertices_against_segments(const std::vector<std::array<Vec3, 2>>& from, con
 }
 
 // The segments of `outline` mapped by `to` whose boxes meet `region`.
-std::vector<std::array<Vec3, 2>> outline_near(const std::vector<std::array<Vec3, 2>>& outline, const Pose& to,
+std::vector<std::array<Vec3, 2>> outline_near(const Outline& outline, const Pose& to,
                                               const Aabb& region) {
   std::vector<std::array<Vec3, 2>> out;
-  for (const auto& e : outline) {
+  for (const auto& e : outline.segments) {
     const std::array<Vec3, 2> m{to * e[0], to * e[1]};
     Aabb box;
     box.extend(m[0]);

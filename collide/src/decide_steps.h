@@ -13,8 +13,8 @@
 
 namespace cadclash::detail {
 
-// Per surface: the outline of its triangles (boundary_edges), made for the surfaces that need it.
-using Outlines = std::vector<std::vector<std::array<Vec3, 2>>>;
+// Per surface: the outline of its triangles (make_outline), made for the surfaces that need it.
+using Outlines = std::vector<Outline>;
 
 // Where one pair's decision stands between the steps.
 struct Pending {
@@ -37,7 +37,7 @@ struct Pending {
 struct FaceView {
   const Surface& surface;
   const SurfaceBvh& bvh;
-  const std::vector<std::array<Vec3, 2>>* outline = nullptr;
+  const Outline* outline = nullptr;
 };
 
 // Step 1: the interval of the model's triangles, settled when it decides (certified and exact modes).

@@ -92,7 +92,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (nfaces >= 8)
     for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
       const SurfaceId f = faces[static_cast<std::size_t>(i)];
-      outlines[f] = boundary_edges(model.surfaces[f].mesh);
+      outlines[f] = make_outline(model.surfaces[f].mesh);
     }
     run_step(open, pending, threads, deadline,
              [&](std::size_t k) { analytic_contact(eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o); });

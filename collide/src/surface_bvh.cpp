@@ -46,25 +46,28 @@ void build_node(SurfaceBvh& bvh, const std::vector<Vec3>& centroids, std::uint32
 
 }  // namespace
 
-SurfaceBvh build_surface_bvh(const TriangleMesh& mesh) {
+SurfaceBvh build_box_bvh(std::vector<Aabb> boxes) {
   SurfaceBvh bvh;
-  const auto n = static_cast<std::uint32_t>(mesh.triangles.size());
+  const auto n = static_cast<std::uint32_t>(boxes.size());
   if (n == 0) return bvh;
-  bvh.triangle_boxes.resize(n);
+  bvh.triangle_boxes = std::move(boxes);
   std::vector<Vec3> centroids(n);
   bvh.order.resize(n);
   for (std::uint32_t t = 0; t < n; ++t) {
-    const auto& tri = mesh.triangles[t];
-    Aabb b;
-    for (std::uint32_t v : tri) b.extend(mesh.vertices[v]);
-    bvh.triangle_boxes[t] = b;
-    centroids[t] = b.center();
+    centroids[t] = bvh.triangle_boxes[t].center();
     bvh.order[t] = t;
   }
   bvh.nodes.reserve(2 * (n / kLeafSize + 1));
   bvh.nodes.emplace_back();
   build_node(bvh, centroids, 0, 0, n);
   return bvh;
+}
+
+SurfaceBvh build_surface_bvh(const TriangleMesh& mesh) {
+  std::vector<Aabb> boxes(mesh.triangles.size());
+  for (std::size_t t = 0; t < boxes.size(); ++t)
+    for (std::uint32_t v : mesh.triangles[t]) boxes[t].extend(mesh.vertices[v]);
+  return build_box_bvh(std::move(boxes));
 }
 
 void query_surface_bvh(const SurfaceBvh& bvh, const Aabb& query, std::vector<std::uint32_t>& out,
@@ -95,6 +98,8 @@ void query_surface_bvh(const SurfaceBvh& bvh, const Aabb& query, std::vector<std
 double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
   double best = std::numeric_limits<double>::infinity();
   if (bvh.nodes.empty()) return best;
+  // Nearer child first: the best so far shrinks sooner and prunes more. The minimum is the same in
+  // any order.
   std::uint32_t stack[64];
   int top = 0;
   stack[top++] = 0;
@@ -106,11 +111,13 @@ double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, cons
         const std::uint32_t t = bvh.order[i];
         if (bvh.triangle_boxes[t].exteriorDistance(p) > std::min(best, reach)) continue;
         const auto& tri = mesh.triangles[t];
-        best = std::min(best, triangle_distance(p, p, p, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]));
+        best = std::min(best, point_triangle_distance(p, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]));
       }
     } else {
-      stack[top++] = node.first;
-      stack[top++] = node.first + 1;
+      const bool left_nearer = bvh.nodes[node.first].box.squaredExteriorDistance(p) <=
+                               bvh.nodes[node.first + 1].box.squaredExteriorDistance(p);
+      stack[top++] = left_nearer ? node.first + 1 : node.first;
+      stack[top++] = left_nearer ? node.first : node.first + 1;
     }
   }
   return best;

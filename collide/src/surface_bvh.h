@@ -20,6 +20,9 @@ struct SurfaceBvh {
   std::vector<Aabb> triangle_boxes;  // per triangle index, exact boxes of the stored vertices
 };
 
+// The same tree over any boxes (item k's box is boxes[k]; `triangle_boxes` holds them).
+SurfaceBvh build_box_bvh(std::vector<Aabb> boxes);
+
 // Builds the tree (median split on the longest axis of the centroids; leaves of <= 4 triangles).
 SurfaceBvh build_surface_bvh(const TriangleMesh& mesh);
 
@@ -29,7 +32,7 @@ void query_surface_bvh(const SurfaceBvh& bvh, const Aabb& query, std::vector<std
                        std::uint64_t& box_tests);
 
 // The smallest distance from `p` to a triangle of `mesh` (the mesh `bvh` was built on) whose box
-// comes within `reach` of p, by triangle_distance; +inf when none does. Nearer triangles are never
+// comes within `reach` of p, by point_triangle_distance; +inf when none does. Nearer triangles are never
 // pruned, so a result <= reach is the distance to the whole mesh.
 double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach);
 

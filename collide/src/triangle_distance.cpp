@@ -220,6 +220,26 @@ double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
   return triangle_distance(a0, a1, a2, b0, b1, b2, stats);
 }
 
+// triangle_distance(p, p, p, b0, b1, b2) without the intersection test and the terms a degenerate
+// first triangle cannot contribute: the same candidates (p against B's edges and face, B's vertices
+// against p), relative to p and scaled the same way, so the value agrees with it to the last bit
+// wherever p is off the triangle (there a 0 becomes the smallest positive double, as there).
+double point_triangle_distance(const Vec3& p, const Vec3& b0, const Vec3& b1, const Vec3& b2) {
+  const P3 o = load(p);
+  P3 B[3] = {load(b0) - o, load(b1) - o, load(b2) - o};
+  double ext = 0.0;
+  for (const P3& v : B) ext = std::max({ext, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  if (!(ext <= std::numeric_limits<double>::max()) || (ext > 0.0 && (ext < 0x1p-200 || ext > 0x1p200)))
+    return triangle_distance(p, p, p, b0, b1, b2);  // rare ranges: the general path's scaling
+  const P3 zero{0.0, 0.0, 0.0};
+  const Edge eb[3] = {make_edge(B[0], B[1]), make_edge(B[1], B[2]), make_edge(B[2], B[0])};
+  double best = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < 3; ++j) best = std::min({best, point_edge2(zero, eb[j]), norm2(B[j])});
+  const Face fb = make_face(B[0], eb[0].d, B[2] - B[0]);
+  if (fb.proper) best = std::min(best, point_face2(zero, fb));
+  return positive(std::sqrt(best));
+}
+
 double triangle_distance_apart(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                                const Vec3& b1, const Vec3& b2) {
   return disjoint_distance(a0, a1, a2, b0, b1, b2, 0.0);

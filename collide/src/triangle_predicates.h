@@ -65,6 +65,11 @@ double triangle_distance(const Vec3& a0, const Vec3& a1, const Vec3& a2,
 double triangle_distance_apart(const Vec3& a0, const Vec3& a1, const Vec3& a2,
                                const Vec3& b0, const Vec3& b1, const Vec3& b2);
 
+// The distance from point p to the closed triangle (b0, b1, b2): triangle_distance(p, p, p, b0, b1,
+// b2) to the last bit where p is off the triangle (so always > 0 there), without its intersection
+// test; where p lies on the triangle, a value within that same rounding of 0 (never below 0). Precondition: coordinates finite.
+double point_triangle_distance(const Vec3& p, const Vec3& b0, const Vec3& b1, const Vec3& b2);
+
 // True iff triangle_distance(a, b) <= d, answered with early outs: boxes farther apart than d, or
 // one triangle wholly beyond d on one side of the other's plane (with a certified bound, widened by
 // 64 x 2^-53 x the pair's extent so it never contradicts triangle_distance), return false before any

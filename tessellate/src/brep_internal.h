@@ -31,6 +31,8 @@ struct FaceLocator {
   std::unique_ptr<BRepTopAdaptor_FClass2d> domain;
   mutable std::mutex domain_mutex;
   std::vector<std::pair<TopoDS_Edge, Aabb>> edges;  // edges with a 3D curve, each with its box
+  // Per edge: points of its curve at evenly spaced parameters (t, point), where Newton starts.
+  std::vector<std::vector<std::pair<double, gp_Pnt>>> samples;
   explicit FaceLocator(const TopoDS_Face& face);
   ~FaceLocator();
 };

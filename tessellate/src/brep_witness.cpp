@@ -18,7 +18,6 @@
 #include <Extrema_LocateExtCC.hxx>
 #include <Extrema_POnCurv.hxx>
 #include <Poly_Triangulation.hxx>
-#include <ShapeAnalysis_Curve.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopLoc_Location.hxx>
 #include <TopoDS.hxx>
@@ -66,15 +65,19 @@ std::optional<gp_Pnt2d> nearest_node_parameters(const TopoDS_Face& face, const g
   return tri->UVNode(nearest);
 }
 
-// The point of the face's edges nearest `p` that ShapeAnalysis_Curve's projection finds (a point of
-// an edge's 3D curve within its range; the edges bound the face): the edge, the parameter and the
-// distance. Edges are projected nearest box first; one whose box is farther than the best point so
-// far cannot give a nearer one.
+// A point of the face's edges near `p`: per edge, Newton on |C(t) - p|^2 from the edge's sample
+// nearest p (a point of the curve within its range; the edges bound the face): the edge, the
+// parameter and the distance. Any point of an edge bounds the face's distance from above, so a
+// local minimum serves; from the nearest of samples a few per polynomial span apart, it is the
+// nearest point for any p within a span of the edge, where witnesses are asked. Edges are tried
+// nearest box first; one whose box is farther than the best point so far cannot give a nearer one.
 struct EdgePoint {
   std::size_t edge = 0;
   double t = 0.0;
   double distance = 0.0;
 };
+
+constexpr int kMaxEdgeNewtonSteps = 8;
 
 std::optional<EdgePoint> nearest_edge_point(const FaceLocator& where, const gp_Pnt& p) {
   std::vector<std::pair<double, std::size_t>> order;
@@ -82,15 +85,30 @@ std::optional<EdgePoint> nearest_edge_point(const FaceLocator& where, const gp_P
     order.emplace_back(where.edges[i].second.exteriorDistance(Vec3(p.X(), p.Y(), p.Z())), i);
   std::sort(order.begin(), order.end());
   std::optional<EdgePoint> best;
-  const ShapeAnalysis_Curve projector;
   for (const auto& [box_distance, i] : order) {
     if (best && box_distance > best->distance) break;
+    const auto& samples = where.samples[i];
+    if (samples.empty()) continue;
+    std::size_t k = 0;
+    for (std::size_t j = 1; j < samples.size(); ++j)
+      if (samples[j].second.SquareDistance(p) < samples[k].second.SquareDistance(p)) k = j;
     const BRepAdaptor_Curve curve(where.edges[i].first);
-    gp_Pnt projected;
-    double t = 0.0;
-    projector.Project(curve, p, Precision::Confusion(), projected, t);
-    if (!(t >= curve.FirstParameter() && t <= curve.LastParameter())) continue;
-    const double d = p.Distance(curve.Value(t));
+    const double t0 = curve.FirstParameter(), t1 = curve.LastParameter();
+    double t = samples[k].first;
+    for (int step = 0; step < kMaxEdgeNewtonSteps; ++step) {
+      gp_Pnt c;
+      gp_Vec d1, d2;
+      curve.D2(t, c, d1, d2);
+      const gp_Vec w(p, c);
+      const double slope = d1.Dot(w), curvature = d2.Dot(w) + d1.SquareMagnitude();
+      if (!(curvature > 0.0)) break;
+      const double next = std::clamp(t - slope / curvature, t0, t1);
+      const bool done = std::abs(next - t) <= 1e-12 * (1.0 + std::abs(t));
+      t = next;
+      if (done) break;
+    }
+    double d = p.Distance(curve.Value(t));
+    if (const double ds = p.Distance(samples[k].second); !(d <= ds)) d = ds, t = samples[k].first;
     if (!best || d < best->distance) best = EdgePoint{i, t, d};
   }
   return best;
@@ -141,6 +159,20 @@ FaceLocator::FaceLocator(const TopoDS_Face& face)
     double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
     box.Get(x0, y0, z0, x1, y1, z1);
     edges.emplace_back(edge, Aabb(Vec3(x0, y0, z0), Vec3(x1, y1, z1)));
+    std::vector<std::pair<double, gp_Pnt>> along;
+    try {
+      const BRepAdaptor_Curve curve(edge);
+      const double t0 = curve.FirstParameter(), t1 = curve.LastParameter();
+      const int n = std::clamp(8 * curve.NbIntervals(GeomAbs_C2), 16, 512);
+      if (std::isfinite(t0) && std::isfinite(t1) && t1 >= t0)
+        for (int k = 0; k < n; ++k) {
+          const double t = k + 1 == n ? t1 : t0 + (t1 - t0) * k / (n - 1);
+          along.emplace_back(t, curve.Value(t));
+        }
+    } catch (const Standard_Failure&) {
+      along.clear();  // no samples: the edge gives no witness point
+    }
+    samples.push_back(std::move(along));
   }
 }
 

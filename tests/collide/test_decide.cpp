@@ -1,5 +1,6 @@
 // The certified decision's pieces: the round-off bound against a long-double reference under large
 // rigid motions, the triangles' interval and verdict, and the analytic lower bounds.
+#include "box_util.h"
 #include "decide.h"
 #include "surface_bvh.h"
 #include "triangle_predicates.h"
@@ -247,6 +248,45 @@ TEST(PointMeshDistance, EqualsBruteForceWithinTheReach) {
   EXPECT_GT(within, 100);
   EXPECT_GT(beyond, 100);
   EXPECT_EQ(point_mesh_distance(SurfaceBvh{}, TriangleMesh{}, Vec3::Zero(), 1.0), std::numeric_limits<double>::infinity());
+}
+
+// The outline's tree answers what a scan over every segment answers, near and far from the origin,
+// for margins from far below the segments' length to far above, including points at the margin.
+TEST(NearOutline, AgreesWithAScanOverEverySegment) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double offset : {0.0, 1e3, 1e6}) {
+    // A wavy grid patch with two holes: its outline is the rim and the holes' rims.
+    TriangleMesh mesh;
+    const int n = 24;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i)
+        mesh.vertices.push_back(Vec3(offset + i, offset - 0.5 * j, offset + 0.3 * std::sin(0.7 * i + 0.4 * j)));
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        if ((i >= 5 && i < 9 && j >= 5 && j < 8) || (i >= 14 && i < 20 && j >= 12 && j < 21)) continue;
+        const auto v = static_cast<std::uint32_t>(j * (n + 1) + i);
+        mesh.triangles.push_back({v, v + 1, v + n + 2});
+        mesh.triangles.push_back({v, v + n + 2, v + n + 1});
+      }
+    const detail::Outline outline = detail::make_outline(mesh);
+    ASSERT_EQ(outline.segments.size(), detail::boundary_edges(mesh).size());
+    ASSERT_EQ(outline.segments.size(), std::size_t{4 * n + 2 * (4 + 3) + 2 * (6 + 9)});
+    int near = 0, far = 0;
+    for (int k = 0; k < 3000; ++k) {
+      const Vec3 p = Vec3(offset, offset, offset) + Vec3(-2 + 28 * u(rng), -14 + 16 * u(rng), -1 + 2 * u(rng));
+      double scan2 = std::numeric_limits<double>::infinity();
+      for (const auto& [a, b] : outline.segments) scan2 = std::min(scan2, (detail::closest_on_segment(p, a, b) - p).squaredNorm());
+      for (double margin : {1e-3, 0.1, 0.7, 3.0, std::sqrt(scan2)}) {
+        const bool want = scan2 <= margin * margin;
+        EXPECT_EQ(detail::near_outline(outline, p, margin), want) << offset << ' ' << k << ' ' << margin;
+        (want ? near : far) += 1;
+      }
+    }
+    EXPECT_GT(near, 1000);
+    EXPECT_GT(far, 1000);
+  }
+  EXPECT_FALSE(detail::near_outline(detail::Outline{}, Vec3::Zero(), 1e9));
 }
 
 }  // namespace

@@ -151,6 +151,51 @@ INSTANTIATE_TEST_SUITE_P(Families, DistanceFamilies,
                                            Family::Degenerate, Family::RigidMotion),
                          family_test_name);
 
+// point_triangle_distance is triangle_distance with a degenerate first triangle, to the last bit,
+// on every family's B and on points spread from B's vertices, edges and interior outwards; on the
+// triangle (where triangle_distance says 0) it is within rounding of 0.
+TEST(PointTriangleDistance, IsTriangleDistanceOfAPointToTheLastBit) {
+  test::Rng rng(31);
+  int compared = 0, on_triangle = 0, mismatches = 0;
+  for (int f = 0; f < static_cast<int>(Family::kCount); ++f)
+    for (int i = 0; i < kPairsPerFamily / 8; ++i) {
+      const TriPair c = test::make_case(static_cast<Family>(f), rng);
+      const Tri& b = c.b;
+      const double size = std::max({(b[1] - b[0]).norm(), (b[2] - b[0]).norm(), 1e-300});
+      // A point of B (barycentric) moved off it by a random amount, or a vertex of A.
+      const double w0 = rng.uniform(), w1 = rng.uniform() * (1 - w0);
+      Vec3 p = w0 * b[0] + w1 * b[1] + (1 - w0 - w1) * b[2];
+      switch (rng.integer(0, 3)) {
+        case 0: break;                                                   // on (or rounded off) B
+        case 1: p += rng.vec(-1, 1) * size * std::pow(10.0, -rng.integer(0, 12)); break;
+        case 2: p += rng.vec(-1, 1) * size * 10.0; break;
+        default: p = c.a[static_cast<std::size_t>(rng.integer(0, 2))];
+      }
+      const double want = triangle_distance(p, p, p, b[0], b[1], b[2]);
+      const double got = detail::point_triangle_distance(p, b[0], b[1], b[2]);
+      if (want == 0.0) {
+        ++on_triangle;
+        double ext = 0;
+        for (const Vec3& v : b) ext = std::max(ext, (v - p).cwiseAbs().maxCoeff());
+        if (!(got > 0.0 && got <= std::max(1e-12 * ext, std::numeric_limits<double>::denorm_min())) && ++mismatches <= 5)
+          ADD_FAILURE() << test::family_name(static_cast<Family>(f)) << ' ' << i << ": " << got << " on the triangle";
+      } else {
+        ++compared;
+        if (got != want && ++mismatches <= 5)
+          ADD_FAILURE() << test::family_name(static_cast<Family>(f)) << ' ' << i << ": " << got << " vs " << want;
+      }
+    }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(on_triangle, 0);
+  // Extreme ranges take the general path's scaling.
+  const Vec3 tiny(0x1p-1060, 0, 0), big(0x1p1020, 0x1p1019, 0);
+  EXPECT_EQ(detail::point_triangle_distance(tiny, Vec3(0, 0x1p-1070, 0), Vec3(0, 0, 0x1p-1070), Vec3(0, 0x1p-1070, 0x1p-1070)),
+            triangle_distance(tiny, tiny, tiny, Vec3(0, 0x1p-1070, 0), Vec3(0, 0, 0x1p-1070), Vec3(0, 0x1p-1070, 0x1p-1070)));
+  EXPECT_EQ(detail::point_triangle_distance(big, Vec3(-0x1p1020, 0, 0), Vec3(-0x1p1020, 1, 0), Vec3(-0x1p1020, 0, 1)),
+            triangle_distance(big, big, big, Vec3(-0x1p1020, 0, 0), Vec3(-0x1p1020, 1, 0), Vec3(-0x1p1020, 0, 1)));
+}
+
 // No point pair sampled on the two triangles is closer than the reported distance.
 TEST(TriangleDistance, NeverAboveSampledPairs) {
   test::Rng rng(5);
