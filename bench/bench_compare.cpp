@@ -9,8 +9,7 @@
 // agreement of the quick run.
 #include "compare_peers.h"
 #include "compare_workload.h"
-#include "surface_bvh.h"
-#include "triangle_predicates.h"
+#include "cadclash/testing/benchmark_switches.h"
 
 #include "cadclash/import.h"
 
@@ -106,20 +105,17 @@ std::vector<double> repeat(const Settings& s, F&& once) {
   return times;
 }
 
-// The cadclash structures' build time and size: the per-surface BVHs (what Scene builds once) plus
-// the triangles they index, over the distinct surfaces of the model.
-void cadclash_build_cost(const Model& model, double& seconds, double& bytes_per_triangle) {
-  std::size_t bytes = 0, triangles = 0;
+// The cadclash structures' build time and size: the per-surface hierarchies (what a Scene builds
+// once, here all at once on one thread) plus the triangles and vertices they index.
+void cadclash_build_cost(Model& model, double& seconds, double& bytes_per_triangle) {
+  cadclash::Scene scene(model);
   const auto t0 = std::chrono::steady_clock::now();
-  for (const cadclash::Surface& s : model.surfaces) {
-    const cadclash::detail::SurfaceBvh bvh = cadclash::detail::build_surface_bvh(s.mesh);
-    bytes += bvh.nodes.size() * sizeof(bvh.nodes[0]) + bvh.order.size() * sizeof(bvh.order[0]) +
-             bvh.triangle_boxes.size() * sizeof(bvh.triangle_boxes[0]) +
-             s.mesh.vertices.size() * sizeof(s.mesh.vertices[0]) + s.mesh.triangles.size() * sizeof(s.mesh.triangles[0]);
-    triangles += s.mesh.triangles.size();
-  }
+  scene.build_hierarchies(1);
   seconds = seconds_since(t0);
-  bytes_per_triangle = triangles ? static_cast<double>(bytes) / static_cast<double>(triangles) : 0.0;
+  const cadclash::SceneMemory m = scene.memory();
+  bytes_per_triangle = m.triangle_count ? static_cast<double>(m.triangles + m.vertices + m.hierarchies) /
+                                              static_cast<double>(m.triangle_count)
+                                        : 0.0;
 }
 
 void run_cadclash(const Settings& s, const cb::Workload& w, Row& row) {
@@ -139,7 +135,7 @@ void run_cadclash(const Settings& s, const cb::Workload& w, Row& row) {
   const CollideOptions& o = row.method.options;
   row.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   cadclash::CollideCounters total;
-  cadclash::detail::set_float_only_for_benchmark(row.method.float_only);
+  cadclash::testing::set_float_only_for_benchmark(row.method.float_only);
   row.times = repeat(s, [&](bool first) {
     cb::PoseState state(model);
     for (InstanceId i : w.moving) scene.set_pose(i, state.poses[i]);
@@ -159,7 +155,7 @@ void run_cadclash(const Settings& s, const cb::Workload& w, Row& row) {
       }
     }
   });
-  cadclash::detail::set_float_only_for_benchmark(false);
+  cadclash::testing::set_float_only_for_benchmark(false);
   row.triangle_tests = total.triangle_tests;
   row.exact_fallbacks = total.exact_fallbacks;
   cadclash_build_cost(model, row.build_seconds, row.bytes_per_triangle);

@@ -2,7 +2,7 @@
 // fixed set of 4096 pairs; items/s is pairs per second, `fallback` the share sent to the exact path.
 //   build-rel/bench/bench_triangle_predicates --benchmark_min_time=0.2
 #include "test_triangle_cases.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <benchmark/benchmark.h>
 
@@ -13,7 +13,7 @@
 namespace {
 
 using cadclash::Vec3;
-using cadclash::detail::TrianglePredicateStats;
+using cadclash::TrianglePredicateStats;
 using cadclash::test::Family;
 using cadclash::test::TriPair;
 
@@ -61,17 +61,17 @@ void run(benchmark::State& state, const std::vector<TriPair>& pairs, F&& f) {
 }
 
 bool filtered(const TriPair& p, TrianglePredicateStats& s) {
-  return cadclash::detail::triangles_intersect(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], s);
+  return cadclash::triangles_intersect(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], s);
 }
 bool exact(const TriPair& p, TrianglePredicateStats&) {
-  return cadclash::detail::triangles_intersect_exact(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2]);
+  return cadclash::triangles_intersect_exact(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2]);
 }
 bool oracle(const TriPair& p, TrianglePredicateStats&) { return cadclash::test::oracle_intersect(p.a, p.b); }
 bool distance(const TriPair& p, TrianglePredicateStats& s) {
-  return cadclash::detail::triangle_distance(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], s) < 0.01;
+  return cadclash::triangle_distance(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], s) < 0.01;
 }
 bool within(const TriPair& p, TrianglePredicateStats& s) {
-  return cadclash::detail::triangles_within(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], 0.01, s);
+  return cadclash::triangles_within(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2], 0.01, s);
 }
 
 void register_all() {

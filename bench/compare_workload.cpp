@@ -1,5 +1,7 @@
 #include "compare_workload.h"
 
+#include "cadclash/geometry.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -10,15 +12,6 @@
 
 namespace cadclash::bench {
 namespace {
-
-Aabb transformed(const Aabb& b, const Pose& t) {
-  if (b.isEmpty()) return b;
-  Aabb out;
-  for (int c = 0; c < 8; ++c)
-    out.extend(t * Vec3((c & 1) ? b.max().x() : b.min().x(), (c & 2) ? b.max().y() : b.min().y(),
-                        (c & 4) ? b.max().z() : b.min().z()));
-  return out;
-}
 
 InstanceId find_path(const Model& model, const std::string& path) {
   for (InstanceId i = 0; i < model.instances.size(); ++i)
@@ -113,7 +106,7 @@ std::vector<std::array<InstanceId, 2>> overlapping_instance_pairs(const Model& m
   std::vector<Aabb> world(n);
   std::vector<InstanceId> order;
   for (InstanceId i = 0; i < n; ++i) {
-    world[i] = transformed(part_boxes[model.instances[i].part], poses[i]);
+    world[i] = placed_box(part_boxes[model.instances[i].part], poses[i]);
     if (world[i].isEmpty()) continue;
     // Rounding of the mapped corners must not separate boxes that touch exactly.
     const double pad = 1e-9 * (1.0 + std::max(world[i].min().cwiseAbs().maxCoeff(), world[i].max().cwiseAbs().maxCoeff()));
@@ -241,7 +234,7 @@ bool write_path_csv(const Model& model, const GeneratedPath& path, const std::st
 Model instanced_grid(const Model& base, std::uint32_t copies) {
   const std::vector<Aabb> boxes = part_triangle_boxes(base);
   Aabb world;
-  for (const Instance& in : base.instances) world.extend(transformed(boxes[in.part], in.pose));
+  for (const Instance& in : base.instances) world.extend(placed_box(boxes[in.part], in.pose));
   const Vec3 size = world.sizes();
   const double gap = 0.1 * size.norm();
   const auto cols = static_cast<std::uint32_t>(std::ceil(std::sqrt(static_cast<double>(copies))));

@@ -7,7 +7,7 @@
 // build points on small integer lattices (in coordinate planes or in an arbitrary plane), scale and
 // shift them exactly, and then optionally nudge single coordinates by a few ulps.
 #include "test_triangle_cases.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <fuzzer/FuzzedDataProvider.h>
 
@@ -91,7 +91,7 @@ std::array<Vec3, 6> decode(FuzzedDataProvider& in) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace cadclash::detail;
+  using namespace cadclash;
   FuzzedDataProvider in(data, size);
   const std::array<Vec3, 6> p = decode(in);
   const Vec3 &a0 = p[0], &a1 = p[1], &a2 = p[2], &b0 = p[3], &b1 = p[4], &b2 = p[5];

@@ -1,7 +1,6 @@
 #include "decide.h"
 
-#include "box_util.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -48,11 +47,6 @@ double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, doubl
 
 double effective_uncertainty(const Surface& s, double part_magnitude) {
   return s.uncertainty > 0.0 ? s.uncertainty : 0x1p-24 * part_magnitude;
-}
-
-double box_norm(const Aabb& box) {
-  if (box.isEmpty()) return 0.0;
-  return box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
 }
 
 bool triangles_are_exact(const Model& model, SurfaceId s) {

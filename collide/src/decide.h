@@ -28,9 +28,6 @@ double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, doubl
 // single-precision representation bound 2^-24 of its part's largest coordinate magnitude.
 double effective_uncertainty(const Surface& s, double part_magnitude);
 
-// The largest Euclidean norm of a point of `box` (0 for an empty box).
-double box_norm(const Aabb& box);
-
 // The touching threshold T = tolerance + εa + εb (effective uncertainties).
 inline double touch_threshold(double eps_a, double eps_b, double tolerance) { return tolerance + eps_a + eps_b; }
 

@@ -5,7 +5,7 @@
 // vertex need lie; its support point toward the plane proves it.
 #include "decide_steps.h"
 
-#include "box_util.h"
+#include "cadclash/geometry.h"
 
 #include <algorithm>
 #include <cmath>

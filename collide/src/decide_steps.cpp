@@ -2,8 +2,7 @@
 // bound on the exact faces' distance, and only what it leaves open goes to the next.
 #include "decide_steps.h"
 
-#include "box_util.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,6 @@
 #include "narrow_phase.h"
 
-#include "box_util.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <array>
 #include <algorithm>

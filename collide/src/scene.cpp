@@ -41,6 +41,37 @@ InstanceId Scene::find_instance(const std::string& path) const {
   return it == impl_->by_path.end() ? kInvalidId : it->second;
 }
 
+std::size_t Scene::build_hierarchies(int threads) {
+  detail::SceneData& s = *impl_;
+  std::vector<SurfaceId> todo;
+  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid)
+    if (!s.bvh_ready[sid] && s.model.surfaces[sid].has_triangles) todo.push_back(sid);
+  const auto n = static_cast<std::ptrdiff_t>(todo.size());
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 1) if (n >= 4)
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    const SurfaceId sid = todo[static_cast<std::size_t>(k)];
+    s.bvh[sid] = detail::build_surface_bvh(s.model.surfaces[sid].mesh);
+  }
+  for (SurfaceId sid : todo) s.bvh_ready[sid] = 1;
+  return todo.size();
+}
+
+SceneMemory Scene::memory() const {
+  const detail::SceneData& s = *impl_;
+  SceneMemory m;
+  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid) {
+    if (!s.bvh_ready[sid]) continue;
+    const TriangleMesh& mesh = s.model.surfaces[sid].mesh;
+    m.triangles += mesh.triangles.size() * sizeof(mesh.triangles[0]);
+    m.vertices += mesh.vertices.size() * sizeof(mesh.vertices[0]);
+    m.hierarchies += detail::bvh_bytes(s.bvh[sid]);
+    m.triangle_count += mesh.triangles.size();
+  }
+  m.instances = s.poses.size() * sizeof(Pose) + s.world_box.size() * sizeof(Aabb) + s.dirty.size() +
+                s.in_a.size() + s.in_b.size();
+  return m;
+}
+
 Report Scene::check(const CollideOptions& o) {
   assert(o.tolerance >= 0.0 && o.clearance >= 0.0 && o.time_budget_seconds >= 0.0);
   detail::SceneData& s = *impl_;

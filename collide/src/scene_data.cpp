@@ -1,5 +1,6 @@
 #include "scene_data.h"
 
+#include "cadclash/geometry.h"
 #include "decide.h"
 
 #include <cassert>

@@ -1,5 +1,5 @@
 // Stage 1: instance world boxes and the broad phase.
-#include "box_util.h"
+#include "cadclash/geometry.h"
 #include "scene_stages.h"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 // Stage 2: the object and surface levels (OAABB of the instance pair, surviving surfaces, candidate
 // surface pairs), then the task list and the memory ledger.
-#include "box_util.h"
+#include "cadclash/geometry.h"
 #include "decide.h"
 #include "scene_stages.h"
 

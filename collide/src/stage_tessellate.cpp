@@ -20,11 +20,6 @@ std::uint64_t mesh_bytes(const TriangleMesh& m) {
   return m.vertices.size() * sizeof(Vec3) + m.triangles.size() * sizeof(m.triangles[0]);
 }
 
-std::uint64_t bvh_bytes(const SurfaceBvh& b) {
-  return b.nodes.size() * sizeof(b.nodes[0]) + b.order.size() * sizeof(b.order[0]) +
-         b.triangle_boxes.size() * sizeof(Aabb);
-}
-
 // Triangles for the surfaces of one round that have none yet; charged to their first pair.
 void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wave) {
   Model& model = s.model;

@@ -1,8 +1,7 @@
 #include "surface_bvh.h"
 
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
-#include "box_util.h"
 
 #include <algorithm>
 #include <limits>

@@ -23,6 +23,12 @@ struct SurfaceBvh {
 // The same tree over any boxes (item k's box is boxes[k]; `triangle_boxes` holds them).
 SurfaceBvh build_box_bvh(std::vector<Aabb> boxes);
 
+// The bytes the tree holds (nodes, order, boxes).
+inline std::uint64_t bvh_bytes(const SurfaceBvh& b) {
+  return b.nodes.size() * sizeof(b.nodes[0]) + b.order.size() * sizeof(b.order[0]) +
+         b.triangle_boxes.size() * sizeof(b.triangle_boxes[0]);
+}
+
 // Builds the tree (median split on the longest axis of the centroids; leaves of <= 4 triangles).
 SurfaceBvh build_surface_bvh(const TriangleMesh& mesh);
 

@@ -7,14 +7,14 @@
 // (the normal of a sliver, nearly parallel edges) can only lose a candidate, never report a
 // distance that is too small, and the well-conditioned candidate of the same class (an edge
 // endpoint against the other edge) still finds the minimum.
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 
-namespace cadclash::detail {
+namespace cadclash {
 namespace {
 
 struct P3 {
@@ -271,4 +271,4 @@ bool triangles_within(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3
   return disjoint_distance(a0, a1, a2, b0, b1, b2, d) <= d;
 }
 
-}  // namespace cadclash::detail
+}  // namespace cadclash

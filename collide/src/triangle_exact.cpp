@@ -1,7 +1,7 @@
 // The exact triangle–triangle decision: CGAL's filtered exact predicates (EPICK), which the float
 // filter of triangle_intersect.cpp falls back to. Kept in its own object library because CGAL needs
 // -frounding-math, which would slow down the rest of the collide module.
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Intersections_3/Point_3_Segment_3.h>
@@ -11,7 +11,7 @@
 
 #include <utility>
 
-namespace cadclash::detail {
+namespace cadclash {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -96,4 +96,4 @@ bool triangles_intersect_exact(const Vec3& a0, const Vec3& a1, const Vec3& a2,
   return simplices_intersect(classify(a0, a1, a2), classify(b0, b1, b2));
 }
 
-}  // namespace cadclash::detail
+}  // namespace cadclash

@@ -27,7 +27,8 @@
 // product; the total absolute error from underflow is below 2^-1020 and the floor 2^-1000 (plus
 // the u·P spare) covers it. A certified sign is never zero, so every certified configuration is the
 // generic one GD handles with strict signs.
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
+#include "cadclash/testing/benchmark_switches.h"
 
 #include <algorithm>
 #include <atomic>
@@ -39,7 +40,7 @@
 #error "triangle_intersect.cpp: the error bounds need IEEE arithmetic; do not build with -ffast-math"
 #endif
 
-namespace cadclash::detail {
+namespace cadclash {
 namespace {
 
 constexpr double kOrientBound = 9.0 * 0x1p-53;
@@ -247,7 +248,9 @@ std::atomic<bool> float_only_for_benchmark{false};
 
 }  // namespace
 
+namespace testing {
 void set_float_only_for_benchmark(bool on) { float_only_for_benchmark.store(on, std::memory_order_relaxed); }
+}  // namespace testing
 
 bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                          const Vec3& b1, const Vec3& b2, TrianglePredicateStats& stats) {
@@ -265,4 +268,4 @@ bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
   return triangles_intersect_exact(a0, a1, a2, b0, b1, b2);
 }
 
-}  // namespace cadclash::detail
+}  // namespace cadclash

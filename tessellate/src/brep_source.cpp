@@ -1,6 +1,8 @@
 // BrepSource: the exact faces of one part, tessellated on demand and measured exactly.
 #include "brep_internal.h"
 
+#include "cadclash/geometry.h"
+
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
@@ -17,18 +19,6 @@
 
 namespace cadclash {
 namespace {
-
-Aabb placed_box(const Aabb& local, const Pose& pose) {
-  Aabb world;
-  if (local.isEmpty()) return world;
-  for (int corner = 0; corner < 8; ++corner) world.extend(pose * local.corner(static_cast<Aabb::CornerType>(corner)));
-  return world;
-}
-
-double box_distance(const Aabb& a, const Aabb& b) {
-  const Vec3 gap = (a.min() - b.max()).cwiseMax(b.min() - a.max()).cwiseMax(0.0);
-  return gap.norm();
-}
 
 // Shared locks on both parts: either part's faces may be meshed by another thread meanwhile
 // (triangulate holds the lock exclusively); distances only read the faces, so any number run at once.

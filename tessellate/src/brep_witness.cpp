@@ -3,6 +3,8 @@
 // minimum that BRepExtrema_DistShapeShape searches for in about half a millisecond.
 #include "brep_internal.h"
 
+#include "cadclash/geometry.h"  // box_norm: bounds every point and control point a face's evaluation combines
+
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -39,12 +41,6 @@ namespace {
 // it combines, which the face's box (built from the control polygon for B-splines) bounds.
 // 2^-40 covers 8,000 such roundings.
 constexpr double kEvaluationRounding = 0x1p-40;
-
-// The largest distance of a box corner from the origin: bounds every point and control point the
-// face's evaluation combines.
-double box_norm(const Aabb& box) {
-  return box.isEmpty() ? 0.0 : box.min().cwiseAbs().cwiseMax(box.max().cwiseAbs()).norm();
-}
 
 // The parameters of the face's triangulation node nearest to `p`: a node lies on the surface, so
 // Newton started there reaches the foot point of any point within a triangle's size of the face.

@@ -18,7 +18,7 @@
 #include "cadclash/collide.h"
 #include "cadclash/testing/scenes.h"
 #include "cadclash/testing/truth.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <gtest/gtest.h>
 
@@ -470,7 +470,7 @@ TEST(OcctDistance, MissedMinimumDoesNotDecideApart) {
   double fine = 1e300;
   for (const auto& x : ma.triangles)
     for (const auto& y : mb.triangles)
-      fine = std::min(fine, detail::triangle_distance(ta * ma.vertices[x[0]], ta * ma.vertices[x[1]], ta * ma.vertices[x[2]],
+      fine = std::min(fine, triangle_distance(ta * ma.vertices[x[0]], ta * ma.vertices[x[1]], ta * ma.vertices[x[2]],
                                                       tb * mb.vertices[y[0]], tb * mb.vertices[y[1]], tb * mb.vertices[y[2]]));
   const double upper = fine + da + db;  // the exact faces are at most this far apart
   const auto occt = pa.source->exact_distance(fa, ta, *pb.source, fb, tb, 1.0);

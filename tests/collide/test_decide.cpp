@@ -1,9 +1,8 @@
 // The certified decision's pieces: the round-off bound against a long-double reference under large
 // rigid motions, the triangles' interval and verdict, and the analytic lower bounds.
-#include "box_util.h"
 #include "decide.h"
 #include "surface_bvh.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +23,6 @@ using detail::verdict;
 using detail::build_surface_bvh;
 using detail::point_mesh_distance;
 using detail::SurfaceBvh;
-using detail::triangle_distance;
 
 using Mat4L = Eigen::Matrix<long double, 4, 4>;
 
@@ -57,7 +55,7 @@ TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
       rel.translation() = Vec3(0.1 * (k % 5), -0.2, std::pow(10.0, hh(rng)));
       const Pose pb = pa * rel;  // B's pose as a user's assembly would store it: rounded doubles
       const Pose t_ab = pa.inverse(Eigen::Isometry) * pb;
-      const double got = detail::triangle_distance(a0, a1, a2, t_ab * b0, t_ab * b1, t_ab * b2);
+      const double got = triangle_distance(a0, a1, a2, t_ab * b0, t_ab * b1, t_ab * b2);
       const Mat4L ma = pa.matrix().cast<long double>(), mb = pb.matrix().cast<long double>();
       const Mat4L rel_ld = ma.inverse() * mb;
       long double ref = 1e300L;
@@ -276,7 +274,7 @@ TEST(NearOutline, AgreesWithAScanOverEverySegment) {
     for (int k = 0; k < 3000; ++k) {
       const Vec3 p = Vec3(offset, offset, offset) + Vec3(-2 + 28 * u(rng), -14 + 16 * u(rng), -1 + 2 * u(rng));
       double scan2 = std::numeric_limits<double>::infinity();
-      for (const auto& [a, b] : outline.segments) scan2 = std::min(scan2, (detail::closest_on_segment(p, a, b) - p).squaredNorm());
+      for (const auto& [a, b] : outline.segments) scan2 = std::min(scan2, (closest_on_segment(p, a, b) - p).squaredNorm());
       for (double margin : {1e-3, 0.1, 0.7, 3.0, std::sqrt(scan2)}) {
         const bool want = scan2 <= margin * margin;
         EXPECT_EQ(detail::near_outline(outline, p, margin), want) << offset << ' ' << k << ' ' << margin;

@@ -46,6 +46,33 @@ TEST(Scene, OnlyMovedInstancesGetNewWorldBoxes) {
   expect_same_pairs(r, fresh.check(o));
 }
 
+// build_hierarchies builds each surface's tree once, memory() counts what is held, and a check after
+// it answers as one that built the trees itself.
+TEST(Scene, BuildsHierarchiesUpFrontAndCountsItsBytes) {
+  Model m = row_of_boxes(3);
+  m.instances[1].pose = translation(1.0, 0.2, 0.1);  // b1 overlaps b0
+  std::uint64_t triangles = 0;
+  for (const Surface& s : m.surfaces) triangles += s.mesh.triangles.size();
+  Scene scene(m);
+  const SceneMemory before = scene.memory();
+  EXPECT_EQ(before.hierarchies, 0u);
+  EXPECT_EQ(before.triangle_count, 0u);
+  EXPECT_GT(before.instances, 3 * sizeof(Pose));
+  EXPECT_EQ(scene.build_hierarchies(2), m.surfaces.size());
+  EXPECT_EQ(scene.build_hierarchies(), 0u);  // nothing left to build
+  const SceneMemory after = scene.memory();
+  EXPECT_EQ(after.triangle_count, triangles);
+  EXPECT_EQ(after.triangles, triangles * sizeof(m.surfaces[0].mesh.triangles[0]));
+  EXPECT_GT(after.vertices, 0u);
+  EXPECT_GT(after.hierarchies, triangles * sizeof(Aabb));  // a box per triangle, plus the nodes
+  EXPECT_EQ(after.total(), after.triangles + after.vertices + after.hierarchies + after.instances);
+  Scene lazy(m);
+  const Report r = lazy.check();
+  ASSERT_FALSE(r.pairs.empty());
+  expect_same_pairs(scene.check(), r);
+  EXPECT_EQ(lazy.memory().triangle_count, triangles);  // the overlap reached every face of b0 and b1
+}
+
 TEST(Scene, SelectionsAndExclusions) {
   Model m = row_of_boxes(4);
   for (InstanceId i = 0; i < 4; ++i) m.instances[i].pose = translation(0.3 * i, 0, 0);  // all overlap

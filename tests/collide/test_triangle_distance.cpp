@@ -2,7 +2,7 @@
 // section over each edge pair, Ericson's closest point for each vertex–face pair, the exact oracle
 // for 0), a sampled upper bound, known configurations, symmetry and rigid-motion invariance.
 #include "test_triangle_cases.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
 
 #include <gtest/gtest.h>
 
@@ -14,9 +14,6 @@
 namespace cadclash {
 namespace {
 
-using detail::triangle_distance;
-using detail::TrianglePredicateStats;
-using detail::triangles_within;
 using test::Family;
 using test::Tri;
 using test::TriPair;
@@ -172,7 +169,7 @@ TEST(PointTriangleDistance, IsTriangleDistanceOfAPointToTheLastBit) {
         default: p = c.a[static_cast<std::size_t>(rng.integer(0, 2))];
       }
       const double want = triangle_distance(p, p, p, b[0], b[1], b[2]);
-      const double got = detail::point_triangle_distance(p, b[0], b[1], b[2]);
+      const double got = point_triangle_distance(p, b[0], b[1], b[2]);
       if (want == 0.0) {
         ++on_triangle;
         double ext = 0;
@@ -190,9 +187,9 @@ TEST(PointTriangleDistance, IsTriangleDistanceOfAPointToTheLastBit) {
   EXPECT_GT(on_triangle, 0);
   // Extreme ranges take the general path's scaling.
   const Vec3 tiny(0x1p-1060, 0, 0), big(0x1p1020, 0x1p1019, 0);
-  EXPECT_EQ(detail::point_triangle_distance(tiny, Vec3(0, 0x1p-1070, 0), Vec3(0, 0, 0x1p-1070), Vec3(0, 0x1p-1070, 0x1p-1070)),
+  EXPECT_EQ(point_triangle_distance(tiny, Vec3(0, 0x1p-1070, 0), Vec3(0, 0, 0x1p-1070), Vec3(0, 0x1p-1070, 0x1p-1070)),
             triangle_distance(tiny, tiny, tiny, Vec3(0, 0x1p-1070, 0), Vec3(0, 0, 0x1p-1070), Vec3(0, 0x1p-1070, 0x1p-1070)));
-  EXPECT_EQ(detail::point_triangle_distance(big, Vec3(-0x1p1020, 0, 0), Vec3(-0x1p1020, 1, 0), Vec3(-0x1p1020, 0, 1)),
+  EXPECT_EQ(point_triangle_distance(big, Vec3(-0x1p1020, 0, 0), Vec3(-0x1p1020, 1, 0), Vec3(-0x1p1020, 0, 1)),
             triangle_distance(big, big, big, Vec3(-0x1p1020, 0, 0), Vec3(-0x1p1020, 1, 0), Vec3(-0x1p1020, 0, 1)));
 }
 
@@ -336,7 +333,7 @@ TEST(TrianglesWithin, SubnormalSliverIsNotSeparatedByItsPlane) {
   const Vec3 b0(0.0, 0x1.2p+39, 0x1.4p+38), b1(0x1p+37, -0x1.4p+38, -0x1.8p+37),
       b2(-0x0.0000000000003p-1022, 0x1.2p+39, 0x1.4p+38);
   TrianglePredicateStats stats;
-  const double d = detail::triangle_distance(a0, a0, a2, b0, b1, b2, stats);
+  const double d = triangle_distance(a0, a0, a2, b0, b1, b2, stats);
   ASSERT_TRUE(std::isfinite(d));
   EXPECT_TRUE(triangles_within(a0, a0, a2, b0, b1, b2, d * (1 + 0x1p-40), stats)) << d;
   EXPECT_TRUE(triangles_within(b0, b1, b2, a0, a0, a2, d * (1 + 0x1p-40), stats)) << d;

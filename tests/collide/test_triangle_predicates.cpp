@@ -13,7 +13,8 @@
 // (test_triangle_predicates_slow, CTest label `slow`) checks 10^7 pairs per family with other seeds:
 //   CADCLASH_SLOW_TESTS=1 ctest --test-dir build -L slow --output-on-failure
 #include "test_triangle_cases.h"
-#include "triangle_predicates.h"
+#include "cadclash/geometry.h"
+#include "cadclash/testing/benchmark_switches.h"
 
 #include <gtest/gtest.h>
 
@@ -24,9 +25,6 @@
 namespace cadclash {
 namespace {
 
-using detail::TrianglePredicateStats;
-using detail::triangles_intersect;
-using detail::triangles_intersect_exact;
 using test::Family;
 using test::Tri;
 using test::TriPair;
@@ -78,10 +76,10 @@ TEST_P(ORACLE_SUITE, ZeroDisagreements) {
     bool float_failed = false;
     float_wrong += test::float_only_intersect(p.a, p.b, &float_failed) != expected || float_failed;
     // cadclash's own filters without the exact stage (bench_compare's "float only" switch).
-    detail::set_float_only_for_benchmark(true);
+    testing::set_float_only_for_benchmark(true);
     TrianglePredicateStats filter_stats;
     filter_only_wrong += intersect(p.a, p.b, filter_stats) != expected;
-    detail::set_float_only_for_benchmark(false);
+    testing::set_float_only_for_benchmark(false);
     if (got != expected && ++disagreements <= 5)
       ADD_FAILURE() << "pair " << i << ": got " << got << ", oracle " << expected << "\n" << describe(p);
     const bool exact = triangles_intersect_exact(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2]);

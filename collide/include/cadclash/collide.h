@@ -271,6 +271,18 @@ struct SceneSelection {
   std::vector<std::string> excluded_subassemblies;  // pairs with both paths under one of these prefixes ("/root/sub")
 };
 
+// What a Scene's collision model holds, in bytes per component: the triangles and vertices of the
+// surfaces that have a hierarchy (the Model's arrays, counted once per surface), the hierarchies
+// built so far, and the per-instance data (poses, world boxes, flags).
+struct SceneMemory {
+  std::uint64_t triangles = 0;
+  std::uint64_t vertices = 0;
+  std::uint64_t hierarchies = 0;
+  std::uint64_t instances = 0;
+  std::uint64_t triangle_count = 0;  // triangles of the surfaces counted above
+  std::uint64_t total() const { return triangles + vertices + hierarchies + instances; }
+};
+
 // A prepared scene: per-surface BVHs and instance world boxes are built once; each check() updates
 // only the instances moved by set_pose since the last check.
 // The model must outlive the scene; the scene writes only surfaces' triangles (lazy tessellation).
@@ -289,6 +301,13 @@ class Scene {
   InstanceId find_instance(const std::string& path) const;
 
   Report check(const CollideOptions& options = {});
+
+  // Builds now the hierarchy of every surface that has triangles and none yet (check() builds them
+  // on demand, for the surfaces its pairs reach). threads <= 0: all available. Returns how many.
+  std::size_t build_hierarchies(int threads = 0);
+
+  // The bytes held now (see SceneMemory).
+  SceneMemory memory() const;
 
  private:
   struct Impl;

@@ -1,5 +1,6 @@
 #include "cadclash/testing/scenes.h"
 
+#include "cadclash/geometry.h"
 #include "cadclash/import.h"
 #include "cadclash/tessellate.h"
 #include "cadclash/testing/truth.h"
@@ -136,12 +137,6 @@ Aabb part_box(const Model& m, PartId p) {
   return box;
 }
 
-Aabb transformed(const Aabb& box, const Pose& pose) {
-  Aabb out;
-  for (int c = 0; c < 8; ++c) out.extend(pose * box.corner(static_cast<Aabb::CornerType>(c)));
-  return out;
-}
-
 // Rotation about world z by `deg` degrees, built entry by entry so that the third row and column are
 // exactly (0, 0, 1): heights along z are not rounded by it.
 Eigen::Matrix3d rot_z(double deg) {
@@ -171,7 +166,7 @@ TopoDS_Compound part_compound(const Model& m, PartId p) {
 // Exact distance from part p placed by `pose` to the plane {x : n·x = h} (a square face far larger
 // than the part, centred under it).
 double distance_to_plane(const Model& m, PartId p, const Pose& pose, const Vec3& n, double h) {
-  const Aabb box = transformed(part_box(m, p), pose);
+  const Aabb box = placed_box(part_box(m, p), pose);
   const double half = 10.0 * box.sizes().norm() + 1.0;
   const Vec3 c = box.center();
   const Vec3 on_plane = c - (n.dot(c) - h) * n;
@@ -379,7 +374,7 @@ BuiltScene board_scene(const std::string& external_dir, double deflection) {
       pose.translation() = Vec3(at->x() - rp.x(), at->y() - rp.y(), tz);
     } else {
       pose.translation() = Vec3(0, 0, tz);
-      const Vec3 t = layout.place(m.parts[part].name, xy(transformed(part_box(m, part), pose)));
+      const Vec3 t = layout.place(m.parts[part].name, xy(placed_box(part_box(m, part), pose)));
       pose.translation() = Vec3(t.x(), t.y(), tz);
     }
     return pose;
@@ -417,7 +412,7 @@ BuiltScene board_scene(const std::string& external_dir, double deflection) {
     const InstanceId pin = add("/board/pin/bolt", bolt, pb);
     s.placements.push_back({pin, "bolt through a hole of the board (coaxial, equal radius), head seated, turned 17 deg",
                             board, 0.0, 0.0});
-    layout.take(xy(transformed(part_box(m, bolt), pb)));
+    layout.take(xy(placed_box(part_box(m, bolt), pb)));
     // The nut: its +z face against the plate's bottom face, bore axis on the hole axis.
     const std::uint32_t nut_top = outer_plane_facing(m, nut, up);
     std::vector<std::uint32_t> bore;
@@ -466,7 +461,7 @@ BuiltScene board_scene(const std::string& external_dir, double deflection) {
     const double tz = h_top + cyl->radius - (r * cyl->origin).z();
     const double tx = m.surfaces[m.parts[plate].first_surface + top_face].aabb.max().x() + kMargin - he.x();
     ps.translation() = Vec3(0, 0, tz);
-    const Box2 fp = xy(transformed(sb, ps));
+    const Box2 fp = xy(placed_box(sb, ps));
     const Vec3 t = layout.place("the screw", fp, tx);
     ps.translation() = Vec3(tx, t.y(), tz);
     on_board("/board/screw", screw, ps, "screw lying on its side, analytic cylinder tangent, head over the edge", 0.0,
@@ -481,7 +476,7 @@ BuiltScene board_scene(const std::string& external_dir, double deflection) {
     const double spin = 29.5 * std::numbers::pi / 180.0;
     Pose pl = Pose::Identity();
     pl.linear() = rot_z(17.0) * lie * Eigen::AngleAxisd(spin, Vec3::UnitZ()).toRotationMatrix();
-    const Box2 fp = xy(transformed(part_box(m, bolt), pl));
+    const Box2 fp = xy(placed_box(part_box(m, bolt), pl));
     const Vec3 t = layout.place("the lying bolt", fp);
     const double high = h_top + 2.0 * part_box(m, bolt).sizes().norm();
     pl.translation() = Vec3(t.x(), t.y(), high);
@@ -537,7 +532,7 @@ void move_scene(Model& model, const Pose& motion) {
 
 Model grid_copies(const Model& model, int copies, double gap) {
   Aabb box;
-  for (const Instance& i : model.instances) box.extend(transformed(part_box(model, i.part), i.pose));
+  for (const Instance& i : model.instances) box.extend(placed_box(part_box(model, i.part), i.pose));
   const Vec3 size = box.sizes();
   const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(copies))));
   Model out;
