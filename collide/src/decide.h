@@ -89,6 +89,13 @@ Outline make_outline(const TriangleMesh& mesh);
 // speeds up (it skips boxes farther than margin by more than any rounding of either distance).
 bool near_outline(const Outline& outline, const Vec3& p, double margin);
 
+// Per surface: its outline once made, kept by the Scene beside the surface's tree and dropped with it
+// (the outline depends on the triangles alone).
+struct OutlineCache {
+  std::vector<Outline> outline;
+  std::vector<char> ready;
+};
+
 // Contact certificate from a surface's parameters: the smallest distance g from a vertex of
 // `mesh_a` (mapped into B's frame by `to_b`, lying in `region` given in B's frame) to the full
 // surface `an_b`, over the vertices whose foot point on that surface is provably a point of face B:
@@ -131,12 +138,13 @@ struct DecideResult {
 
 // The decision stage (collide.h, "Certified decisions"), per options.decision. Refinements run in
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
-// is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface).
+// is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface),
+// `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`.
 // `eps` holds every surface's effective_uncertainty, `bvh` the tree of every surface with triangles.
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                                       std::vector<RefinedSurface>& refined,
+                                       std::vector<RefinedSurface>& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
                                        CollideCounters& counters);
 

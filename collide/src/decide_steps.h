@@ -13,9 +13,6 @@
 
 namespace cadclash::detail {
 
-// Per surface: the outline of its triangles (make_outline), made for the surfaces that need it.
-using Outlines = std::vector<Outline>;
-
 // Where one pair's decision stands between the steps.
 struct Pending {
   Interval d;

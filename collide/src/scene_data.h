@@ -5,6 +5,7 @@
 
 #include "budget.h"
 #include "cadclash/collide.h"
+#include "decide.h"
 #include "narrow_phase.h"
 #include "refine.h"
 #include "surface_bvh.h"
@@ -31,6 +32,7 @@ struct SceneData {
   std::vector<SurfaceBvh> bvh;
   std::vector<char> bvh_ready;
   std::vector<RefinedSurface> refined;  // finer faces made for refinement, kept for later queries
+  OutlineCache outlines;                // surfaces' outlines made by the decision stage, likewise
   std::vector<char> in_a, in_b;
   std::set<std::pair<InstanceId, InstanceId>> excluded;
   std::unordered_map<std::string, InstanceId> by_path;

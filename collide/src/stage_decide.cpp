@@ -59,7 +59,7 @@ void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending,
 
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                                       std::vector<RefinedSurface>& refined,
+                                       std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
                                        CollideCounters& counters) {
   std::vector<DecideResult> results(tasks.size());
@@ -72,7 +72,10 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   std::vector<Pending> pending(tasks.size());
   std::vector<CollideCounters> task_counters(tasks.size());
   auto meshed = [&](std::size_t k) { return tasks[k].outcome != nullptr; };
-  Outlines outlines(model.surfaces.size());  // made for the surfaces of the open pairs (step 2b)
+  // Made for the surfaces of the open pairs (step 2b) unless the Scene has them from an earlier query.
+  std::vector<Outline>& outlines = outline_cache.outline;
+  outlines.resize(model.surfaces.size());
+  outline_cache.ready.resize(model.surfaces.size(), 0);
   auto finer = [&](SurfaceId f) { return finer_view(model, bvh, refined, f); };
   auto view = [&](SurfaceId f) { return FaceView{model.surfaces[f], bvh[f], outlines[f].empty() ? nullptr : &outlines[f]}; };
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
@@ -87,13 +90,15 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   if (certified) {
     // Step 2b: analytic contact witnesses, on the outlines of the open pairs' surfaces.
     const std::vector<std::size_t> open = select(pending, meshed);
-    const std::vector<SurfaceId> faces = faces_of(tasks, open);
+    std::vector<SurfaceId> faces = faces_of(tasks, open);
+    std::erase_if(faces, [&](SurfaceId f) { return outline_cache.ready[f] != 0; });
     const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (nfaces >= 8)
     for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
       const SurfaceId f = faces[static_cast<std::size_t>(i)];
       outlines[f] = make_outline(model.surfaces[f].mesh);
     }
+    for (SurfaceId f : faces) outline_cache.ready[f] = 1;
     run_step(open, pending, threads, deadline,
              [&](std::size_t k) { analytic_contact(eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o); });
     // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
@@ -224,7 +229,8 @@ void decision_stage(SceneData& s, QueryState& q) {
     task_of.push_back(k);
   }
   std::vector<DecideResult> results =
-      decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, q.o, q.threads, q.deadline, q.report.counters);
+      decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
+                   q.report.counters);
   for (std::size_t i = 0; i < results.size(); ++i) {
     const std::size_t k = task_of[i];
     const std::size_t pair = q.tasks[k].pair;

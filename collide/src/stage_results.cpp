@@ -21,6 +21,10 @@ void release_past_cutoff(SceneData& s, const QueryState& q) {
     if (q.first_need[sid] < q.cutoff) continue;
     s.bvh[sid] = SurfaceBvh{};
     s.bvh_ready[sid] = 0;
+    if (sid < s.outlines.ready.size() && s.outlines.ready[sid]) {
+      s.outlines.outline[sid] = Outline{};
+      s.outlines.ready[sid] = 0;
+    }
   }
 }
 
