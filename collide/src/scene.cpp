@@ -94,6 +94,7 @@ Report Scene::check(const CollideOptions& o) {
   detail::containment_stage(s, q);     // whole instances inside others
   time.triangle_level = detail::seconds_since(t);
   detail::results_stage(s, q);  // the kept prefix, in a fixed order
+  q.report.model_memory = memory();
   time.total = detail::seconds_since(q.t0);
   return std::move(q.report);
 }

@@ -183,6 +183,19 @@ QueryReport read_query(const Json& j, const std::string& p) {
     q.unexamined_pairs.push_back({text(field(u[k], pk, "a"), pk + "/a"), text(field(u[k], pk, "b"), pk + "/b")});
   }
   q.memory_charged_bytes = count(field(j, p, "memory_charged_bytes"), p + "/memory_charged_bytes");
+  if (j.contains("model")) {  // written since the model's size was reported; older reports lack it
+    const std::string pm = p + "/model";
+    const Json& model = object(j["model"], pm);
+    const std::string pb = pm + "/bytes";
+    const Json& bytes = object(field(model, pm, "bytes"), pb);
+    q.model.triangles = count(field(bytes, pb, "triangles"), pb + "/triangles");
+    q.model.vertices = count(field(bytes, pb, "vertices"), pb + "/vertices");
+    q.model.hierarchies = count(field(bytes, pb, "hierarchies"), pb + "/hierarchies");
+    q.model.instances = count(field(bytes, pb, "instances"), pb + "/instances");
+    if (count(field(bytes, pb, "total"), pb + "/total") != q.model.total())
+      fail(pb + "/total", "is not the sum of the components");
+    q.model.triangle_count = count(field(model, pm, "triangles"), pm + "/triangles");
+  }
   return q;
 }
 

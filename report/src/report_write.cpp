@@ -116,6 +116,13 @@ void put_query(const QueryReport& q, const ReportWriteOptions& o, nlohmann::json
   for (const auto& [a, b] : q.unexamined_pairs) u.push_back({{"a", a}, {"b", b}});
   j["unexamined_pairs"] = std::move(u);
   j["memory_charged_bytes"] = q.memory_charged_bytes;
+  j["model"] = {{"bytes",
+                 {{"triangles", q.model.triangles},
+                  {"vertices", q.model.vertices},
+                  {"hierarchies", q.model.hierarchies},
+                  {"instances", q.model.instances},
+                  {"total", q.model.total()}}},
+                {"triangles", q.model.triangle_count}};
 }
 
 }  // namespace
@@ -143,6 +150,7 @@ QueryReport query_report(const Model& model, const Report& r) {
   if (!r.complete) q.stopped_by = r.stopped_by;
   for (const auto& [a, b] : r.unexamined_pairs) q.unexamined_pairs.push_back({model.instances[a].path, model.instances[b].path});
   q.memory_charged_bytes = r.memory_charged;
+  q.model = r.model_memory;
   return q;
 }
 

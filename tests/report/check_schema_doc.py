@@ -26,6 +26,8 @@ SECTIONS = {
     "Summary": "summary",
     "Counters": "counters",
     "Timings": "timings",
+    "`model`": "model",
+    "`model.bytes`": "model_bytes",
     "Step (with `--path`)": "step",
 }
 # Documented keys no run here writes, with the reason. Keep empty when possible.
@@ -72,6 +74,9 @@ def collect(report: dict, seen: dict) -> None:
         for key in ("summary", "counters", "timings"):
             if key in obj:
                 add(key, obj[key])
+        if "model" in obj:
+            add("model", obj["model"])
+            add("model_bytes", obj["model"]["bytes"])
         for u in obj.get("unexamined_pairs", []):
             add("unexamined", u)
 

@@ -93,6 +93,10 @@ TEST(ReportMalformed, NamesTheOffendingValue) {
       {"/diagnostics", "x", "/diagnostics"},
       {"/complete", "yes", "/complete"},
       {"/memory_charged_bytes", 1e3, "/memory_charged_bytes"},
+      {"/model/bytes/hierarchies", -2, "/model/bytes/hierarchies"},
+      {"/model/bytes/total", 1, "/model/bytes/total"},
+      {"/model/triangles", "many", "/model/triangles"},
+      {"/model", 3, "/model"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = valid();

@@ -60,6 +60,7 @@ QueryReport sample_query() {
   q.stopped_by = "memory budget";
   q.unexamined_pairs = {{"/a", "/c"}};
   q.memory_charged_bytes = 123456789;
+  q.model = SceneMemory{1200, 2400, 5600, 300, 100};
   return q;
 }
 
@@ -100,6 +101,15 @@ TEST(ReportRoundTrip, HandMadeReportWithEveryOptionalField) {
   EXPECT_EQ(q.pairs[2].a.whole_part, true);
   EXPECT_EQ(q.counters.dismissed_pairs, 24u);
   EXPECT_EQ(read.report.settings.triangle_level, TriangleLevel::Bvh);
+  EXPECT_EQ(q.model.hierarchies, 5600u);
+  EXPECT_EQ(q.model.triangle_count, 100u);
+  EXPECT_NE(text.find("\"total\": 9500"), std::string::npos);
+  // Written before the model's size was reported: read as zeros.
+  nlohmann::json old = nlohmann::json::parse(text);
+  old.erase("model");
+  const ReportReadResult read_old = check_report_from_parsed(old);
+  ASSERT_FALSE(read_old.error);
+  EXPECT_EQ(read_old.report.query->model.total(), 0u);
   // Without timings: none written, and the rest unchanged.
   const std::string bare = check_report_text(sample_report(), {.timings = false});
   EXPECT_EQ(bare.find("\"timings\""), std::string::npos);

@@ -242,6 +242,18 @@ struct SurfacePairResult {
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
 };
 
+// What a Scene's collision model holds, in bytes per component: the triangles and vertices of the
+// surfaces that have a hierarchy (the Model's arrays, counted once per surface), the hierarchies
+// built so far, and the per-instance data (poses, world boxes, flags).
+struct SceneMemory {
+  std::uint64_t triangles = 0;
+  std::uint64_t vertices = 0;
+  std::uint64_t hierarchies = 0;
+  std::uint64_t instances = 0;
+  std::uint64_t triangle_count = 0;  // triangles of the surfaces counted above
+  std::uint64_t total() const { return triangles + vertices + hierarchies + instances; }
+};
+
 struct Report {
   std::vector<SurfacePairResult> pairs;  // sorted by (instance_a, instance_b, surface_a, surface_b)
   CollideCounters counters;
@@ -257,6 +269,9 @@ struct Report {
   // Bytes charged against memory_budget_bytes (computed whether or not a budget is set); the same
   // for any thread count.
   std::uint64_t memory_charged = 0;
+  // What the scene's collision model held after this query (Scene::memory()); the same for any
+  // thread count.
+  SceneMemory model_memory;
 };
 
 // One-off query of two instances. Tessellates (require_triangles) exactly the surfaces it needs.
@@ -271,17 +286,6 @@ struct SceneSelection {
   std::vector<std::string> excluded_subassemblies;  // pairs with both paths under one of these prefixes ("/root/sub")
 };
 
-// What a Scene's collision model holds, in bytes per component: the triangles and vertices of the
-// surfaces that have a hierarchy (the Model's arrays, counted once per surface), the hierarchies
-// built so far, and the per-instance data (poses, world boxes, flags).
-struct SceneMemory {
-  std::uint64_t triangles = 0;
-  std::uint64_t vertices = 0;
-  std::uint64_t hierarchies = 0;
-  std::uint64_t instances = 0;
-  std::uint64_t triangle_count = 0;  // triangles of the surfaces counted above
-  std::uint64_t total() const { return triangles + vertices + hierarchies + instances; }
-};
 
 // A prepared scene: per-surface BVHs and instance world boxes are built once; each check() updates
 // only the instances moved by set_pose since the last check.

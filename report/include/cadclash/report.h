@@ -207,6 +207,7 @@ struct QueryReport {
   std::string stopped_by;                 // empty: every instance pair was examined (null)
   std::vector<std::array<std::string, 2>> unexamined_pairs;  // instance paths
   std::uint64_t memory_charged_bytes = 0;
+  SceneMemory model;  // "model": bytes per component and triangles (absent in reports written before it: zeros)
 };
 
 struct StepReport {
