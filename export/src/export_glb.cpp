@@ -1,6 +1,8 @@
-// glTF 2.0 binary export, written with nlohmann-json; layout in mesh_glb.h.
-#include "mesh_export.h"
-#include "mesh_glb.h"
+// glTF 2.0 binary export, written with nlohmann-json; layout in cadclash/glb_layout.h.
+#include "writers.h"
+
+#include "cadclash/glb_layout.h"
+#include "cadclash/report.h"
 
 #include <cstring>
 #include <limits>
@@ -87,7 +89,7 @@ std::vector<Diagnostic> write_glb(const Model& model, const std::string& path) {
       for (const auto& t : s.mesh.triangles) min_index = std::min({min_index, t[0], t[1], t[2]});
       accessors.back()["min"] = {min_index};
 
-      nlohmann::json extras = surface_provenance_json(s);
+      nlohmann::json extras = provenance_json(s);
       extras["surface_id"] = sid;
       extras["positions_f64"] = f64_view;
       primitives.push_back({{"attributes", {{"POSITION", pos_accessor}}},
