@@ -1,5 +1,6 @@
-# Installs the four libraries, their headers, the cadclash tool, a CMake package
-# (find_package(cadclash [COMPONENTS collide report tessellate import]) → cadclash::<component>) and cadclash.pc.
+# Installs the five libraries, their headers, the cadclash tool, a CMake package
+# (find_package(cadclash [COMPONENTS collide report tessellate import export]) → cadclash::<component>)
+# and cadclash.pc.
 #
 # Each library gets its own export file so that a consumer asking only for `collide` needs neither
 # OpenCASCADE nor assimp. The libraries are static by default: their PRIVATE dependencies are exported
@@ -35,6 +36,7 @@ cadclash_install_component(collide cadclash_collide cadclash_triangle_exact)
 cadclash_install_component(report cadclash_report)
 cadclash_install_component(tessellate cadclash_tessellate)
 cadclash_install_component(import cadclash_import)
+cadclash_install_component(export cadclash_export)
 
 if(TARGET cadclash)
   install(TARGETS cadclash RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT cadclash_runtime)
@@ -55,7 +57,7 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/cadclashConfigVersion.cma
 install(FILES ${PROJECT_BINARY_DIR}/cadclashConfig.cmake ${PROJECT_BINARY_DIR}/cadclashConfigVersion.cmake
   DESTINATION ${CADCLASH_INSTALL_CMAKEDIR} COMPONENT cadclash_development)
 
-# pkg-config: one cadclash.pc for all three libraries (static archives need every dependency on the
+# pkg-config: one cadclash.pc for all the libraries (static archives need every dependency on the
 # link line, so they go to Libs; a shared build moves them to Libs.private). Paths are relative to
 # the .pc file so `cmake --install --prefix` elsewhere still works.
 file(RELATIVE_PATH _pc_to_prefix "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace cadclash::cli {
@@ -191,112 +192,143 @@ void print_partial(const Model& m, const Report& r, std::ostream& os) {
   if (r.unexamined_pairs.size() > kShown) os << "  ... and " << r.unexamined_pairs.size() - kShown << " more\n";
 }
 
+// The --path trajectory's rows; std::nullopt, after saying why on stderr, when the file cannot be
+// read or has errors.
+std::optional<std::vector<TrajectoryRow>> read_trajectory(const std::string& csv) {
+  std::ifstream f(csv, std::ios::binary);
+  if (!f) {
+    std::cerr << csv << ": error: cannot open trajectory\n";
+    return std::nullopt;
+  }
+  std::stringstream text;
+  text << f.rdbuf();
+  std::vector<Diagnostic> ds;
+  std::vector<TrajectoryRow> rows = parse_trajectory(text.str(), csv, ds);
+  print_diagnostics(ds);
+  if (has_error(ds)) {
+    std::cerr << "cadclash check: the trajectory has errors; nothing checked\n";
+    return std::nullopt;
+  }
+  return rows;
+}
+
+// The instances --select-a/-b name and the sub-assemblies --exclude-under leaves out; std::nullopt,
+// after saying so on stderr, when a --select matches no instance.
+std::optional<SceneSelection> scene_selection(const Model& m, const CheckOptions& o) {
+  SceneSelection sel;
+  sel.set_a = select(m, o.select_a);
+  sel.set_b = select(m, o.select_b);
+  if ((!o.select_a.empty() && sel.set_a.empty()) || (!o.select_b.empty() && sel.set_b.empty())) {
+    std::cerr << "cadclash check: --select-a/--select-b match no instance path\n";
+    return std::nullopt;
+  }
+  sel.excluded_subassemblies = o.exclude_under;
+  return sel;
+}
+
+// What the query (or every step of the trajectory) found, beyond what went into the CheckReport.
+struct CheckOutcome {
+  bool collision = false;
+  std::string stopped_by;               // first budget that ran out; empty when every query finished
+  std::vector<Diagnostic> diagnostics;  // the queries' own
+  Report shown;                         // what --html shows: the query, or a trajectory's last step
+};
+
+// One query of the prepared scene (run --repeat times, the last kept): the table and summary on
+// stdout, the results into `report`.
+CheckOutcome check_once(const CheckOptions& o, const Model& m, Scene& scene, const CollideOptions& copt,
+                        CheckReport& report) {
+  CheckOutcome out;
+  Report r = scene.check(copt);
+  for (int k = 1; k < o.repeat; ++k) r = scene.check(copt);  // a prepared scene: BVHs already built
+  out.diagnostics = r.diagnostics;
+  ClassCounts n;
+  n.add(r);
+  out.collision = n.collision();
+  if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
+  if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
+  print_table(m, r, std::cout);
+  print_summary(r, !o.no_timings, std::cout);
+  if (o.fast) std::cout << "fast mode: classes from the triangles' deflection band, not certified on the exact faces\n";
+  print_partial(m, r, std::cout);
+  if (!r.complete) out.stopped_by = r.stopped_by;
+  report.query = query_report(m, r);
+  out.shown = std::move(r);
+  return out;
+}
+
+// The trajectory replayed on the prepared scene: one line per step on stdout, each step into `report`.
+CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, Scene& scene, const std::vector<TrajectoryRow>& rows,
+                              const CollideOptions& copt, CheckReport& report) {
+  CheckOutcome out;
+  std::vector<Diagnostic> ds;
+  std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
+  print_diagnostics(ds);
+  report.trajectory = o.path_csv;
+  for (const StepResult& s : steps) {
+    ClassCounts n;
+    n.add(s.report);
+    out.collision = out.collision || n.collision();
+    out.diagnostics.insert(out.diagnostics.end(), s.report.diagnostics.begin(), s.report.diagnostics.end());
+    std::cout << "step " << s.step << ": " << n.c[0] << " penetrating, " << n.c[1] << " touching, " << n.c[2]
+              << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided";
+    if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
+    if (!s.report.complete) {
+      std::cout << "  PARTIAL: stopped by the " << s.report.stopped_by << ", " << s.report.unexamined_pairs.size()
+                << " of " << s.report.counters.instance_pairs << " instance pairs not examined";
+      if (out.stopped_by.empty()) out.stopped_by = s.report.stopped_by;
+    }
+    std::cout << '\n';
+    report.steps.push_back({s.step, query_report(m, s.report)});
+  }
+  std::size_t distinct_steps = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
+  const std::size_t not_checked = distinct_steps - steps.size();
+  report.steps_not_checked = not_checked;
+  if (not_checked > 0) {
+    std::cout << "\nPARTIAL REPORT: stopped by the time budget: " << not_checked << " of " << distinct_steps
+              << " steps not checked\n";
+    if (out.stopped_by.empty()) out.stopped_by = "time budget";
+  }
+  report.stopped_by = out.stopped_by;
+  for (const Diagnostic& d : ds) report.diagnostics.push_back(format_diagnostic(d));
+  if (!steps.empty()) out.shown = std::move(steps.back().report);
+  return out;
+}
+
 int run_check(const CheckOptions& o) {
   if (!o.html.empty() && !html_report_available()) {
     std::cerr << "cadclash check: --html needs a build with the viewer (CMake option CADCLASH_HTML_VIEWER=ON)\n";
     return kExitUsage;
   }
   ImportResult imported = import_inputs(o.in);
-  bool input_error = has_error(imported.diagnostics);
   Model& m = imported.model;
   if (m.instances.empty()) {
     std::cerr << "cadclash check: no instances to check\n";
     return kExitInputError;
   }
-
   std::vector<TrajectoryRow> rows;
   if (!o.path_csv.empty()) {
-    std::ifstream f(o.path_csv, std::ios::binary);
-    if (!f) {
-      std::cerr << o.path_csv << ": error: cannot open trajectory\n";
-      return kExitInputError;
-    }
-    std::stringstream text;
-    text << f.rdbuf();
-    std::vector<Diagnostic> ds;
-    rows = parse_trajectory(text.str(), o.path_csv, ds);
-    print_diagnostics(ds);
-    if (has_error(ds)) {
-      std::cerr << "cadclash check: the trajectory has errors; nothing checked\n";
-      return kExitInputError;
-    }
+    std::optional<std::vector<TrajectoryRow>> read = read_trajectory(o.path_csv);
+    if (!read) return kExitInputError;
+    rows = std::move(*read);
   }
-
-  SceneSelection sel;
-  sel.set_a = select(m, o.select_a);
-  sel.set_b = select(m, o.select_b);
-  if ((!o.select_a.empty() && sel.set_a.empty()) || (!o.select_b.empty() && sel.set_b.empty())) {
-    std::cerr << "cadclash check: --select-a/--select-b match no instance path\n";
-    return kExitInputError;
-  }
-  sel.excluded_subassemblies = o.exclude_under;
+  const std::optional<SceneSelection> sel = scene_selection(m, o);
+  if (!sel) return kExitInputError;
   const CollideOptions copt = collide_options(o);
-  Scene scene(m, sel);
+  Scene scene(m, *sel);
 
   CheckReport report;
   report.files = o.in.files;
   report.settings = report_settings_of(o, copt);
-  bool collision = false;
-  std::string stopped_by;  // first budget that ran out; empty when every query finished
-  std::vector<Diagnostic> run_diags;
-  Report shown;  // what --html shows: the query, or a trajectory's last step
-  if (rows.empty()) {
-    Report r = scene.check(copt);
-    for (int k = 1; k < o.repeat; ++k) r = scene.check(copt);  // a prepared scene: BVHs already built
-    run_diags = r.diagnostics;
-    ClassCounts n;
-    n.add(r);
-    collision = n.collision();
-    if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
-    if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
-    print_table(m, r, std::cout);
-    print_summary(r, !o.no_timings, std::cout);
-    if (o.fast) std::cout << "fast mode: classes from the triangles' deflection band, not certified on the exact faces\n";
-    print_partial(m, r, std::cout);
-    if (!r.complete) stopped_by = r.stopped_by;
-    report.query = query_report(m, r);
-    shown = std::move(r);
-  } else {
-    std::vector<Diagnostic> ds;
-    std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
-    print_diagnostics(ds);
-    report.trajectory = o.path_csv;
-    for (const StepResult& s : steps) {
-      ClassCounts n;
-      n.add(s.report);
-      collision = collision || n.collision();
-      run_diags.insert(run_diags.end(), s.report.diagnostics.begin(), s.report.diagnostics.end());
-      std::cout << "step " << s.step << ": " << n.c[0] << " penetrating, " << n.c[1] << " touching, " << n.c[2]
-                << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided";
-      if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
-      if (!s.report.complete) {
-        std::cout << "  PARTIAL: stopped by the " << s.report.stopped_by << ", " << s.report.unexamined_pairs.size()
-                  << " of " << s.report.counters.instance_pairs << " instance pairs not examined";
-        if (stopped_by.empty()) stopped_by = s.report.stopped_by;
-      }
-      std::cout << '\n';
-      report.steps.push_back({s.step, query_report(m, s.report)});
-    }
-    std::size_t distinct_steps = 0;
-    for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
-    const std::size_t not_checked = distinct_steps - steps.size();
-    report.steps_not_checked = not_checked;
-    if (not_checked > 0) {
-      std::cout << "\nPARTIAL REPORT: stopped by the time budget: " << not_checked << " of " << distinct_steps
-                << " steps not checked\n";
-      if (stopped_by.empty()) stopped_by = "time budget";
-    }
-    report.stopped_by = stopped_by;
-    for (const Diagnostic& d : ds) report.diagnostics.push_back(format_diagnostic(d));
-    if (!steps.empty()) shown = std::move(steps.back().report);
-  }
-  print_diagnostics(run_diags);
-  input_error = input_error || has_error(run_diags);
+  CheckOutcome run = rows.empty() ? check_once(o, m, scene, copt, report) : check_trajectory(o, m, scene, rows, copt, report);
+  print_diagnostics(run.diagnostics);
+  const bool input_error = has_error(imported.diagnostics) || has_error(run.diagnostics);
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
-  for (const Diagnostic& d : run_diags) report.diagnostics.push_back(format_diagnostic(d));
-  report.complete = imported.complete && !has_error(run_diags) && stopped_by.empty();
-  if (!stopped_by.empty())
-    std::cerr << "cadclash check: warning: partial report: the " << stopped_by << " ran out before every pair was examined\n";
+  for (const Diagnostic& d : run.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
+  report.complete = imported.complete && !has_error(run.diagnostics) && run.stopped_by.empty();
+  if (!run.stopped_by.empty())
+    std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
   const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
   if (!o.json.empty()) {
@@ -307,11 +339,11 @@ int run_check(const CheckOptions& o) {
       return kExitInputError;
     }
   }
-  if (!o.html.empty() && !save_html_report(o.html, m, scene, shown, j))
+  if (!o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
     return kExitInputError;
   if (input_error) return kExitInputError;
-  if (o.fail_on_collision && collision) return kExitCollision;  // a definite finding, partial report or not
-  return stopped_by.empty() ? kExitOk : kExitBudget;
+  if (o.fail_on_collision && run.collision) return kExitCollision;  // a definite finding, partial report or not
+  return run.stopped_by.empty() ? kExitOk : kExitBudget;
 }
 
 }  // namespace

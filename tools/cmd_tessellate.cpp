@@ -1,6 +1,8 @@
 // cadclash tessellate: write the surface-tagged model to OBJ or glTF binary.
 #include "cli_common.h"
 
+#include "cadclash/export.h"
+
 #include <iostream>
 #include <memory>
 #include <numeric>

@@ -8,6 +8,8 @@
 
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 
 #include <functional>
 #include <optional>
@@ -52,6 +54,33 @@ void record_occt_failure(Transfer& t, const std::string& path, const std::string
 
 // A new XCAF document that pack_transfer can store. Throws Standard_Failure if OCCT cannot make one.
 Handle(TDocStd_Document) new_xcaf_document();
+
+// The products of a file `reader` has read, transferred into a new XCAF document `t.doc`: the step
+// the STEP and IGES readers share. Every fail of OCCT's transfer check list (session `ws`) becomes an
+// error naming its entity by `label`, as "<format> transfer" (and t.complete = false). Returns the
+// transfer process, which tags the faces with their entities (map_face_entities); std::nullopt when
+// the transfer failed, with an error saying so and no shapes left in `t`. Throws what OCCT throws.
+// CafReader: STEPCAFControl_Reader or IGESCAFControl_Reader.
+template <class CafReader>
+std::optional<Handle(Transfer_TransientProcess)> transfer_document(CafReader& reader, const Handle(XSControl_WorkSession)& ws,
+                                                                   const Handle(Interface_InterfaceModel)& model,
+                                                                   const EntityLabelFn& label, const std::string& path,
+                                                                   const std::string& format, Transfer& t) {
+  t.doc = new_xcaf_document();
+  const bool transferred = reader.Transfer(t.doc) == Standard_True;
+  const Handle(Transfer_TransientProcess) process =
+      ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
+  if (!process.IsNull() &&
+      append_checks(process->CheckList(Standard_True), model, label, path, format + " transfer", false, t.diagnostics) > 0)
+    t.complete = false;
+  if (!transferred) {
+    t.diagnostics.push_back({Severity::Error, path, 0, -1, format + " transfer failed; no shape could be made"});
+    t.complete = false;
+    t.discard_shapes();
+    return std::nullopt;
+  }
+  return process;
+}
 
 // The transfer as bytes (OCCT's binary XCAF document or shape format, plus our tags and diagnostics).
 std::string pack_transfer(const Transfer& t);

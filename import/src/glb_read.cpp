@@ -1,9 +1,13 @@
-// Reading back a .glb that cadclash wrote: the exact parts, surfaces, names, ids, instances, poses.
+// Reading back a .glb that cadclash wrote (layout in cadclash/glb_layout.h): the exact parts, surfaces,
+// names, ids, instances, poses.
 // The file is untrusted: every index, offset and length is checked before use.
 #include "mesh_common.h"
-#include "mesh_export.h"
-#include "mesh_glb.h"
 #include "readers.h"
+
+#include "cadclash/glb_layout.h"
+#include "cadclash/report.h"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstring>
@@ -11,6 +15,12 @@
 
 namespace cadclash::detail {
 namespace {
+
+// The two chunks of a GLB file, as views into its bytes.
+struct GlbChunks {
+  std::string_view json;
+  std::string_view bin;  // empty when the file has no BIN chunk
+};
 
 std::uint32_t get_u32(std::string_view bytes, std::size_t at) {
   std::uint32_t v = 0;
@@ -65,19 +75,8 @@ std::vector<T> read_accessor(const nlohmann::json& doc, std::string_view bin, st
   return out;
 }
 
-bool load_glb_json(const std::string& path, std::string& bytes, GlbChunks& chunks, nlohmann::json& doc, std::string& error) {
-  if (!read_whole_file(path, bytes, error)) return false;
-  if (!split_glb(bytes, chunks, error)) return false;
-  doc = nlohmann::json::parse(chunks.json, nullptr, false);
-  if (doc.is_discarded() || !doc.is_object()) {
-    error = "the JSON chunk is not a JSON object";
-    return false;
-  }
-  return true;
-}
-
-}  // namespace
-
+// Splits a GLB file into its chunks, checking the header and every length. Returns false with a
+// one-sentence `error` when the bytes are not a well-formed GLB.
 bool split_glb(std::string_view bytes, GlbChunks& chunks, std::string& error) {
   if (bytes.size() < 20 || get_u32(bytes, 0) != kGlbMagic) {
     error = "not a binary glTF file (no 'glTF' magic)";
@@ -111,6 +110,26 @@ bool split_glb(std::string_view bytes, GlbChunks& chunks, std::string& error) {
   }
   return true;
 }
+
+// A surface's name and provenance back from a primitive's extras (cadclash::report's
+// provenance_from_json); throws, as the other checks of read_cadclash_glb do, on a bad value.
+void surface_provenance_from_json(const nlohmann::json& j, Surface& s) {
+  if (const std::optional<ReportError> e = provenance_from_json(j, s))
+    throw nlohmann::json::other_error::create(501, "surface provenance " + format_report_error(*e), &j);
+}
+
+bool load_glb_json(const std::string& path, std::string& bytes, GlbChunks& chunks, nlohmann::json& doc, std::string& error) {
+  if (!read_whole_file(path, bytes, error)) return false;
+  if (!split_glb(bytes, chunks, error)) return false;
+  doc = nlohmann::json::parse(chunks.json, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object()) {
+    error = "the JSON chunk is not a JSON object";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
 
 bool is_cadclash_glb(const std::string& path) {
   // Only the first 20 bytes and the start of the JSON chunk are needed: our writer puts "asset"

@@ -101,20 +101,8 @@ Transfer read_iges_transfer(const std::string& path, bool one_by_one, const std:
       transfer_roots_one_by_one(reader, label, path, skip, mark, result);
       return result;
     }
-    result.doc = new_xcaf_document();
-    const bool transferred = reader.Transfer(result.doc) == Standard_True;
-    const Handle(Transfer_TransientProcess) process =
-        ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
-    if (!process.IsNull() &&
-        append_checks(process->CheckList(Standard_True), model, label, path, "IGES transfer", false, result.diagnostics) > 0)
-      result.complete = false;
-    if (!transferred) {
-      result.diagnostics.push_back({Severity::Error, path, 0, -1, "IGES transfer failed; no shape could be made"});
-      result.complete = false;
-      result.discard_shapes();
-    } else {
-      result.faces = map_face_entities(process, describe_iges_face(label));
-    }
+    if (const auto process = transfer_document(reader, ws, model, label, path, "IGES", result))
+      result.faces = map_face_entities(*process, describe_iges_face(label));
   } catch (const Standard_Failure& e) {
     record_occt_failure(result, path, "IGES", e);
   }

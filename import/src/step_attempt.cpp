@@ -17,10 +17,10 @@
 #include <TopExp_Explorer.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
-#include <XSControl_TransferReader.hxx>
 #include <XSControl_WorkSession.hxx>
 
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -105,22 +105,12 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
   cut_deep_mapped_items(model, label, path, result);
   report_assembly_cycles(model, label, path, result);
 
-  result.doc = new_xcaf_document();
-  const bool transferred = reader.Transfer(result.doc) == Standard_True;
-  const Handle(Transfer_TransientProcess) process =
-      ws.IsNull() || ws->TransferReader().IsNull() ? Handle(Transfer_TransientProcess)() : ws->TransferReader()->TransientProcess();
-  if (!process.IsNull() &&
-      append_checks(process->CheckList(Standard_True), model, label, path, "STEP transfer", false, result.diagnostics) > 0)
-    result.complete = false;
+  const std::optional<Handle(Transfer_TransientProcess)> process =
+      transfer_document(reader, ws, model, label, path, "STEP", result);
   run.mark(kTransferred);
-  if (!transferred) {
-    result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP transfer failed; no shape could be made"});
-    result.complete = false;
-    result.discard_shapes();
-    return;
-  }
+  if (!process) return;
   if (has_faces(result.doc)) run.mark(kShapes);
-  result.faces = map_face_entities(process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
+  result.faces = map_face_entities(*process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
     if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
     out.id = label(entity);
     const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);

@@ -18,11 +18,11 @@ expect() {  # expect <output file> <fixed string>
 
 cmake --install "$build" --prefix "$prefix" > "$work/install.log"
 for f in include/cadclash/collide.h include/cadclash/report.h include/cadclash/tessellate.h include/cadclash/import.h \
-         lib/cmake/cadclash/cadclashConfig.cmake lib/pkgconfig/cadclash.pc; do
+         include/cadclash/export.h include/cadclash/glb_layout.h lib/cmake/cadclash/cadclashConfig.cmake lib/pkgconfig/cadclash.pc; do
   [[ -f $prefix/$f ]] || fail "not installed: $f"
 done
 ls "$prefix"/lib/libcadclash_collide.* "$prefix"/lib/libcadclash_report.* "$prefix"/lib/libcadclash_tessellate.* \
-   "$prefix"/lib/libcadclash_import.* > /dev/null || fail "libraries not installed"
+   "$prefix"/lib/libcadclash_import.* "$prefix"/lib/libcadclash_export.* > /dev/null || fail "libraries not installed"
 [[ -x $prefix/bin/cadclash ]] || fail "cadclash tool not installed"
 
 # Only the scratch prefix may provide cadclash: no fallback to the build tree's package registry.

@@ -1,5 +1,6 @@
-// cadclash/import.h — reading files into a surface-tagged Model, and writing one back out.
-// The one public header of cadclash::import.
+// cadclash/import.h — reading files into a surface-tagged Model.
+// The one public header of cadclash::import. Writing a Model out (OBJ, .glb) is cadclash::export's
+// (cadclash/export.h); this reads what it writes back exactly.
 //
 // Formats, chosen by file extension (case-insensitive):
 //   .stp .step (AP203/AP214/AP242), .igs .iges, .brep   B-rep assemblies through OCCT XCAF; one surface per face
@@ -87,18 +88,5 @@ ImportResult import_file(const std::string& path, const ImportOptions& options =
 // Reads several files into one scene. When more than one file is given, each file's instance paths
 // are prefixed with "/<file name>" so they stay unique.
 ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options = {});
-
-// Writes `model` to `path`: .obj (one `g` per surface) or .glb (glTF 2.0 binary, one primitive per
-// surface, instances as nodes, provenance in `extras`). Surfaces without triangles are written
-// empty-free: they are skipped and listed. Returns diagnostics; an error means nothing usable was written.
-// - .obj: every instance's copy of every surface, placed in world coordinates, as
-//   `g <instance path>/<surface name>` (whitespace and '#' become '_') preceded by a comment
-//   `# cadclash-surface {json}` with the exact name, part, surface id and provenance. Coordinates are
-//   written to read back bit-exact. Reading it back gives one surface per group, in the same order.
-// - .glb: one mesh per part, one primitive per surface (part-local float32 POSITION with min/max,
-//   uint32 indices), one node per instance (name = path, column-major matrix). Provenance is in
-//   each primitive's extras.cadclash, with a float64 copy of the positions, so importing our .glb
-//   gives back exactly the same parts, surfaces, names, ids, vertices, instances and poses.
-std::vector<Diagnostic> export_model(const Model& model, const std::string& path);
 
 }  // namespace cadclash

@@ -1,6 +1,7 @@
 // Export to OBJ and .glb, import again: the same surfaces, names, ids, instances and poses.
+#include "cadclash/export.h"
 #include "readers.h"
-#include "test_mesh_util.h"
+#include "../import/test_mesh_util.h"
 
 #include <gtest/gtest.h>
 #include "../test_temp.h"

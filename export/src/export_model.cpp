@@ -1,5 +1,5 @@
 // export_model(): choose the writer by extension.
-#include "mesh_export.h"
+#include "writers.h"
 
 #include <algorithm>
 #include <cctype>

@@ -5,7 +5,9 @@
 // whitespace becomes '_', as a group name is one word), and the comment line before it,
 // "# cadclash-surface {json}", gives the exact names, ids and provenance. Coordinates are written in
 // the shortest form that reads back to the same double, so a re-import is exact.
-#include "mesh_export.h"
+#include "writers.h"
+
+#include "cadclash/report.h"
 
 #include <charconv>
 #include <fstream>
@@ -47,7 +49,7 @@ std::vector<Diagnostic> write_obj(const Model& model, const std::string& path) {
         skipped[sid] = true;
         continue;
       }
-      nlohmann::json j = surface_provenance_json(s);
+      nlohmann::json j = provenance_json(s);
       j["instance"] = instance.path;
       j["instance_id"] = iid;
       j["part"] = part.name;
