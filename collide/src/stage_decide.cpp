@@ -55,122 +55,144 @@ void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending,
   }
 }
 
-}  // namespace
+// One decision run: its inputs, and each pair's state between the steps.
+struct Run {
+  const Model& model;
+  std::span<const Pose> poses;
+  std::span<const double> eps;
+  std::span<const SurfaceBvh> bvh;
+  std::span<const DecideTask> tasks;
+  std::vector<RefinedSurface>& refined;
+  OutlineCache& outlines;
+  const CollideOptions& o;
+  int threads;
+  const Deadline& deadline;
+  std::vector<Pending> pending = std::vector<Pending>(tasks.size());
+  std::vector<CollideCounters> task_counters = std::vector<CollideCounters>(tasks.size());
 
-std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
-                                       std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                                       std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
-                                       const CollideOptions& o, int threads, const Deadline& deadline,
-                                       CollideCounters& counters) {
-  std::vector<DecideResult> results(tasks.size());
-  if (o.decision == DecisionMode::Fast) {
-    for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
-    return results;
+  bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
+  FaceView view(SurfaceId f) const {
+    const Outline& outline = outlines.outline[f];
+    return FaceView{model.surfaces[f], bvh[f], outline.empty() ? nullptr : &outline};
   }
-  const bool certified = o.decision == DecisionMode::Certified;
-  const auto n = static_cast<std::ptrdiff_t>(tasks.size());
-  std::vector<Pending> pending(tasks.size());
-  std::vector<CollideCounters> task_counters(tasks.size());
-  auto meshed = [&](std::size_t k) { return tasks[k].outcome != nullptr; };
-  // Made for the surfaces of the open pairs (step 2b) unless the Scene has them from an earlier query.
-  std::vector<Outline>& outlines = outline_cache.outline;
-  outlines.resize(model.surfaces.size());
-  outline_cache.ready.resize(model.surfaces.size(), 0);
-  auto finer = [&](SurfaceId f) { return finer_view(model, bvh, refined, f); };
-  auto view = [&](SurfaceId f) { return FaceView{model.surfaces[f], bvh[f], outlines[f].empty() ? nullptr : &outlines[f]}; };
-  // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
-#pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    pending[ku] = from_mesh(model, eps, tasks[ku], o);
-    if (!pending[ku].settled && certified && meshed(ku)) analytic(model, eps, tasks[ku], pending[ku], o);
-  }
-  for (const Pending& p : pending) counters.ambiguous_pairs += !p.settled;
+  FaceView finer(SurfaceId f) const { return finer_view(model, bvh, refined, f); }
+  // The open pairs that satisfy `keep`.
+  template <class Keep>
+  std::vector<std::size_t> open(Keep keep) const { return select(pending, keep); }
+  template <class Step>
+  void step(const std::vector<std::size_t>& ks, Step s) { run_step(ks, pending, threads, deadline, s); }
+};
 
-  if (certified) {
-    // Step 2b: analytic contact witnesses, on the outlines of the open pairs' surfaces.
-    const std::vector<std::size_t> open = select(pending, meshed);
-    std::vector<SurfaceId> faces = faces_of(tasks, open);
-    std::erase_if(faces, [&](SurfaceId f) { return outline_cache.ready[f] != 0; });
-    const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (nfaces >= 8)
-    for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
-      const SurfaceId f = faces[static_cast<std::size_t>(i)];
-      outlines[f] = make_outline(model.surfaces[f].mesh);
-    }
-    for (SurfaceId f : faces) outline_cache.ready[f] = 1;
-    run_step(open, pending, threads, deadline,
-             [&](std::size_t k) { analytic_contact(eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o); });
-    // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
-    // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
-    // cross by round-off only, and the vertex witnesses prove those.
-    run_step(select(pending, [&](std::size_t k) {
-               return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->penetration > pending[k].threshold;
-             }), pending,
-             threads, deadline, [&](std::size_t k) {
-               crossing_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
-             });
-    // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
-    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
-      tangent_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
-    });
-    // Step 3: witness vertices near the other face (a few exact point queries each).
-    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
-      witness_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), tasks[k].outcome, pending[k].band,
-                   pending[k], o, task_counters[k]);
-    });
-    // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
-    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
-      edge_witness_step(model, poses, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
-    });
-    // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
-    run_step(select(pending, meshed), pending, threads, deadline, [&](std::size_t k) {
-      edge_support_step(model, eps, tasks[k], view(tasks[k].sa), view(tasks[k].sb), pending[k], o, task_counters[k]);
-    });
-    // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see
-    // (apart), not a contact within T (far below any band): crossing or touching triangles go on.
-    const std::vector<std::size_t> gaps = select(pending, [&](std::size_t k) {
-      if (!meshed(k) || !refinement_can_separate(model, tasks[k], pending[k])) return false;
-      const std::vector<SurfaceId> which = faces_to_refine(model, tasks[k]);
-      return std::any_of(which.begin(), which.end(), [&](SurfaceId s) { return can_refine(model, s); });
-    });
-    if (!gaps.empty() && !deadline.expired())
-      counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, gaps), refined, threads);
-    run_step(gaps, pending, threads, deadline, [&](std::size_t k) {
-      refined_step(eps, tasks[k], finer(tasks[k].sa), finer(tasks[k].sb), pending[k], o, task_counters[k]);
-    });
+// The outlines of the listed pairs' surfaces the Scene does not have yet.
+void make_outlines(Run& run, const std::vector<std::size_t>& ks) {
+  std::vector<SurfaceId> faces = faces_of(run.tasks, ks);
+  std::erase_if(faces, [&](SurfaceId f) { return run.outlines.ready[f] != 0; });
+  const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
+#pragma omp parallel for num_threads(run.threads) schedule(dynamic, 4) if (nfaces >= 8)
+  for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
+    const SurfaceId f = faces[static_cast<std::size_t>(i)];
+    run.outlines.outline[f] = make_outline(run.model.surfaces[f].mesh);
   }
+  for (SurfaceId f : faces) run.outlines.ready[f] = 1;
+}
 
-  // Step 5: the exact faces, for what is still open.
-  run_step(select(pending, [](std::size_t) { return true; }), pending, threads, deadline, [&](std::size_t k) {
-    Pending& p = pending[k];
-    if (exact_step(model, poses, tasks[k], p, o, task_counters[k]) || !meshed(k)) return;
+// Steps 2b to 3c: witnesses of contact, each a few point queries (certified mode).
+void witness_steps(Run& run) {
+  const auto& tasks = run.tasks;
+  auto meshed = [&](std::size_t k) { return run.meshed(k); };
+  // Step 2b: analytic contact witnesses, on the outlines of the open pairs' surfaces.
+  const std::vector<std::size_t> open = run.open(meshed);
+  make_outlines(run, open);
+  run.step(open, [&](std::size_t k) {
+    analytic_contact(run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k], run.o);
+  });
+  // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
+  // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
+  // cross by round-off only, and the vertex witnesses prove those.
+  run.step(run.open([&](std::size_t k) {
+             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->penetration > run.pending[k].threshold;
+           }),
+           [&](std::size_t k) {
+             crossing_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
+                           run.o, run.task_counters[k]);
+           });
+  // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
+  run.step(run.open(meshed), [&](std::size_t k) {
+    tangent_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k], run.o,
+                 run.task_counters[k]);
+  });
+  // Step 3: witness vertices near the other face (a few exact point queries each).
+  run.step(run.open(meshed), [&](std::size_t k) {
+    witness_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), tasks[k].outcome,
+                 run.pending[k].band, run.pending[k], run.o, run.task_counters[k]);
+  });
+  // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
+  run.step(run.open(meshed), [&](std::size_t k) {
+    edge_witness_step(run.model, run.poses, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
+                      run.o, run.task_counters[k]);
+  });
+  // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
+  run.step(run.open(meshed), [&](std::size_t k) {
+    edge_support_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
+                      run.o, run.task_counters[k]);
+  });
+}
+
+// Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see (apart),
+// not a contact within T (far below any band): crossing or touching triangles go on.
+void refinement_step(Run& run, CollideCounters& counters) {
+  const Model& model = run.model;
+  const std::vector<std::size_t> gaps = run.open([&](std::size_t k) {
+    if (!run.meshed(k) || !refinement_can_separate(model, run.tasks[k], run.pending[k])) return false;
+    const std::vector<SurfaceId> which = faces_to_refine(model, run.tasks[k]);
+    return std::any_of(which.begin(), which.end(), [&](SurfaceId s) { return can_refine(model, s); });
+  });
+  if (!gaps.empty() && !run.deadline.expired())
+    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, run.tasks, gaps), run.refined, run.threads);
+  run.step(gaps, [&](std::size_t k) {
+    refined_step(run.eps, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k], run.o,
+                 run.task_counters[k]);
+  });
+}
+
+// Steps 5 and 6: the exact faces for what is still open, and exact values above T corroborated (or
+// contradicted) by finer triangles.
+void exact_steps(Run& run, CollideCounters& counters) {
+  const Model& model = run.model;
+  const auto& tasks = run.tasks;
+  run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
+    Pending& p = run.pending[k];
+    if (exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]) || !run.meshed(k)) return;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
     const bool exact = triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb);
-    settle(p, verdict(p.d, p.threshold), exact ? DecidedBy::MeshExact : DecidedBy::Mesh, tasks[k].outcome, o.clearance);
+    settle(p, verdict(p.d, p.threshold), exact ? DecidedBy::MeshExact : DecidedBy::Mesh, tasks[k].outcome,
+           run.o.clearance);
   });
-
-  // Step 6: exact values above T, corroborated (or contradicted) by finer triangles.
   const std::vector<std::size_t> check =
-      select(pending, [&](std::size_t k) { return pending[k].needs_lower && meshed(k); });
-  if (!check.empty() && !deadline.expired())
-    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, check), refined, threads);
-  run_step(check, pending, threads, deadline, [&](std::size_t k) {
-    corroborate(model, eps, tasks[k], finer(tasks[k].sa), finer(tasks[k].sb), pending[k], o, task_counters[k]);
+      run.open([&](std::size_t k) { return run.pending[k].needs_lower && run.meshed(k); });
+  if (!check.empty() && !run.deadline.expired())
+    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, check), run.refined, run.threads);
+  run.step(check, [&](std::size_t k) {
+    corroborate(model, run.eps, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
+                run.task_counters[k]);
   });
+}
 
-  for (std::size_t k = 0; k < tasks.size(); ++k) {
-    const DecideTask& t = tasks[k];
-    Pending& p = pending[k];
-    counters.exact_queries += task_counters[k].exact_queries;
-    counters.witness_queries += task_counters[k].witness_queries;
-    counters.distance_tests += task_counters[k].distance_tests;
+// Each pair's answer from its final state, in task order, with the counters.
+std::vector<DecideResult> collect(Run& run, CollideCounters& counters) {
+  std::vector<DecideResult> results(run.tasks.size());
+  for (std::size_t k = 0; k < run.tasks.size(); ++k) {
+    const DecideTask& t = run.tasks[k];
+    Pending& p = run.pending[k];
+    counters.exact_queries += run.task_counters[k].exact_queries;
+    counters.witness_queries += run.task_counters[k].witness_queries;
+    counters.distance_tests += run.task_counters[k].distance_tests;
     if (p.cut) {
       results[k].cut = true;
       continue;
     }
     if (!p.settled) {  // nothing could decide it: say so, with what is known
-      if (!(p.d.lo <= std::max(p.threshold, o.clearance))) continue;
+      if (!(p.d.lo <= std::max(p.threshold, run.o.clearance))) continue;
       p.cls = ContactClass::Undecided;
       p.by = DecidedBy::Undecided;
     }
@@ -178,7 +200,8 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
       // Counted (with what proved it) when the triangles' band alone, fast mode, would have called it
       // in contact; the many pairs every mode leaves out are not.
       if (t.outcome != nullptr) {
-        if (classify(*t.outcome, band_threshold(model.surfaces[t.sa], model.surfaces[t.sb], o.tolerance), 0.0)) {
+        const double band = band_threshold(run.model.surfaces[t.sa], run.model.surfaces[t.sb], run.o.tolerance);
+        if (classify(*t.outcome, band, 0.0)) {
           ++counters.dismissed_pairs;
           count(counters, p.by);
         }
@@ -195,6 +218,40 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     results[k].result = std::move(r);
   }
   return results;
+}
+
+}  // namespace
+
+std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+                                       std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
+                                       std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
+                                       const CollideOptions& o, int threads, const Deadline& deadline,
+                                       CollideCounters& counters) {
+  if (o.decision == DecisionMode::Fast) {
+    std::vector<DecideResult> results(tasks.size());
+    for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
+    return results;
+  }
+  const bool certified = o.decision == DecisionMode::Certified;
+  // Outlines are made for the surfaces of the open pairs (step 2b) unless the Scene has them already.
+  outline_cache.outline.resize(model.surfaces.size());
+  outline_cache.ready.resize(model.surfaces.size(), 0);
+  Run run{model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline};
+  // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
+  const auto n = static_cast<std::ptrdiff_t>(tasks.size());
+#pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    run.pending[ku] = from_mesh(model, eps, tasks[ku], o);
+    if (!run.pending[ku].settled && certified && run.meshed(ku)) analytic(model, eps, tasks[ku], run.pending[ku], o);
+  }
+  for (const Pending& p : run.pending) counters.ambiguous_pairs += !p.settled;
+  if (certified) {
+    witness_steps(run);
+    refinement_step(run, counters);
+  }
+  exact_steps(run, counters);
+  return collect(run, counters);
 }
 
 }  // namespace cadclash::detail
