@@ -80,6 +80,81 @@ void store_plane_pcurves(const std::vector<TopoDS_Face>& faces) {
   }
 }
 
+// Healing: only faces BRepCheck rejects are touched, one at a time, so face indices and the file's
+// entity ids stay attached to the same faces. Per face: 1 when it was healed.
+std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& impl, std::vector<Diagnostic>& diagnostics) {
+  const std::size_t n = impl.faces.size();
+  std::vector<char> healed(n, 0);
+  bool whole_valid = false;
+  try {
+    whole_valid = BRepCheck_Analyzer(*in.shape, Standard_True).IsValid() == Standard_True;
+  } catch (const Standard_Failure&) {
+  }
+  if (whole_valid) return healed;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (face_is_valid(impl.faces[i])) continue;
+    healed[i] = heal_face(impl.faces[i]) ? 1 : 0;
+    const bool fixed = healed[i] != 0 && face_is_valid(impl.faces[i]);
+    diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl.entity_ids[i],
+                                     heal_message(in.name, i, healed[i] != 0, fixed)});
+  }
+  return healed;
+}
+
+// The triangles of every face of the part at `deflection` (eager import): faces left without them
+// are listed as errors and make the import incomplete.
+void mesh_faces(const BrepPartInput& in, BrepSource::Impl& impl, double deflection, const TessellationOptions& options,
+                const detail::MeshDeadline& deadline, std::vector<Surface>& surfaces, std::vector<Diagnostic>& diagnostics,
+                bool& complete) {
+  const std::size_t n = impl.faces.size();
+  // One BRepMesh call over all faces of the part: shared edges are discretised once and BRepMesh
+  // spreads the faces over threads.
+  TopoDS_Compound compound;
+  BRep_Builder builder;
+  builder.MakeCompound(compound);
+  for (const TopoDS_Face& f : impl.faces) builder.Add(compound, f);
+  std::string why;
+  const bool meshed =
+      detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why, deadline);
+  (void)meshed;  // faces left without triangles are retried one by one below
+
+  std::vector<char> good(n, 0);
+#pragma omp parallel for schedule(dynamic, 4) if (options.parallel && n > 8)
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    double achieved = 0.0;
+    if (detail::read_face_triangles(impl.faces[i], options.verify_deflection, surfaces[i].mesh, achieved)) {
+      surfaces[i].deflection = achieved;
+      // A near miss is re-meshed finer below; a face whose measured error is far above the request
+      // (large trimmed NURBS faces, where a finer BRepMesh costs minutes) keeps its honest figure.
+      good[i] = !options.verify_deflection || achieved <= deflection || achieved > kNearMiss * deflection ? 1 : 0;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (good[i] == 0) {
+      double achieved = 0.0;
+      std::string face_why;
+      if (detail::mesh_face_to(impl.faces[i], deflection, options.angular_deflection, options.verify_deflection,
+                               surfaces[i].mesh, achieved, face_why, deadline)) {
+        surfaces[i].deflection = achieved;
+        good[i] = 1;
+      } else {
+        surfaces[i].mesh = {};
+        diagnostics.push_back(Diagnostic{Severity::Error, in.source_file, 0, impl.entity_ids[i],
+                                         failure_message(impl, i, face_why.empty() ? why : face_why)});
+        complete = false;
+      }
+    }
+    if (good[i] != 0) {
+      // A plane bounded by lines: its triangles are the face; what BRepMesh or the centroid
+      // measure reports is rounding.
+      if (surfaces[i].exact_triangles) surfaces[i].deflection = 0.0;
+      surfaces[i].has_triangles = true;
+      surfaces[i].aabb.extend(mesh_aabb(surfaces[i].mesh));
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
@@ -105,23 +180,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     impl->entity_ids.resize(n, -1);
     for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl->entity_ids[i] = in.tags[i].entity_id;
 
-    // Healing: only faces BRepCheck rejects are touched, one at a time, so face indices and the
-    // file's entity ids stay attached to the same faces.
-    std::vector<char> healed(n, 0);
-    bool whole_valid = false;
-    try {
-      whole_valid = BRepCheck_Analyzer(*in.shape, Standard_True).IsValid() == Standard_True;
-    } catch (const Standard_Failure&) {
-    }
-    if (!whole_valid) {
-      for (std::size_t i = 0; i < n; ++i) {
-        if (face_is_valid(impl->faces[i])) continue;
-        healed[i] = heal_face(impl->faces[i]) ? 1 : 0;
-        const bool fixed = healed[i] != 0 && face_is_valid(impl->faces[i]);
-        diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl->entity_ids[i],
-                                         heal_message(in.name, i, healed[i] != 0, fixed)});
-      }
-    }
+    const std::vector<char> healed = heal_invalid_faces(in, *impl, diagnostics);
 
     store_plane_pcurves(impl->faces);
 
@@ -166,54 +225,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     impl->exact_faces.resize(n);
     for (std::size_t i = 0; i < n; ++i) impl->exact_faces[i] = surfaces[i].exact_triangles ? 1 : 0;
 
-    if (!lazy && n > 0) {
-      // One BRepMesh call over all faces of the part: shared edges are discretised once and BRepMesh
-      // spreads the faces over threads.
-      TopoDS_Compound compound;
-      BRep_Builder builder;
-      builder.MakeCompound(compound);
-      for (const TopoDS_Face& f : impl->faces) builder.Add(compound, f);
-      std::string why;
-      const bool meshed =
-          detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why, deadline);
-      (void)meshed;  // faces left without triangles are retried one by one below
-
-      std::vector<char> good(n, 0);
-#pragma omp parallel for schedule(dynamic, 4) if (options.parallel && n > 8)
-      for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        double achieved = 0.0;
-        if (detail::read_face_triangles(impl->faces[i], options.verify_deflection, surfaces[i].mesh, achieved)) {
-          surfaces[i].deflection = achieved;
-          // A near miss is re-meshed finer below; a face whose measured error is far above the request
-          // (large trimmed NURBS faces, where a finer BRepMesh costs minutes) keeps its honest figure.
-          good[i] = !options.verify_deflection || achieved <= deflection || achieved > kNearMiss * deflection ? 1 : 0;
-        }
-      }
-      for (std::size_t i = 0; i < n; ++i) {
-        if (good[i] == 0) {
-          double achieved = 0.0;
-          std::string face_why;
-          if (detail::mesh_face_to(impl->faces[i], deflection, options.angular_deflection, options.verify_deflection,
-                                   surfaces[i].mesh, achieved, face_why, deadline)) {
-            surfaces[i].deflection = achieved;
-            good[i] = 1;
-          } else {
-            surfaces[i].mesh = {};
-            diagnostics.push_back(Diagnostic{Severity::Error, in.source_file, 0, impl->entity_ids[i],
-                                             failure_message(*impl, i, face_why.empty() ? why : face_why)});
-            complete = false;
-          }
-        }
-        if (good[i] != 0) {
-          // A plane bounded by lines: its triangles are the face; what BRepMesh or the centroid
-          // measure reports is rounding.
-          if (surfaces[i].exact_triangles) surfaces[i].deflection = 0.0;
-          surfaces[i].has_triangles = true;
-          surfaces[i].aabb.extend(mesh_aabb(surfaces[i].mesh));
-        }
-      }
-    }
+    if (!lazy && n > 0) mesh_faces(in, *impl, deflection, options, deadline, surfaces, diagnostics, complete);
 
     part.source = std::make_shared<BrepSource>(std::move(impl));
     model.parts.push_back(std::move(part));

@@ -29,15 +29,14 @@ void add_counts(SurfaceRepairStats& into, const SurfaceRepairStats& s) {
   into.changed = into.changed || s.changed;
 }
 
-// Repairs one mesh part; appends one stats entry per surface with triangles.
-void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, MeshRepairReport& report) {
-  const Part& part = model.parts[pid];
+// The part's surfaces as one soup for CGAL, each triangle tagged with its surface (local index), the
+// points merged across surfaces; what is dropped on the way (unused, merged, degenerate, collinear,
+// duplicate) is counted in `stats` (one entry per surface, sized by the caller).
+detail::TaggedSoup gather_soup(const Model& model, const Part& part, std::vector<SurfaceRepairStats>& stats) {
   const std::uint32_t n_tags = part.surface_count;
-  std::vector<SurfaceRepairStats> stats(n_tags);
   detail::TaggedSoup soup;
   detail::PointMerger part_points;
   std::unordered_set<detail::TriKey, detail::TriKeyHash> seen_triangles;
-
   for (std::uint32_t local = 0; local < n_tags; ++local) {
     const SurfaceId sid = part.first_surface + local;
     const Surface& surface = model.surfaces[sid];
@@ -85,6 +84,41 @@ void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, Mes
       soup.tags.push_back(local);
     }
   }
+  return soup;
+}
+
+// Each surface rebuilt from the repaired triangles carrying its tag, vertices in order of first use.
+std::vector<TriangleMesh> rebuild_by_tag(const detail::MeshStageResult& r, std::uint32_t n_tags) {
+  std::vector<TriangleMesh> rebuilt(n_tags);
+  std::vector<std::uint32_t> local_index(r.points.size(), ~0u);
+  std::vector<std::uint32_t> stamp(r.points.size(), ~0u);
+  std::vector<std::vector<std::size_t>> by_tag(n_tags);
+  for (std::size_t i = 0; i < r.triangles.size(); ++i) by_tag[r.tags[i]].push_back(i);
+  for (std::uint32_t tag = 0; tag < n_tags; ++tag) {
+    TriangleMesh& out = rebuilt[tag];
+    for (std::size_t i : by_tag[tag]) {
+      Tri t{};
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t p = r.triangles[i][static_cast<std::size_t>(c)];
+        if (stamp[p] != tag) {
+          stamp[p] = tag;
+          local_index[p] = static_cast<std::uint32_t>(out.vertices.size());
+          out.vertices.push_back(r.points[p]);
+        }
+        t[static_cast<std::size_t>(c)] = local_index[p];
+      }
+      out.triangles.push_back(t);
+    }
+  }
+  return rebuilt;
+}
+
+// Repairs one mesh part; appends one stats entry per surface with triangles.
+void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, MeshRepairReport& report) {
+  const Part& part = model.parts[pid];
+  const std::uint32_t n_tags = part.surface_count;
+  std::vector<SurfaceRepairStats> stats(n_tags);
+  const detail::TaggedSoup soup = gather_soup(model, part, stats);
 
   detail::MeshStageResult r;
   if (soup.triangles.empty()) {  // nothing left for CGAL: every surface ends up empty
@@ -99,30 +133,7 @@ void repair_part(Model& model, PartId pid, const MeshRepairOptions& options, Mes
     return;
   }
 
-  // Rebuild each surface from the triangles carrying its tag, vertices in order of first use.
-  std::vector<TriangleMesh> rebuilt(n_tags);
-  std::vector<std::uint32_t> local_index(r.points.size(), ~0u);
-  std::vector<std::uint32_t> stamp(r.points.size(), ~0u);
-  {
-    std::vector<std::vector<std::size_t>> by_tag(n_tags);
-    for (std::size_t i = 0; i < r.triangles.size(); ++i) by_tag[r.tags[i]].push_back(i);
-    for (std::uint32_t tag = 0; tag < n_tags; ++tag) {
-      TriangleMesh& out = rebuilt[tag];
-      for (std::size_t i : by_tag[tag]) {
-        Tri t{};
-        for (int c = 0; c < 3; ++c) {
-          const std::uint32_t p = r.triangles[i][static_cast<std::size_t>(c)];
-          if (stamp[p] != tag) {
-            stamp[p] = tag;
-            local_index[p] = static_cast<std::uint32_t>(out.vertices.size());
-            out.vertices.push_back(r.points[p]);
-          }
-          t[static_cast<std::size_t>(c)] = local_index[p];
-        }
-        out.triangles.push_back(t);
-      }
-    }
-  }
+  std::vector<TriangleMesh> rebuilt = rebuild_by_tag(r, n_tags);
 
   bool part_changed = false;
   for (std::uint32_t local = 0; local < n_tags; ++local) {
