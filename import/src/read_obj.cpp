@@ -239,36 +239,26 @@ std::vector<std::pair<std::int64_t, std::string>> repeated_faces(const ObjScan& 
   return out;
 }
 
-}  // namespace
+// The faces that survive the check against the final vertex list, as the normalised OBJ text assimp
+// reads (vertex i written as its number, groups renamed s<k>), with one surface per group in order
+// of its first good face; bad faces are listed and dropped, degenerate and repeated ones listed.
+struct KeptFaces {
+  std::string normalised;
+  std::vector<std::string> surface_names;
+  std::size_t count = 0;
+};
 
-ImportResult read_obj(const std::string& path, const ImportOptions&) {
-  std::string text, error;
-  if (!read_whole_file(path, text, error)) return failed_import(path, error);
-  if (text.empty()) return failed_import(path, "empty file: no vertices or faces");
-  if (std::int64_t line = 0; find_binary_byte(text, line)) {
-    ImportResult r = failed_import(path, "binary data: not a text OBJ file");
-    r.diagnostics.back().line = line;
-    return r;
-  }
-
-  ImportResult result;
-  DiagnosticCollector diags(path);
-  bool dropped = false;
-  ObjScan scan;
-  scan_obj(text, scan, diags, dropped);
-  text.clear();
-  text.shrink_to_fit();
-
-  // Check every face against the final vertex list; assign surfaces in order of first good face.
+KeptFaces keep_faces(const ObjScan& scan, DiagnosticCollector& diags, bool& dropped) {
+  KeptFaces kept;
+  std::string& normalised = kept.normalised;
+  std::vector<std::string>& surface_names = kept.surface_names;
+  std::size_t& kept_faces = kept.count;
   const auto nv = static_cast<std::int64_t>(scan.vertices.size());
   std::vector<std::uint32_t> surface_of_group(scan.group_names.size(), kNoGroup);
-  std::vector<std::string> surface_names;
-  std::string normalised;
   normalised.reserve(scan.vertices.size() * 16 + scan.corners.size() * 8);
   for (std::int64_t i = 0; i < nv; ++i) {
     normalised += "v " + std::to_string(i & 0xFFFFFF) + ' ' + std::to_string(i >> 24) + " 0\n";
   }
-  std::size_t kept_faces = 0;
   std::uint32_t last_surface = kNoGroup;
   std::vector<Vec3> face_points;
   std::vector<std::uint32_t> kept_face, kept_surface;  // scan.faces index and surface of each kept face
@@ -311,6 +301,33 @@ ImportResult read_obj(const std::string& path, const ImportOptions&) {
   }
   for (auto& [line, message] : repeated_faces(scan, kept_face, kept_surface, surface_names))
     diags.add(Severity::Warning, line, "repeated faces kept", std::move(message));
+  return kept;
+}
+
+}  // namespace
+
+ImportResult read_obj(const std::string& path, const ImportOptions&) {
+  std::string text, error;
+  if (!read_whole_file(path, text, error)) return failed_import(path, error);
+  if (text.empty()) return failed_import(path, "empty file: no vertices or faces");
+  if (std::int64_t line = 0; find_binary_byte(text, line)) {
+    ImportResult r = failed_import(path, "binary data: not a text OBJ file");
+    r.diagnostics.back().line = line;
+    return r;
+  }
+
+  ImportResult result;
+  DiagnosticCollector diags(path);
+  bool dropped = false;
+  ObjScan scan;
+  scan_obj(text, scan, diags, dropped);
+  text.clear();
+  text.shrink_to_fit();
+
+  KeptFaces kept = keep_faces(scan, diags, dropped);
+  const std::vector<std::string>& surface_names = kept.surface_names;
+  const std::size_t kept_faces = kept.count;
+  std::string& normalised = kept.normalised;
   if (scan.ignored_lines_points > 0)
     diags.add(Severity::Warning, 0, "line and point elements ignored",
               std::to_string(scan.ignored_lines_points) + " line/point elements (l, p) ignored: they bound no surface");

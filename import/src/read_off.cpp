@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -101,79 +102,51 @@ struct OffFace {
   std::uint32_t group;
 };
 
-}  // namespace
-
-ImportResult read_off(const std::string& path, const ImportOptions&) {
-  std::string text, error;
-  if (!read_whole_file(path, text, error)) return failed_import(path, error);
-  if (text.empty()) return failed_import(path, "empty file: no OFF header");
-  const auto fail_at = [&](std::int64_t line, std::string message) {
-    ImportResult r = failed_import(path, std::move(message));
-    r.diagnostics.back().line = line;
-    return r;
-  };
-
-  LineReader lines(text);
+// The file's content lines as tokens (comments removed), and failures naming a line.
+struct OffScanner {
+  const std::string& path;
+  LineReader lines;
   std::string_view raw;
   std::vector<std::string_view> tokens;
-  // Next line with content, comments removed; false at the end.
-  const auto next_tokens = [&]() {
+
+  // Next line with content; false at the end.
+  bool next_tokens() {
     while (lines.next(raw)) {
       split_tokens(raw.substr(0, raw.find('#')), tokens);
       if (!tokens.empty()) return true;
     }
     return false;
-  };
-
-  // Header keyword, then the counts (possibly on the same line).
-  if (!next_tokens()) return fail_at(lines.line_number(), "no OFF header: the file holds only comments or blanks");
-  OffHeader header;
-  bool n_dimension = false;
-  if (!parse_off_keyword(tokens[0], header, n_dimension))
-    return fail_at(lines.line_number(), "not an OFF file: the first word is not an OFF keyword ('" +
-                                            printable_token(tokens[0]) + "')");
-  if (tokens.size() > 1 && tokens[1] == "BINARY") return fail_at(lines.line_number(), "binary OFF is not supported");
-  if (std::int64_t line = 0; find_binary_byte(text, line)) return fail_at(line, "binary data: not a text OFF file");
-  std::vector<std::string_view> counts(tokens.begin() + 1, tokens.end());
-  if (n_dimension) {
-    if (counts.empty() && next_tokens()) counts = tokens;
-    std::int64_t dim = 0;
-    if (counts.empty() || !parse_int(counts[0], dim) || dim != 3)
-      return fail_at(lines.line_number(), "only 3-dimensional nOFF files are supported");
-    counts.erase(counts.begin());
   }
-  if (counts.empty()) {
-    if (!next_tokens()) return fail_at(lines.line_number(), "truncated: the file ends before the vertex and face counts");
-    counts = tokens;
+  ImportResult fail_at(std::int64_t line, std::string message) const {
+    ImportResult r = failed_import(path, std::move(message));
+    r.diagnostics.back().line = line;
+    return r;
   }
-  const std::int64_t counts_line = lines.line_number();
-  std::int64_t nv = 0, nf = 0;
-  if (counts.size() < 2 || !parse_int(counts[0], nv) || !parse_int(counts[1], nf) || nv < 0 || nf < 0)
-    return fail_at(counts_line, "malformed counts: expected 'vertices faces [edges]' as non-negative integers");
+};
 
-  ImportResult result;
-  DiagnosticCollector diags(path);
-  bool dropped = false;
-
-  // Vertices. Nothing is reserved from the header: a wrong count must not allocate.
-  std::vector<Vec3> vertices;
-  std::vector<std::int64_t> bad_vertex_line;
+// The `nv` vertices the header announced (`counts_line`): a bad one is kept as a placeholder with its
+// line in `bad_vertex_line` (faces using it are dropped); a file that ends early or turns to faces
+// fails the import (the returned result).
+std::optional<ImportResult> read_vertices(OffScanner& sc, const OffHeader& header, std::int64_t nv,
+                                          std::int64_t counts_line, DiagnosticCollector& diags,
+                                          std::vector<Vec3>& vertices, std::vector<std::int64_t>& bad_vertex_line) {
+  const std::vector<std::string_view>& tokens = sc.tokens;
   const std::size_t coords = header.homogeneous ? 4 : 3;
   std::size_t first_vertex_tokens = 0;
   for (std::int64_t i = 0; i < nv; ++i) {
-    if (!next_tokens())
-      return fail_at(lines.line_number(), "truncated: the header (line " + std::to_string(counts_line) + ") announces " +
+    if (!sc.next_tokens())
+      return sc.fail_at(sc.lines.line_number(), "truncated: the header (line " + std::to_string(counts_line) + ") announces " +
                                               std::to_string(nv) + " vertices but the file ends after " +
                                               std::to_string(i));
     if (i == 0) first_vertex_tokens = tokens.size();
-    const std::int64_t line_no = lines.line_number();
+    const std::int64_t line_no = sc.lines.line_number();
     // A line of integers that reads as "n i1 .. in [colour]" where a vertex is expected means the
     // header announced more vertices than the file has.
     if (i > 0 && tokens.size() != first_vertex_tokens) {
       std::int64_t n = 0, dummy = 0;
       const bool integers = std::all_of(tokens.begin(), tokens.end(), [&](std::string_view t) { return parse_int(t, dummy); });
       if (integers && parse_int(tokens[0], n) && n >= 1 && static_cast<std::size_t>(n) + 1 <= tokens.size())
-        return fail_at(line_no, "expected vertex " + std::to_string(i + 1) + " of " + std::to_string(nv) +
+        return sc.fail_at(line_no, "expected vertex " + std::to_string(i + 1) + " of " + std::to_string(nv) +
                                     " but found a face: the vertex count in the header (line " +
                                     std::to_string(counts_line) + ") is larger than the file's");
     }
@@ -213,15 +186,20 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
     vertices.push_back(bad ? Vec3::Zero() : p);
     bad_vertex_line.push_back(bad);
   }
+  return std::nullopt;
+}
 
-  // Faces.
-  std::vector<OffFace> faces;
-  std::vector<FaceColour> groups;
+// The `nf` faces: one colour group per distinct colour (groups in order of first use); a bad face is
+// listed and dropped (`dropped`), as are missing faces and trailing data.
+void read_faces(OffScanner& sc, std::int64_t nf, std::int64_t nv, std::int64_t counts_line,
+                const std::vector<Vec3>& vertices, const std::vector<std::int64_t>& bad_vertex_line,
+                DiagnosticCollector& diags, std::vector<OffFace>& faces, std::vector<FaceColour>& groups, bool& dropped) {
+  const std::vector<std::string_view>& tokens = sc.tokens;
   std::unordered_map<std::string, std::uint32_t> group_of_key;
   std::int64_t faces_read = 0;
   for (; faces_read < nf; ++faces_read) {
-    if (!next_tokens()) break;
-    const std::int64_t line_no = lines.line_number();
+    if (!sc.next_tokens()) break;
+    const std::int64_t line_no = sc.lines.line_number();
     std::int64_t n = 0;
     std::string problem;
     OffFace face{line_no, {}, 0};
@@ -267,23 +245,22 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
     faces.push_back(std::move(face));
   }
   if (faces_read < nf) {
-    diags.add(Severity::Error, lines.line_number(), "truncated files",
+    diags.add(Severity::Error, sc.lines.line_number(), "truncated files",
               "truncated: the header (line " + std::to_string(counts_line) + ") announces " + std::to_string(nf) +
                   " faces but the file ends after " + std::to_string(faces_read));
     dropped = true;
-  } else if (next_tokens()) {
-    diags.add(Severity::Error, lines.line_number(), "trailing data",
+  } else if (sc.next_tokens()) {
+    diags.add(Severity::Error, sc.lines.line_number(), "trailing data",
               "data after the " + std::to_string(nf) + " faces the header (line " + std::to_string(counts_line) +
                   ") announces: its counts are probably wrong; the rest is ignored");
     dropped = true;
   }
-  if (faces.empty()) {
-    diags.add(Severity::Error, 0, "files without faces", "no usable faces: nothing to import");
-    diags.flush_into(result.diagnostics);
-    result.complete = false;
-    return result;
-  }
+}
 
+// The validated vertices and faces through CGAL's OFF reader into one surface per colour group of
+// `model`; false when CGAL cannot read them (listed).
+bool build_surfaces(const std::vector<Vec3>& vertices, const std::vector<OffFace>& faces,
+                    const std::vector<FaceColour>& groups, DiagnosticCollector& diags, Model& model) {
   // CGAL reads the normalised copy.
   std::string normalised = "OFF\n" + std::to_string(vertices.size()) + ' ' + std::to_string(faces.size()) + " 0\n";
   for (const Vec3& p : vertices) {
@@ -303,12 +280,10 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
   const bool ok = CGAL::IO::read_OFF(in, points, polygons, CGAL::parameters::verbose(false));
   if (!ok || points.size() != vertices.size() || polygons.size() != faces.size()) {
     diags.add(Severity::Error, 0, "CGAL failures", "CGAL could not read the validated OFF data");
-    diags.flush_into(result.diagnostics);
-    result.complete = false;
-    return result;
+    return false;
   }
 
-  std::vector<Surface>& surfaces = result.model.surfaces;
+  std::vector<Surface>& surfaces = model.surfaces;
   surfaces.resize(groups.size());
   std::vector<std::unordered_map<std::size_t, std::uint32_t>> local_index(groups.size());
   std::vector<std::vector<std::uint64_t>> source_of_local(groups.size());
@@ -339,6 +314,67 @@ ImportResult read_off(const std::string& path, const ImportOptions&) {
     surfaces[s].provenance.source_name = groups[s].key;
     surfaces[s].provenance.face_index = static_cast<std::int32_t>(s);
     surfaces[s].provenance.colour = groups[s].rgb;
+  }
+  return true;
+}
+
+}  // namespace
+
+ImportResult read_off(const std::string& path, const ImportOptions&) {
+  std::string text, error;
+  if (!read_whole_file(path, text, error)) return failed_import(path, error);
+  if (text.empty()) return failed_import(path, "empty file: no OFF header");
+  OffScanner sc{path, LineReader(text), {}, {}};
+  const std::vector<std::string_view>& tokens = sc.tokens;
+
+  // Header keyword, then the counts (possibly on the same line).
+  if (!sc.next_tokens()) return sc.fail_at(sc.lines.line_number(), "no OFF header: the file holds only comments or blanks");
+  OffHeader header;
+  bool n_dimension = false;
+  if (!parse_off_keyword(tokens[0], header, n_dimension))
+    return sc.fail_at(sc.lines.line_number(), "not an OFF file: the first word is not an OFF keyword ('" +
+                                            printable_token(tokens[0]) + "')");
+  if (tokens.size() > 1 && tokens[1] == "BINARY") return sc.fail_at(sc.lines.line_number(), "binary OFF is not supported");
+  if (std::int64_t line = 0; find_binary_byte(text, line)) return sc.fail_at(line, "binary data: not a text OFF file");
+  std::vector<std::string_view> counts(tokens.begin() + 1, tokens.end());
+  if (n_dimension) {
+    if (counts.empty() && sc.next_tokens()) counts = tokens;
+    std::int64_t dim = 0;
+    if (counts.empty() || !parse_int(counts[0], dim) || dim != 3)
+      return sc.fail_at(sc.lines.line_number(), "only 3-dimensional nOFF files are supported");
+    counts.erase(counts.begin());
+  }
+  if (counts.empty()) {
+    if (!sc.next_tokens()) return sc.fail_at(sc.lines.line_number(), "truncated: the file ends before the vertex and face counts");
+    counts = tokens;
+  }
+  const std::int64_t counts_line = sc.lines.line_number();
+  std::int64_t nv = 0, nf = 0;
+  if (counts.size() < 2 || !parse_int(counts[0], nv) || !parse_int(counts[1], nf) || nv < 0 || nf < 0)
+    return sc.fail_at(counts_line, "malformed counts: expected 'vertices faces [edges]' as non-negative integers");
+
+  ImportResult result;
+  DiagnosticCollector diags(path);
+  bool dropped = false;
+
+  // Vertices. Nothing is reserved from the header: a wrong count must not allocate.
+  std::vector<Vec3> vertices;
+  std::vector<std::int64_t> bad_vertex_line;
+  if (auto failed = read_vertices(sc, header, nv, counts_line, diags, vertices, bad_vertex_line)) return std::move(*failed);
+  std::vector<OffFace> faces;
+  std::vector<FaceColour> groups;
+  read_faces(sc, nf, nv, counts_line, vertices, bad_vertex_line, diags, faces, groups, dropped);
+  if (faces.empty()) {
+    diags.add(Severity::Error, 0, "files without faces", "no usable faces: nothing to import");
+    diags.flush_into(result.diagnostics);
+    result.complete = false;
+    return result;
+  }
+
+  if (!build_surfaces(vertices, faces, groups, diags, result.model)) {
+    diags.flush_into(result.diagnostics);
+    result.complete = false;
+    return result;
   }
   finish_single_part_model(result.model, path);
   diags.flush_into(result.diagnostics);
