@@ -98,6 +98,97 @@ std::array<Vec3, 3> soup_points(const TaggedSoup& soup, const Tri& t) {
   return {soup.points[t[0]], soup.points[t[1]], soup.points[t[2]]};
 }
 
+// Orients each connected component: a closed one outward (inward when it bounds a cavity, nested in
+// an odd number of closed components), an open one as most of its input faces were wound.
+void orient_components(Mesh& mesh, const TaggedSoup& soup, const Mesh::Property_map<FI, std::int64_t>& forigin) {
+  auto [fcc, cc_created] = mesh.add_property_map<FI, std::size_t>("f:cadclash_cc", 0);
+  (void)cc_created;
+  const std::size_t n_cc = PMP::connected_components(mesh, fcc);
+  std::vector<std::vector<FI>> cc_faces(n_cc);
+  for (FI f : mesh.faces()) cc_faces[fcc[f]].push_back(f);
+  struct Component {
+    bool closed = true;
+    double volume6 = 0.0;
+    std::size_t agree = 0;  // faces whose winding matches the input's
+    Aabb box;
+    Vec3 probe = Vec3::Zero();  // centroid of the component's first face
+  };
+  std::vector<Component> cc(n_cc);
+  for (std::size_t c = 0; c < n_cc; ++c) {
+    Component& k = cc[c];
+    for (FI f : cc_faces[c]) {
+      for (HI h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
+        if (mesh.is_border(mesh.opposite(h))) k.closed = false;
+      const std::array<Vec3, 3> p = face_points(mesh, f);
+      k.volume6 += p[0].dot(p[1].cross(p[2]));
+      for (const Vec3& v : p) k.box.extend(v);
+      if (f == cc_faces[c].front()) k.probe = (p[0] + p[1] + p[2]) / 3.0;
+      const std::array<Vec3, 3> q = soup_points(soup, soup.triangles[static_cast<std::size_t>(forigin[f])]);
+      if (same_winding(q, p) > 0) ++k.agree;
+    }
+  }
+  // A closed component nested inside an odd number of other closed components bounds a cavity and
+  // faces inward; the others face outward. Nesting by the generalized winding number of the
+  // component's probe point (|w| ~ 1 inside a closed surface, ~ 0 outside).
+  for (std::size_t c = 0; c < n_cc; ++c) {
+    Component& k = cc[c];
+    bool reverse = 2 * k.agree < cc_faces[c].size();
+    if (k.closed && k.volume6 != 0.0) {
+      std::size_t depth = 0;
+      for (std::size_t d = 0; d < n_cc; ++d) {
+        if (d == c || !cc[d].closed || !cc[d].box.contains(k.box)) continue;
+        double solid = 0.0;
+        for (FI f : cc_faces[d]) {
+          const std::array<Vec3, 3> p = face_points(mesh, f);
+          const Vec3 a = p[0] - k.probe, b = p[1] - k.probe, e = p[2] - k.probe;
+          const double la = a.norm(), lb = b.norm(), le = e.norm();
+          solid += 2.0 * std::atan2(a.dot(b.cross(e)), la * lb * le + a.dot(b) * le + a.dot(e) * lb + b.dot(e) * la);
+        }
+        if (std::abs(solid) > 2.0 * CGAL_PI) ++depth;  // |w| > 0.5
+      }
+      reverse = (k.volume6 < 0.0) == (depth % 2 == 0);
+    }
+    if (reverse) PMP::reverse_face_orientations(cc_faces[c], mesh);
+  }
+  mesh.remove_property_map(fcc);
+}
+
+// Fills the border cycles of at most options.max_hole_edges edges (0: all), each hole's triangles
+// tagged with the surface owning most of its border; counted per tag.
+void fill_holes(Mesh& mesh, const MeshRepairOptions& options, Mesh::Property_map<FI, std::uint32_t>& ftag,
+                Mesh::Property_map<FI, std::int64_t>& forigin, std::vector<TagCounts>& counts) {
+  // Border cycles in order of their lowest halfedge index, so the result never depends on hashing.
+  std::vector<HI> starts;
+  std::vector<bool> seen(mesh.num_halfedges(), false);
+  for (HI h : mesh.halfedges()) {
+    if (!mesh.is_border(h) || seen[h.idx()]) continue;
+    std::size_t length = 0;
+    for (HI g : CGAL::halfedges_around_face(h, mesh)) {
+      seen[g.idx()] = true;
+      ++length;
+    }
+    if (options.max_hole_edges == 0 || length <= options.max_hole_edges) starts.push_back(h);
+  }
+  for (HI h : starts) {
+    if (!mesh.is_border(h)) continue;  // an earlier fill closed it
+    std::map<std::uint32_t, std::size_t> votes;
+    for (HI g : CGAL::halfedges_around_face(h, mesh)) ++votes[ftag[mesh.face(mesh.opposite(g))]];
+    std::uint32_t owner = votes.begin()->first;
+    std::size_t best = 0;
+    for (const auto& [tag, n] : votes)
+      if (n > best) owner = tag, best = n;  // strict >: ties keep the lower tag
+    std::vector<FI> added;
+    PMP::triangulate_hole(mesh, h, std::back_inserter(added));
+    if (added.empty()) continue;
+    for (FI f : added) {
+      ftag[f] = owner;
+      forigin[f] = -1;
+    }
+    ++counts[owner].filled_holes;
+    counts[owner].hole_faces += static_cast<std::uint32_t>(added.size());
+  }
+}
+
 }  // namespace
 
 MeshStageResult repair_soup_cgal(const TaggedSoup& soup, std::uint32_t tag_count, const MeshRepairOptions& options) {
@@ -150,58 +241,7 @@ MeshStageResult repair_soup_cgal(const TaggedSoup& soup, std::uint32_t tag_count
       for (std::uint32_t t : u) ++r.counts[t].duplicated_vertices;
   }
 
-  if (options.orient) {
-    auto [fcc, cc_created] = mesh.add_property_map<FI, std::size_t>("f:cadclash_cc", 0);
-    (void)cc_created;
-    const std::size_t n_cc = PMP::connected_components(mesh, fcc);
-    std::vector<std::vector<FI>> cc_faces(n_cc);
-    for (FI f : mesh.faces()) cc_faces[fcc[f]].push_back(f);
-    struct Component {
-      bool closed = true;
-      double volume6 = 0.0;
-      std::size_t agree = 0;  // faces whose winding matches the input's
-      Aabb box;
-      Vec3 probe = Vec3::Zero();  // centroid of the component's first face
-    };
-    std::vector<Component> cc(n_cc);
-    for (std::size_t c = 0; c < n_cc; ++c) {
-      Component& k = cc[c];
-      for (FI f : cc_faces[c]) {
-        for (HI h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
-          if (mesh.is_border(mesh.opposite(h))) k.closed = false;
-        const std::array<Vec3, 3> p = face_points(mesh, f);
-        k.volume6 += p[0].dot(p[1].cross(p[2]));
-        for (const Vec3& v : p) k.box.extend(v);
-        if (f == cc_faces[c].front()) k.probe = (p[0] + p[1] + p[2]) / 3.0;
-        const std::array<Vec3, 3> q = soup_points(soup, soup.triangles[static_cast<std::size_t>(forigin[f])]);
-        if (same_winding(q, p) > 0) ++k.agree;
-      }
-    }
-    // A closed component nested inside an odd number of other closed components bounds a cavity and
-    // faces inward; the others face outward. Nesting by the generalized winding number of the
-    // component's probe point (|w| ~ 1 inside a closed surface, ~ 0 outside).
-    for (std::size_t c = 0; c < n_cc; ++c) {
-      Component& k = cc[c];
-      bool reverse = 2 * k.agree < cc_faces[c].size();
-      if (k.closed && k.volume6 != 0.0) {
-        std::size_t depth = 0;
-        for (std::size_t d = 0; d < n_cc; ++d) {
-          if (d == c || !cc[d].closed || !cc[d].box.contains(k.box)) continue;
-          double solid = 0.0;
-          for (FI f : cc_faces[d]) {
-            const std::array<Vec3, 3> p = face_points(mesh, f);
-            const Vec3 a = p[0] - k.probe, b = p[1] - k.probe, e = p[2] - k.probe;
-            const double la = a.norm(), lb = b.norm(), le = e.norm();
-            solid += 2.0 * std::atan2(a.dot(b.cross(e)), la * lb * le + a.dot(b) * le + a.dot(e) * lb + b.dot(e) * la);
-          }
-          if (std::abs(solid) > 2.0 * CGAL_PI) ++depth;  // |w| > 0.5
-        }
-        reverse = (k.volume6 < 0.0) == (depth % 2 == 0);
-      }
-      if (reverse) PMP::reverse_face_orientations(cc_faces[c], mesh);
-    }
-    mesh.remove_property_map(fcc);
-  }
+  if (options.orient) orient_components(mesh, soup, forigin);
 
   if (options.remove_negligible_components) {
     PMP::remove_connected_components_of_negligible_size(mesh);
@@ -211,38 +251,7 @@ MeshStageResult repair_soup_cgal(const TaggedSoup& soup, std::uint32_t tag_count
     }
   }
 
-  if (options.fill_holes) {
-    // Border cycles in order of their lowest halfedge index, so the result never depends on hashing.
-    std::vector<HI> starts;
-    std::vector<bool> seen(mesh.num_halfedges(), false);
-    for (HI h : mesh.halfedges()) {
-      if (!mesh.is_border(h) || seen[h.idx()]) continue;
-      std::size_t length = 0;
-      for (HI g : CGAL::halfedges_around_face(h, mesh)) {
-        seen[g.idx()] = true;
-        ++length;
-      }
-      if (options.max_hole_edges == 0 || length <= options.max_hole_edges) starts.push_back(h);
-    }
-    for (HI h : starts) {
-      if (!mesh.is_border(h)) continue;  // an earlier fill closed it
-      std::map<std::uint32_t, std::size_t> votes;
-      for (HI g : CGAL::halfedges_around_face(h, mesh)) ++votes[ftag[mesh.face(mesh.opposite(g))]];
-      std::uint32_t owner = votes.begin()->first;
-      std::size_t best = 0;
-      for (const auto& [tag, n] : votes)
-        if (n > best) owner = tag, best = n;  // strict >: ties keep the lower tag
-      std::vector<FI> added;
-      PMP::triangulate_hole(mesh, h, std::back_inserter(added));
-      if (added.empty()) continue;
-      for (FI f : added) {
-        ftag[f] = owner;
-        forigin[f] = -1;
-      }
-      ++r.counts[owner].filled_holes;
-      r.counts[owner].hole_faces += static_cast<std::uint32_t>(added.size());
-    }
-  }
+  if (options.fill_holes) fill_holes(mesh, options, ftag, forigin, r.counts);
 
   // Output in face index order: input order first, then hole triangles.
   std::vector<std::uint32_t> vmap(mesh.num_vertices(), ~0u);
