@@ -40,9 +40,8 @@ class Running {
   std::atomic<bool>& flag_;
 };
 
-}  // namespace
-
-void bind_scene(pyb::module_& m) {
+// The options of a query: their enums, CollideOptions, and the pose helpers.
+void bind_options(pyb::module_& m) {
   pyb::enum_<CollideMode>(m, "CollideMode")
       .value("EarlyExit", CollideMode::EarlyExit)
       .value("AllTrianglePairs", CollideMode::AllTrianglePairs);
@@ -83,6 +82,10 @@ void bind_scene(pyb::module_& m) {
       [](const pyb::handle& t, const pyb::handle& q) { return pose_to_array(pose_from_translation_quaternion(t, q)); },
       "4x4 pose from (tx, ty, tz) and (qw, qx, qy, qz) (normalised). ValueError for a zero quaternion.");
 
+}
+
+// The prepared scene (check, replay) and the one-off collide().
+void bind_scene_core(pyb::module_& m) {
   pyb::class_<SceneCore>(m, "SceneCore", pyb::dynamic_attr(), "The C++ prepared scene behind cadclash.Scene.")
       .def(pyb::init([](ModelCore& model, std::vector<std::int64_t> set_a, std::vector<std::int64_t> set_b,
                         std::vector<std::array<std::string, 2>> excluded_pairs,
@@ -171,6 +174,13 @@ void bind_scene(pyb::module_& m) {
     }
     return report_to_tuple(r, std::move(record));
   });
+}
+
+}  // namespace
+
+void bind_scene(pyb::module_& m) {
+  bind_options(m);
+  bind_scene_core(m);
 }
 
 }  // namespace cadclash::py
