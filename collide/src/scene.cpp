@@ -43,17 +43,9 @@ InstanceId Scene::find_instance(const std::string& path) const {
 
 std::size_t Scene::build_hierarchies(int threads) {
   detail::SceneData& s = *impl_;
-  std::vector<SurfaceId> todo;
-  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid)
-    if (!s.bvh_ready[sid] && s.model.surfaces[sid].has_triangles) todo.push_back(sid);
-  const auto n = static_cast<std::ptrdiff_t>(todo.size());
-#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 1) if (n >= 4)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const SurfaceId sid = todo[static_cast<std::size_t>(k)];
-    s.bvh[sid] = detail::build_surface_bvh(s.model.surfaces[sid].mesh);
-  }
-  for (SurfaceId sid : todo) s.bvh_ready[sid] = 1;
-  return todo.size();
+  std::vector<SurfaceId> all(s.model.surfaces.size());
+  for (SurfaceId sid = 0; sid < all.size(); ++sid) all[sid] = sid;
+  return detail::build_trees(s, all, threads > 0 ? threads : omp_get_max_threads(), detail::Deadline{}).size();
 }
 
 SceneMemory Scene::memory() const {

@@ -5,6 +5,9 @@
 
 #include "scene_data.h"
 
+#include <span>
+#include <vector>
+
 namespace cadclash::detail {
 
 // 1. World boxes of the instances moved since the last check, then sweep-and-prune over them (brute
@@ -17,6 +20,10 @@ void surface_level_stage(const SceneData& s, QueryState& q);
 
 // 3. Lazy tessellation of the needed surfaces and their BVHs, in rounds under a memory budget.
 void tessellation_stage(SceneData& s, QueryState& q);
+
+// The trees of those `wave` surfaces that have triangles and no tree yet, built on `threads` threads
+// (marked ready); past the deadline the rest are skipped. Returns the surfaces built, in wave order.
+std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave, int threads, const Deadline& deadline);
 
 // 4. Triangle level of every task within the budget: Version 1 or 2 (collide.h).
 void triangle_level_stage(SceneData& s, QueryState& q);

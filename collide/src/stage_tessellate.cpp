@@ -44,27 +44,35 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
 }
 
 void build_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wave) {
+  for (SurfaceId sid : build_trees(s, wave, q.threads, q.deadline)) {
+    q.built.push_back(sid);
+    q.charge[q.first_need[sid]] += bvh_bytes(s.bvh[sid]);
+  }
+}
+
+}  // namespace
+
+std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave, int threads, const Deadline& deadline) {
   std::vector<SurfaceId> to_build;
   for (SurfaceId sid : wave)
     if (!s.bvh_ready[sid] && s.model.surfaces[sid].has_triangles) to_build.push_back(sid);
   std::vector<char> done(to_build.size(), 0);
   const auto nbuild = static_cast<std::ptrdiff_t>(to_build.size());
-#pragma omp parallel for num_threads(q.threads) schedule(dynamic, 1) if (nbuild >= kMinParallel)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nbuild >= kMinParallel)
   for (std::ptrdiff_t k = 0; k < nbuild; ++k) {
-    if (q.deadline.expired()) continue;
+    if (deadline.expired()) continue;
     const SurfaceId sid = to_build[static_cast<std::size_t>(k)];
     s.bvh[sid] = build_surface_bvh(s.model.surfaces[sid].mesh);
     done[static_cast<std::size_t>(k)] = 1;
   }
+  std::vector<SurfaceId> built;
   for (std::size_t k = 0; k < to_build.size(); ++k) {
     if (!done[k]) continue;
     s.bvh_ready[to_build[k]] = 1;
-    q.built.push_back(to_build[k]);
-    q.charge[q.first_need[to_build[k]]] += bvh_bytes(s.bvh[to_build[k]]);
+    built.push_back(to_build[k]);
   }
+  return built;
 }
-
-}  // namespace
 
 void tessellation_stage(SceneData& s, QueryState& q) {
   const std::size_t round = q.o.memory_budget_bytes > 0 ? kBudgetRound : std::max<std::size_t>(q.needed.size(), 1);

@@ -86,8 +86,9 @@ std::optional<EdgePoint> nearest_edge_point(const FaceLocator& where, const gp_P
     const auto& samples = where.samples[i];
     if (samples.empty()) continue;
     std::size_t k = 0;
+    double nearest = samples[0].second.SquareDistance(p);
     for (std::size_t j = 1; j < samples.size(); ++j)
-      if (samples[j].second.SquareDistance(p) < samples[k].second.SquareDistance(p)) k = j;
+      if (const double d2 = samples[j].second.SquareDistance(p); d2 < nearest) k = j, nearest = d2;
     const BRepAdaptor_Curve curve(where.edges[i].first);
     const double t0 = curve.FirstParameter(), t1 = curve.LastParameter();
     double t = samples[k].first;
