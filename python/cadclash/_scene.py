@@ -9,7 +9,7 @@ import numpy as np
 from . import _cadclash as _core
 from ._model import Instance, Model, _path_under
 from ._options import CollideOptions, _resolve, _to_core
-from ._types import Counters, InputError, PairResult, Replay, Report, StepResult, Timings, _diagnostics
+from ._types import Counters, InputError, ModelMemory, PairResult, Replay, Report, StepResult, Timings, _diagnostics
 
 __all__ = ["Scene", "collide", "replay"]
 
@@ -18,7 +18,7 @@ InstanceKey = Union[int, str, Instance]
 
 def _report(model: Model, raw, settings=None) -> Report:
     """The Report of one query; with the report's ``settings`` it also holds its JSON document."""
-    raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged, record = raw
+    raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged, model_bytes, record = raw
     paths, part_names, surface_names, step_ids = model._names()
     pairs = []
     for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri, by, lo, hi in raw_pairs:
@@ -38,7 +38,7 @@ def _report(model: Model, raw, settings=None) -> Report:
             list(model.files), settings, record, [str(d) for d in model.diagnostics + run_diagnostics],
             model.complete and complete and not any(d.is_error for d in run_diagnostics))
     return Report(pairs, Counters(**counters), Timings(**timings), run_diagnostics, complete, stopped_by,
-                  [(paths[a], paths[b]) for a, b in unexamined], memory_charged, document)
+                  [(paths[a], paths[b]) for a, b in unexamined], memory_charged, ModelMemory(**model_bytes), document)
 
 
 def _given(model: Model, keys) -> List[str]:
@@ -183,5 +183,5 @@ def _replay_document(scene: Scene, o, path: str, steps, steps_raw, distinct_step
     complete = model.complete and not any(d.is_error for d in step_diagnostics) and not stopped_by
     settings = _core.report_settings(o, model, *scene._given)
     return _core.ReportDocument.trajectory(list(model.files), settings, path,
-                                           [(step, raw[8]) for step, raw in steps_raw], not_checked, stopped_by,
+                                           [(step, raw[9]) for step, raw in steps_raw], not_checked, stopped_by,
                                            diagnostics, complete)

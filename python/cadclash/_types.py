@@ -152,6 +152,29 @@ Timings = make_dataclass("Timings", [(name, float, 0.0) for name in _core.TIMING
 Timings.__module__ = __name__
 Timings.__doc__ = "Seconds spent per stage of one query. Never deterministic; leave out of comparisons."
 
+@dataclass(frozen=True)
+class ModelMemory:
+    """What the scene's collision model held after a query, in bytes per component (the JSON
+    report's ``model``, ``Scene::memory()`` in C++): the triangles and vertices of the surfaces that
+    have a hierarchy, the hierarchies built so far and the per-instance data; ``triangle_count`` is
+    the triangles counted. The same for any thread count. Zeros in a report written before it."""
+
+    triangles: int = 0
+    vertices: int = 0
+    hierarchies: int = 0
+    instances: int = 0
+    triangle_count: int = 0
+
+    @property
+    def total(self) -> int:
+        return self.triangles + self.vertices + self.hierarchies + self.instances
+
+    @property
+    def bytes_per_triangle(self) -> float:
+        """total / triangle_count (0.0 when no triangle is held)."""
+        return self.total / self.triangle_count if self.triangle_count else 0.0
+
+
 _CLASSES = _core.CONTACT_CLASSES
 _DECIDED_BY = _core.DECIDED_BY
 
@@ -175,6 +198,7 @@ class Report:
     stopped_by: str = ""
     unexamined_pairs: List[Tuple[str, str]] = field(default_factory=list)
     memory_charged: int = 0
+    model: ModelMemory = field(default_factory=ModelMemory)
     # The JSON report of this query (files, settings, model diagnostics); None for a Report made by hand.
     _document: Optional["_core.ReportDocument"] = field(default=None, repr=False, compare=False)
 
@@ -206,13 +230,11 @@ class Report:
         Pairs carry names and STEP ids but no model ids (``instance_id_a`` ... are None) and
         ``diagnostics`` are every diagnostic of the report (the model's and the query's), parsed
         from their text. ValueError, naming the JSON path (e.g. ``/pairs/3/class``), for anything
-        that is not a version-2 report of one query (a ``--path`` report holds several)."""
+        that is not a version-2 report of one query (a ``--path`` report holds several: read it
+        with ``Replay.from_json``)."""
         doc = _core.ReportDocument.from_json(text)
-        raw_pairs, counters, timings, stopped_by, unexamined, memory_charged = doc._query()
-        pairs = [_pair_from_document(raw) for raw in raw_pairs]
-        return cls(pairs, Counters(**counters), Timings(**(timings or {})),
-                   [Diagnostic._from_text(t) for t in doc.diagnostics], doc.complete, stopped_by,
-                   [tuple(u) for u in unexamined], memory_charged, doc)
+        return _query_from_document(doc._query(), [Diagnostic._from_text(t) for t in doc.diagnostics],
+                                    doc.complete, doc)
 
     def count(self, contact: str) -> int:
         """Number of pairs of one class ("penetrating", "touching", "clearance", "containment")."""
@@ -236,6 +258,13 @@ class Report:
                 by[p.decided_by] += 1
         out["decided_by"] = by
         return out
+
+
+def _query_from_document(raw, diagnostics: List[Diagnostic], complete: bool, document) -> Report:
+    raw_pairs, counters, timings, stopped_by, unexamined, memory_charged, model = raw
+    return Report([_pair_from_document(p) for p in raw_pairs], Counters(**counters), Timings(**(timings or {})),
+                  diagnostics, complete, stopped_by, [tuple(u) for u in unexamined], memory_charged,
+                  ModelMemory(**model), document)
 
 
 def _pair_from_document(raw) -> PairResult:
@@ -265,6 +294,25 @@ class Replay:
     diagnostics: List[Diagnostic]
     # The `cadclash check --path` JSON report of this replay; None for a Replay made by hand.
     _document: Optional["_core.ReportDocument"] = field(default=None, repr=False, compare=False)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Replay":
+        """Reads a trajectory report written by ``cadclash check --path CSV --json`` or
+        ``Replay.to_json()``; ``to_json()`` of the result gives ``text`` back byte for byte (with
+        ``timings=True`` when it has timings). Each step's ``Report`` has the step's pairs (names
+        and STEP ids, no model ids), counters, timings, ``model`` bytes and budget fields, no
+        diagnostics and no JSON document of its own; ``diagnostics`` are the report's, parsed from
+        their text. ValueError, naming the JSON path, for anything that is not a version-2
+        trajectory report (a report of one query: ``Report.from_json``)."""
+        doc = _core.ReportDocument.from_json(text)
+        _, raw_steps, _, _ = doc._steps()
+        steps = [StepResult(step, _query_from_document(raw, [], not raw[3], None)) for step, raw in raw_steps]
+        return cls(steps, [Diagnostic._from_text(t) for t in doc.diagnostics], doc)
+
+    @property
+    def steps_not_checked(self) -> int:
+        """Steps a time budget left unchecked (0 for a Replay made by hand)."""
+        return self._document._steps()[2] if self._document is not None else 0
 
     def to_json(self, timings: bool = False) -> str:
         """The JSON report of the replay, byte for byte what ``cadclash check FILES --path CSV --json

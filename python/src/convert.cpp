@@ -77,6 +77,16 @@ pyb::dict counters_to_dict(const CollideCounters& c) {
   return d;
 }
 
+pyb::dict model_memory_to_dict(const SceneMemory& m) {
+  pyb::dict d;
+  d["triangles"] = m.triangles;
+  d["vertices"] = m.vertices;
+  d["hierarchies"] = m.hierarchies;
+  d["instances"] = m.instances;
+  d["triangle_count"] = m.triangle_count;
+  return d;
+}
+
 pyb::dict timings_to_dict(const CollideTimings& t) {
   pyb::dict d;
   for (const TimingField& f : kTimingFields) d[f.name] = t.*f.member;
@@ -108,7 +118,7 @@ pyb::tuple report_to_tuple(const Report& report, QueryReport record) {
   for (const auto& [a, b] : report.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));
   return pyb::make_tuple(pairs, counters_to_dict(report.counters), timings_to_dict(report.timings),
                          diagnostics_to_list(report.diagnostics), report.complete, report.stopped_by, unexamined,
-                         report.memory_charged, std::move(record));
+                         report.memory_charged, model_memory_to_dict(report.model_memory), std::move(record));
 }
 
 }  // namespace cadclash::py

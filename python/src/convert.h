@@ -37,6 +37,8 @@ pyb::tuple report_to_tuple(const Report& report, QueryReport record);
 // {name: value} of the counters / timings (kCounterFields, kTimingFields).
 pyb::dict counters_to_dict(const CollideCounters& c);
 pyb::dict timings_to_dict(const CollideTimings& t);
+// {triangles, vertices, hierarchies, instances, triangle_count}: bytes per component of SceneMemory.
+pyb::dict model_memory_to_dict(const SceneMemory& m);
 
 // A k x 2 uint32 array (a copy) of triangle index pairs.
 pyb::array_t<std::uint32_t> triangle_pairs_array(const std::vector<std::array<std::uint32_t, 2>>& pairs);

@@ -27,7 +27,7 @@ pyb::object side_tuple(const ReportSide& s) {
   return pyb::make_tuple(s.instance, s.part, s.surface, s.step_id >= 0 ? pyb::object(pyb::int_(s.step_id)) : pyb::none());
 }
 
-// (pairs, counters, timings|None, stopped_by, unexamined [(a, b)], memory_charged) with each pair
+// (pairs, counters, timings|None, stopped_by, unexamined [(a, b)], memory_charged, model bytes) with each pair
 // (class, decided_by, lo, hi, intersecting, distance, penetration, exact|None, triangle_pairs,
 //  (instance, part, surface|None, step_id|None) of a, the same of b).
 pyb::tuple query_tuple(const QueryReport& q) {
@@ -41,7 +41,8 @@ pyb::tuple query_tuple(const QueryReport& q) {
   pyb::list unexamined;
   for (const auto& [a, b] : q.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));
   pyb::object timings = q.timings ? pyb::object(timings_to_dict(*q.timings)) : pyb::object(pyb::none());
-  return pyb::make_tuple(pairs, counters_to_dict(q.counters), timings, q.stopped_by, unexamined, q.memory_charged_bytes);
+  return pyb::make_tuple(pairs, counters_to_dict(q.counters), timings, q.stopped_by, unexamined, q.memory_charged_bytes,
+                         model_memory_to_dict(q.model));
 }
 
 }  // namespace
@@ -131,8 +132,14 @@ void bind_report(pyb::module_& m) {
       .def_readonly("complete", &CheckReport::complete)
       .def_property_readonly("is_trajectory", [](const CheckReport& r) { return !r.query.has_value(); })
       .def("_query", [](const CheckReport& r) {
-        if (!r.query) throw pyb::value_error("a trajectory report (--path) holds steps, not one query");
+        if (!r.query) throw pyb::value_error("a trajectory report (--path) holds steps, not one query: read it with Replay.from_json");
         return query_tuple(*r.query);
+      })
+      .def("_steps", [](const CheckReport& r) {
+        if (r.query) throw pyb::value_error("a report of one query holds no steps (no --path trajectory): read it with Report.from_json");
+        pyb::list steps;
+        for (const StepReport& s : r.steps) steps.append(pyb::make_tuple(s.step, query_tuple(s.query)));
+        return pyb::make_tuple(r.trajectory, steps, r.steps_not_checked, r.stopped_by);
       });
 }
 

@@ -140,3 +140,33 @@ def test_replay_is_byte_identical_to_check_path(boxes, data_dir, cli_text):
     text = cli_text(boxes, "--path", csv, "--clearance", "0.2")
     assert '"steps"' in text and len(replayed) > 1
     _same_text(replayed.to_json(), text)
+
+
+def test_a_trajectory_report_reads_back_as_a_replay(boxes, data_dir, cli_text):
+    csv = str(data_dir / "collide" / "path_ok.csv")
+    scene = cadclash.Scene(cadclash.load([str(b) for b in boxes]))
+    replayed = cadclash.replay(scene, csv, clearance=0.2)
+    text = cli_text(boxes, "--path", csv, "--clearance", "0.2")
+    back = cadclash.Replay.from_json(text)
+    assert back.to_json() == text
+    assert [s.step for s in back] == [s.step for s in replayed]
+    for read, live in zip(back, replayed):
+        assert [p.key for p in read.report] == [p.key for p in live.report]
+        assert read.report.counters == live.report.counters
+        assert read.report.model == live.report.model and read.report.complete
+        assert [p.distance for p in read.report] == [p.distance for p in live.report]
+    assert back.steps_not_checked == 0
+    with pytest.raises(ValueError, match="Report.from_json"):
+        cadclash.Replay.from_json(cadclash.Scene(cadclash.load([str(b) for b in boxes])).check().to_json())
+
+
+def test_model_bytes_match_the_json_report(as1, as1_path, cli_text):
+    import json
+    report = cadclash.Scene(as1).check()
+    model = json.loads(cli_text([as1_path]))["model"]
+    assert report.model.triangle_count == model["triangles"] > 0
+    assert report.model.total == model["bytes"]["total"]
+    for k in ("triangles", "vertices", "hierarchies", "instances"):
+        assert getattr(report.model, k) == model["bytes"][k] > 0
+    assert cadclash.Report.from_json(report.to_json()).model == report.model
+    assert report.model.bytes_per_triangle == report.model.total / report.model.triangle_count
