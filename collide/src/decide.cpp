@@ -223,36 +223,29 @@ Outline make_outline(const TriangleMesh& mesh) {
   out.segments = boundary_edges(mesh);
   std::vector<Aabb> boxes(out.segments.size());
   for (std::size_t k = 0; k < boxes.size(); ++k) boxes[k].extend(out.segments[k][0]).extend(out.segments[k][1]);
-  out.tree = build_box_bvh(std::move(boxes));
+  out.tree = build_box_bvh(boxes);
   return out;
 }
 
 bool near_outline(const Outline& outline, const Vec3& p, double margin) {
   const SurfaceBvh& tree = outline.tree;
-  if (tree.nodes.empty() || !(margin >= 0.0)) return false;
+  if (tree.empty() || !(margin >= 0.0)) return false;
   // Both distances are a few roundings of the coordinates' magnitude M off (well within the slack
-  // the callers add to their margins); 2^-40 M covers them, so pruning never changes the answer.
-  const Aabb& root = tree.nodes[0].box;
+  // the callers add to their margins); 2^-40 M covers them, so pruning never changes the answer
+  // (the nodes' float boxes, rounded outward, only prune less).
+  const Aabb& root = tree.root;
   const double mag = std::max({p.cwiseAbs().maxCoeff(), root.min().cwiseAbs().maxCoeff(), root.max().cwiseAbs().maxCoeff()});
   const double prune = margin + 0x1p-40 * mag;
   const double m2 = margin * margin;
-  std::uint32_t stack[64];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const SurfaceBvh::Node& node = tree.nodes[stack[--top]];
-    if (node.box.exteriorDistance(p) > prune) continue;
-    if (node.count == 0) {
-      stack[top++] = node.first;
-      stack[top++] = node.first + 1;
-      continue;
-    }
-    for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-      const auto& [a, b] = outline.segments[tree.order[i]];
-      if ((closest_on_segment(p, a, b) - p).squaredNorm() <= m2) return true;
-    }
-  }
-  return false;
+  bool near = false;
+  walk_bvh(
+      tree, [&](const SurfaceBvh::Node& node) { return node.box().exteriorDistance(p) <= prune; },
+      [&](std::uint32_t i) {
+        const auto& [a, b] = outline.segments[i];
+        near = (closest_on_segment(p, a, b) - p).squaredNorm() <= m2;
+        return near;
+      });
+  return near;
 }
 
 namespace {

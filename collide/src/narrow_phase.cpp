@@ -170,17 +170,17 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
   if (options.use_oaabb) {
     // Surface-pair OAABB in A's frame: where a triangle of one side can come within `search` of the
     // other. Built from the triangles' boxes (the BVH roots): a B-rep face's stored box may be looser.
-    const Aabb tri_box_a = bvh_a.nodes.empty() ? Aabb() : bvh_a.nodes[0].box;
-    if (bvh_a.nodes.empty() || bvh_b.nodes.empty()) return;
-    const Aabb tri_box_b = transform_box(bvh_b.nodes[0].box, t_ab);
+    if (bvh_a.empty() || bvh_b.empty()) return;
+    const Aabb& tri_box_a = bvh_a.root;
+    const Aabb tri_box_b = transform_box(bvh_b.root, t_ab);
     ++counters.aabb_updates;
     const Aabb oaabb = pad_box(tri_box_a, search).intersection(pad_box(tri_box_b, search));
     if (oaabb.isEmpty()) return;
-    query_surface_bvh(bvh_a, oaabb, out.la, counters.aabb_tests);
+    query_surface_bvh(bvh_a, sa.mesh, oaabb, out.la, counters.aabb_tests);
     if (out.la.empty()) return;
     const Aabb oaabb_b = transform_box(oaabb, t_ba);  // the single update into B's frame
     ++counters.aabb_updates;
-    query_surface_bvh(bvh_b, oaabb_b, out.lb, counters.aabb_tests);
+    query_surface_bvh(bvh_b, sb.mesh, oaabb_b, out.lb, counters.aabb_tests);
   } else {
     out.la.resize(sa.mesh.triangles.size());
     out.lb.resize(sb.mesh.triangles.size());
@@ -195,7 +195,7 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
   counters.triangles_a += out.la.size();
   counters.triangles_b += out.lb.size();
   out.box_a.resize(out.la.size());
-  for (std::size_t i = 0; i < out.la.size(); ++i) out.box_a[i] = bvh_a.triangle_boxes[out.la[i]];
+  for (std::size_t i = 0; i < out.la.size(); ++i) out.box_a[i] = triangle_box(sa.mesh, out.la[i]);
   out.tri_b.resize(out.lb.size());
   out.box_b.resize(out.lb.size());
   for (std::size_t j = 0; j < out.lb.size(); ++j) {
@@ -371,38 +371,6 @@ void merge_outcome(PairOutcome& into, PairOutcome&& later) {
 }  // namespace cadclash::detail
 
 namespace cadclash {
-
-const char* contact_class_name(ContactClass c) {
-  switch (c) {
-    case ContactClass::Penetrating: return "penetrating";
-    case ContactClass::Touching: return "touching";
-    case ContactClass::Clearance: return "clearance";
-    case ContactClass::Containment: return "containment";
-    case ContactClass::Undecided: return "undecided";
-  }
-  return "unknown";
-}
-
-const char* decided_by_name(DecidedBy d) {
-  switch (d) {
-    case DecidedBy::Mesh: return "mesh";
-    case DecidedBy::MeshExact: return "mesh-exact";
-    case DecidedBy::Analytic: return "analytic";
-    case DecidedBy::Refined: return "refined";
-    case DecidedBy::Exact: return "exact";
-    case DecidedBy::Undecided: return "undecided";
-  }
-  return "unknown";
-}
-
-const char* decision_mode_name(DecisionMode m) {
-  switch (m) {
-    case DecisionMode::Certified: return "certified";
-    case DecisionMode::Fast: return "fast";
-    case DecisionMode::Exact: return "exact";
-  }
-  return "unknown";
-}
 
 namespace detail {
 

@@ -28,6 +28,7 @@ Scene::~Scene() = default;
 void Scene::set_pose(InstanceId instance, const Pose& pose) {
   assert(instance < impl_->poses.size());
   impl_->poses[instance] = pose;
+  if (!impl_->dirty[instance]) impl_->dirty_list.push_back(instance);
   impl_->dirty[instance] = 1;
 }
 
@@ -56,11 +57,13 @@ SceneMemory Scene::memory() const {
     const TriangleMesh& mesh = s.model.surfaces[sid].mesh;
     m.triangles += mesh.triangles.size() * sizeof(mesh.triangles[0]);
     m.vertices += mesh.vertices.size() * sizeof(mesh.vertices[0]);
-    m.hierarchies += detail::bvh_bytes(s.bvh[sid]);
+    m.hierarchies += detail::bvh_heap_bytes(s.bvh[sid]);
     m.triangle_count += mesh.triangles.size();
   }
+  // Every surface has its slot (exact root box, sizes, pointers) and ready flag, built or not.
+  m.hierarchies += s.bvh.size() * (sizeof(detail::SurfaceBvh) + sizeof(s.bvh_ready[0]));
   m.instances = s.poses.size() * sizeof(Pose) + s.world_box.size() * sizeof(Aabb) + s.dirty.size() +
-                s.in_a.size() + s.in_b.size();
+                s.in_a.size() + s.in_b.size() + s.instance_tree.bytes();
   return m;
 }
 

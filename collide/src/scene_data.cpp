@@ -20,7 +20,9 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   poses.resize(n);
   world_box.resize(n);
   dirty.assign(n, 1);
+  dirty_list.resize(n);
   for (InstanceId i = 0; i < n; ++i) {
+    dirty_list[i] = i;
     assert(model.instances[i].part < model.parts.size());
     poses[i] = model.instances[i].pose;
     by_path.emplace(model.instances[i].path, i);

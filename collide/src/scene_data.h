@@ -8,6 +8,7 @@
 #include "decide.h"
 #include "narrow_phase.h"
 #include "refine.h"
+#include "instance_tree.h"
 #include "surface_bvh.h"
 
 #include <array>
@@ -29,6 +30,8 @@ struct SceneData {
   std::vector<double> eps;          // per surface: effective_uncertainty (decide.h)
   std::vector<Aabb> world_box;      // per instance
   std::vector<char> dirty;
+  std::vector<InstanceId> dirty_list;  // the instances with dirty set, in the order they were moved
+  InstanceTree instance_tree;          // built by the first broad phase with a small selection side
   std::vector<SurfaceBvh> bvh;
   std::vector<char> bvh_ready;
   std::vector<RefinedSurface> refined;  // finer faces made for refinement, kept for later queries

@@ -32,24 +32,66 @@ std::vector<std::array<InstanceId, 2>> sweep(const SceneData& s, double margin, 
   return out;
 }
 
+// The side of the selection a persistent tree query serves better than a sweep: a side of at most
+// 1/16 of the instances (one part moving through a large scene); nullptr when neither is that small.
+const std::vector<InstanceId>* small_side(const SceneData& s) {
+  const std::vector<InstanceId>& a = s.selection.set_a;
+  const std::vector<InstanceId>& b = s.selection.set_b;
+  const std::size_t limit = s.poses.size() / 16;
+  const std::vector<InstanceId>* side = nullptr;
+  if (!a.empty() && a.size() <= limit) side = &a;
+  if (!b.empty() && b.size() <= limit && (side == nullptr || b.size() < side->size())) side = &b;
+  return side;
+}
+
+// The sweep's pairs, found from each instance of `side` through the instance tree: every pair the
+// sweep would test with one instance in `side` is tested here with the sweep's own overlap test
+// (the tree only skips instances whose boxes cannot pass it), so the pairs are the same.
+std::vector<std::array<InstanceId, 2>> tree_pairs(SceneData& s, const std::vector<InstanceId>& side,
+                                                  double margin, CollideCounters& c) {
+  if (!s.instance_tree.built()) s.instance_tree.build(s.world_box);
+  s.instance_tree.rebuild_if_worn(s.world_box);
+  const double half = 0.5 * margin;
+  // pad_box(b, half) grows b by half + kRelativePad·(1 + |b|) <= half + kRelativePad·(1 + |bounds|);
+  // twice that pad on the query box covers it and the rounding of the comparisons.
+  const double reach = half + 2.0 * kRelativePad * (1.0 + box_magnitude(s.instance_tree.bounds()));
+  std::vector<std::array<InstanceId, 2>> out;
+  for (InstanceId i : side) {
+    if (!(s.in_a[i] || s.in_b[i]) || s.world_box[i].isEmpty()) continue;
+    const Aabb pi = pad_box(s.world_box[i], half);
+    s.instance_tree.query(pad_box(pi, reach), [&](InstanceId j) {
+      if (j == i) return;
+      ++c.aabb_tests;
+      const InstanceId a = std::min(i, j), b = std::max(i, j);
+      if (boxes_overlap(pi, pad_box(s.world_box[j], half)) && s.selected(a, b)) out.push_back({a, b});
+    });
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 }  // namespace
 
 void broad_phase_stage(SceneData& s, QueryState& q) {
   const CollideOptions& o = q.o;
   Model& model = s.model;
   CollideCounters& total = q.report.counters;
-  // Only moved instances get new world boxes.
-  for (InstanceId i = 0; i < s.poses.size(); ++i) {
-    if (!s.dirty[i]) continue;
+  // Only moved instances get new world boxes (and refit the instance tree when there is one).
+  for (InstanceId i : s.dirty_list) {
     s.world_box[i] = transform_box(s.part_box[model.instances[i].part], s.poses[i]);
     ++total.aabb_updates;
     s.dirty[i] = 0;
+    if (s.instance_tree.built()) s.instance_tree.refit(i, s.world_box[i]);
   }
+  s.dirty_list.clear();
   std::vector<std::array<InstanceId, 2>> ids;
   if (o.use_oaabb) {
     double share = 0.0;  // the largest deflection (+ uncertainty) any surface brings to the reach
     for (PartId p = 0; p < model.parts.size(); ++p) share = std::max(share, s.part_reach_share(p, o));
-    ids = sweep(s, search_reach(o, share, share, 0.0), total);
+    const double margin = search_reach(o, share, share, 0.0);
+    const std::vector<InstanceId>* side = small_side(s);
+    ids = side != nullptr ? tree_pairs(s, *side, margin, total) : sweep(s, margin, total);
   } else {
     for (InstanceId i = 0; i < s.poses.size(); ++i)
       for (InstanceId j = i + 1; j < s.poses.size(); ++j)

@@ -46,7 +46,7 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
 void build_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wave) {
   for (SurfaceId sid : build_trees(s, wave, q.threads, q.deadline)) {
     q.built.push_back(sid);
-    q.charge[q.first_need[sid]] += bvh_bytes(s.bvh[sid]);
+    q.charge[q.first_need[sid]] += bvh_heap_bytes(s.bvh[sid]);
   }
 }
 

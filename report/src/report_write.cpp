@@ -1,34 +1,10 @@
-// The report's writer: enum names, the model + query → QueryReport resolution, and the JSON.
+// The report's writer: the model + query → QueryReport resolution, and the JSON.
 #include "cadclash/report.h"
 
 #include <cmath>
 #include <limits>
 
 namespace cadclash {
-
-const char* collide_mode_name(CollideMode m) {
-  return m == CollideMode::AllTrianglePairs ? "all-triangle-pairs" : "early-exit";
-}
-
-const char* parallel_version_name(ParallelVersion v) { return v == ParallelVersion::V2 ? "v2" : "v1"; }
-
-const char* schedule_name(Schedule s) {
-  switch (s) {
-    case Schedule::Dynamic: return "dynamic";
-    case Schedule::Static: return "static";
-    case Schedule::Guided: break;
-  }
-  return "guided";
-}
-
-const char* triangle_level_name(TriangleLevel t) {
-  switch (t) {
-    case TriangleLevel::Flat: return "flat";
-    case TriangleLevel::Bvh: return "bvh";
-    case TriangleLevel::Auto: break;
-  }
-  return "auto";
-}
 
 ReportSettings report_settings(const CollideOptions& o) {
   ReportSettings s;

@@ -141,13 +141,19 @@ enum class CollideMode : std::uint8_t {
   EarlyExit,          // per surface pair, stop at the first triangle pair that decides the class
   AllTrianglePairs,   // visit every candidate triangle pair and list all intersecting ones
 };
+// Returns "early-exit" or "all-triangle-pairs".
+const char* collide_mode_name(CollideMode m);
 
 // How the candidate surface pairs are spread over threads.
 enum class ParallelVersion : std::uint8_t {
   V1,  // one work item per candidate surface pair (the paper's Version 1)
   V2,  // one work item per (surface pair, block of A's surviving triangles): the flattened index
 };
+// Returns "v1" or "v2".
+const char* parallel_version_name(ParallelVersion v);
 enum class Schedule : std::uint8_t { Guided, Dynamic, Static };
+// Returns "guided", "dynamic" or "static".
+const char* schedule_name(Schedule s);
 
 // How candidate triangle pairs are formed under the surface-pair OAABB.
 enum class TriangleLevel : std::uint8_t {
@@ -155,6 +161,8 @@ enum class TriangleLevel : std::uint8_t {
   Flat,  // the paper's loops: every triangle of Sk against every triangle of Sl, box test first
   Bvh,   // per-surface BVH queried under the OAABB, candidate pairs by a sweep over the survivors
 };
+// Returns "auto", "flat" or "bvh".
+const char* triangle_level_name(TriangleLevel t);
 
 struct CollideOptions {
   double tolerance = 0.0;         // contact tolerance t, mm (>= 0)

@@ -40,17 +40,8 @@ inline constexpr int kCheckReportVersion = 2;
 // Enum names: every value of each enum the report spells out, and its name
 // ---------------------------------------------------------------------------------------------
 
-// Returns "early-exit" or "all-triangle-pairs".
-const char* collide_mode_name(CollideMode m);
-// Returns "v1" or "v2".
-const char* parallel_version_name(ParallelVersion v);
-// Returns "guided", "dynamic" or "static".
-const char* schedule_name(Schedule s);
-// Returns "auto", "flat" or "bvh".
-const char* triangle_level_name(TriangleLevel t);
-
 // EnumNames<E>::values lists every value of E in declaration order; EnumNames<E>::name(e) is its
-// name in the report (contact_class_name, decided_by_name, ... of collide.h and model.h).
+// name in the report (contact_class_name, collide_mode_name, ... of collide.h; source_kind_name of model.h).
 template <class E> struct EnumNames;
 template <> struct EnumNames<ContactClass> {
   static constexpr std::array values{ContactClass::Penetrating, ContactClass::Touching, ContactClass::Clearance,
