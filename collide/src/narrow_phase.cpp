@@ -216,21 +216,63 @@ std::size_t prepared_bytes(const PreparedPair& p) {
          p.tri_b.size() * sizeof(p.tri_b[0]);
 }
 
-void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
-              const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
-              const Deadline* deadline) {
+namespace {
+
+// One run of the triangle level over a range of A's survivors: the state the candidate visits share.
+struct TriangleRun {
+  TriangleRun(const Surface& surface_a, const PreparedPair& prepared, const CollideOptions& o, PairOutcome& outcome,
+              CollideCounters& c, const Deadline* d)
+      : sa(surface_a), p(prepared), options(o), out(outcome), counters(c), deadline(d) {}
+  const Surface& sa;
+  const PreparedPair& p;
+  const CollideOptions& options;
+  PairOutcome& out;
+  CollideCounters& counters;
+  const Deadline* deadline;
   TrianglePredicateStats stats;
   const bool all = options.mode == CollideMode::AllTrianglePairs;
   const bool want_distance = p.margin > 0.0;
   bool done = false;
   std::uint32_t polls = 0;
-  // Normals for the penetration-only tests below: A's is reused over the run of candidates with the
-  // same triangle of A, B's are kept once computed.
+  // Normals for the penetration-only tests: A's is reused over the run of candidates with the same
+  // triangle of A, B's are kept once computed.
   std::size_t normal_of = ~std::size_t{0};
   Vec3 normal_a;
   std::vector<Vec3> normals_b;
   std::vector<char> have_normal_b;
-  auto test = [&](std::size_t i, std::size_t j) {
+
+  // Once the run has an intersecting pair, another can change the outcome only by raising the
+  // penetration (the maximum crossing depth; deeper than tau ends the run). A pair whose crossing
+  // depth, computed exactly as crossing_depth does, does not exceed it is skipped without the
+  // intersection test: whether it intersects changes nothing. Most candidates of a contact are
+  // decided by the plane sides alone.
+  void raise_penetration(std::size_t i, std::size_t j, const Vec3& a0, const Vec3& a1, const Vec3& a2,
+                         const std::array<Vec3, 3>& tb) {
+    if (normal_of != i) {
+      normal_a = facet_normal(a0, a1, a2);
+      normal_of = i;
+    }
+    if (normals_b.empty()) {
+      normals_b.resize(p.lb.size());
+      have_normal_b.assign(p.lb.size(), 0);
+    }
+    if (!have_normal_b[j]) {
+      normals_b[j] = facet_normal(tb[0], tb[1], tb[2]);
+      have_normal_b[j] = 1;
+    }
+    const Vec3& normal_b = normals_b[j];
+    if (!may_straddle(a0, a1, a2, tb[0], normal_b) || !may_straddle(tb[0], tb[1], tb[2], a0, normal_a)) return;
+    const double over_b = clipped_straddle(a0, a1, a2, tb[0], tb[1], tb[2], normal_b);
+    if (!(over_b > out.penetration)) return;
+    const double depth = std::min(over_b, clipped_straddle(tb[0], tb[1], tb[2], a0, a1, a2, normal_a));
+    if (!(depth > out.penetration)) return;
+    if (!triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) return;
+    out.penetration = depth;
+    if (depth > p.tau) done = true;
+  }
+
+  // Candidate (A's survivor i, B's survivor j).
+  void test(std::size_t i, std::size_t j) {
     if (deadline != nullptr && (++polls & 255u) == 0 && deadline->expired()) {
       out.cut = true;
       done = true;
@@ -242,32 +284,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
     const Vec3& a2 = sa.mesh.vertices[ta[2]];
     const auto& tb = p.tri_b[j];
     if (out.intersecting && !all) {
-      // Once the run has an intersecting pair, another can change the outcome only by raising the
-      // penetration (the maximum crossing depth; deeper than tau ends the run). A pair whose crossing
-      // depth, computed exactly as crossing_depth does, does not exceed it is skipped without the
-      // intersection test: whether it intersects changes nothing. Most candidates of a contact are
-      // decided by the plane sides alone.
-      if (normal_of != i) {
-        normal_a = facet_normal(a0, a1, a2);
-        normal_of = i;
-      }
-      if (normals_b.empty()) {
-        normals_b.resize(p.lb.size());
-        have_normal_b.assign(p.lb.size(), 0);
-      }
-      if (!have_normal_b[j]) {
-        normals_b[j] = facet_normal(tb[0], tb[1], tb[2]);
-        have_normal_b[j] = 1;
-      }
-      const Vec3& normal_b = normals_b[j];
-      if (!may_straddle(a0, a1, a2, tb[0], normal_b) || !may_straddle(tb[0], tb[1], tb[2], a0, normal_a)) return;
-      const double over_b = clipped_straddle(a0, a1, a2, tb[0], tb[1], tb[2], normal_b);
-      if (!(over_b > out.penetration)) return;
-      const double depth = std::min(over_b, clipped_straddle(tb[0], tb[1], tb[2], a0, a1, a2, normal_a));
-      if (!(depth > out.penetration)) return;
-      if (!triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) return;
-      out.penetration = depth;
-      if (depth > p.tau) done = true;
+      raise_penetration(i, j, a0, a1, a2, tb);
       return;
     }
     if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
@@ -289,71 +306,84 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
         }
       }
     }
-  };
+  }
+};
 
+// Sweep over x of A's survivors [begin, end) (grown by the margin) and B's; candidates are then
+// visited in the same (a, b) order as the flat loops, so both variants give the same answer. The
+// boxes are copied in sweep order so that the inner loops read memory in sequence.
+void sweep_candidates(TriangleRun& run, std::size_t begin, std::size_t end) {
+  const PreparedPair& p = run.p;
   const std::size_t na = end - begin, nb = p.lb.size();
-  if (!options.use_oaabb) {
-    for (std::size_t i = begin; i < end && !done; ++i)
-      for (std::size_t j = 0; j < nb && !done; ++j) test(i, j);
-  } else if (options.triangle_level == TriangleLevel::Flat ||
-             (options.triangle_level == TriangleLevel::Auto && na * nb <= options.flat_limit)) {
-    for (std::size_t i = begin; i < end && !done; ++i)
-      for (std::size_t j = 0; j < nb && !done; ++j) {
-        ++counters.aabb_tests;
-        if (boxes_within(p.box_a[i], p.box_b[j], p.margin)) test(i, j);
+  std::vector<std::uint32_t> oa(na), ob(nb);
+  for (std::size_t i = 0; i < na; ++i) oa[i] = static_cast<std::uint32_t>(begin + i);
+  for (std::size_t j = 0; j < nb; ++j) ob[j] = static_cast<std::uint32_t>(j);
+  auto by_min_a = [&](std::uint32_t x, std::uint32_t y) {
+    return p.box_a[x].min().x() < p.box_a[y].min().x() || (p.box_a[x].min().x() == p.box_a[y].min().x() && x < y);
+  };
+  auto by_min_b = [&](std::uint32_t x, std::uint32_t y) {
+    return p.box_b[x].min().x() < p.box_b[y].min().x() || (p.box_b[x].min().x() == p.box_b[y].min().x() && x < y);
+  };
+  std::sort(oa.begin(), oa.end(), by_min_a);
+  std::sort(ob.begin(), ob.end(), by_min_b);
+  const std::vector<SweepBox> sa_boxes = sweep_boxes(p.box_a, oa), sb_boxes = sweep_boxes(p.box_b, ob);
+  std::vector<std::array<std::uint32_t, 2>> cand;
+  std::size_t ia = 0, ib = 0;
+  const double m = p.margin;
+  while (ia < na && ib < nb) {
+    const SweepBox& ba = sa_boxes[ia];
+    const SweepBox& bb = sb_boxes[ib];
+    if (ba.lo[0] - m <= bb.lo[0]) {
+      for (std::size_t k = ib; k < nb && sb_boxes[k].lo[0] <= ba.hi[0] + m; ++k) {
+        ++run.counters.aabb_tests;
+        if (sweep_within(ba, sb_boxes[k], m)) cand.push_back({oa[ia], ob[k]});
       }
-  } else {
-    // Sweep over x of A's survivors (grown by the margin) and B's; candidates are then visited in
-    // the same (a, b) order as the flat loops, so both variants give the same answer. The boxes are
-    // copied in sweep order so that the inner loops read memory in sequence.
-    std::vector<std::uint32_t> oa(na), ob(nb);
-    for (std::size_t i = 0; i < na; ++i) oa[i] = static_cast<std::uint32_t>(begin + i);
-    for (std::size_t j = 0; j < nb; ++j) ob[j] = static_cast<std::uint32_t>(j);
-    auto by_min_a = [&](std::uint32_t x, std::uint32_t y) {
-      return p.box_a[x].min().x() < p.box_a[y].min().x() || (p.box_a[x].min().x() == p.box_a[y].min().x() && x < y);
-    };
-    auto by_min_b = [&](std::uint32_t x, std::uint32_t y) {
-      return p.box_b[x].min().x() < p.box_b[y].min().x() || (p.box_b[x].min().x() == p.box_b[y].min().x() && x < y);
-    };
-    std::sort(oa.begin(), oa.end(), by_min_a);
-    std::sort(ob.begin(), ob.end(), by_min_b);
-    const std::vector<SweepBox> sa_boxes = sweep_boxes(p.box_a, oa), sb_boxes = sweep_boxes(p.box_b, ob);
-    std::vector<std::array<std::uint32_t, 2>> cand;
-    std::size_t ia = 0, ib = 0;
-    const double m = p.margin;
-    while (ia < na && ib < nb) {
-      const SweepBox& ba = sa_boxes[ia];
-      const SweepBox& bb = sb_boxes[ib];
-      if (ba.lo[0] - m <= bb.lo[0]) {
-        for (std::size_t k = ib; k < nb && sb_boxes[k].lo[0] <= ba.hi[0] + m; ++k) {
-          ++counters.aabb_tests;
-          if (sweep_within(ba, sb_boxes[k], m)) cand.push_back({oa[ia], ob[k]});
-        }
-        ++ia;
-      } else {
-        for (std::size_t k = ia; k < na && sa_boxes[k].lo[0] - m <= bb.hi[0]; ++k) {
-          ++counters.aabb_tests;
-          if (sweep_within(sa_boxes[k], bb, m)) cand.push_back({oa[k], ob[ib]});
-        }
-        ++ib;
+      ++ia;
+    } else {
+      for (std::size_t k = ia; k < na && sa_boxes[k].lo[0] - m <= bb.hi[0]; ++k) {
+        ++run.counters.aabb_tests;
+        if (sweep_within(sa_boxes[k], bb, m)) cand.push_back({oa[k], ob[ib]});
       }
-    }
-    // Visit in (a, b) order: a counting sort by A's triangle, then each triangle's few b's sorted.
-    std::vector<std::uint32_t> first(na + 1, 0), by_a(cand.size());
-    for (const auto& c : cand) ++first[c[0] - begin + 1];
-    for (std::size_t i = 0; i < na; ++i) first[i + 1] += first[i];
-    {
-      std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-      for (const auto& c : cand) by_a[fill[c[0] - begin]++] = c[1];
-    }
-    for (std::size_t i = 0; i < na && !done; ++i) {
-      const auto from = by_a.begin() + first[i], to = by_a.begin() + first[i + 1];
-      std::sort(from, to);
-      for (auto it = from; it != to && !done; ++it) test(begin + i, *it);
+      ++ib;
     }
   }
-  counters.triangle_tests += stats.tests;
-  counters.exact_fallbacks += stats.exact_fallbacks;
+  // Visit in (a, b) order: a counting sort by A's triangle, then each triangle's few b's sorted.
+  std::vector<std::uint32_t> first(na + 1, 0), by_a(cand.size());
+  for (const auto& c : cand) ++first[c[0] - begin + 1];
+  for (std::size_t i = 0; i < na; ++i) first[i + 1] += first[i];
+  {
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (const auto& c : cand) by_a[fill[c[0] - begin]++] = c[1];
+  }
+  for (std::size_t i = 0; i < na && !run.done; ++i) {
+    const auto from = by_a.begin() + first[i], to = by_a.begin() + first[i + 1];
+    std::sort(from, to);
+    for (auto it = from; it != to && !run.done; ++it) run.test(begin + i, *it);
+  }
+}
+
+}  // namespace
+
+void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
+              const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
+              const Deadline* deadline) {
+  TriangleRun run(sa, p, options, out, counters, deadline);
+  const std::size_t na = end - begin, nb = p.lb.size();
+  if (!options.use_oaabb) {
+    for (std::size_t i = begin; i < end && !run.done; ++i)
+      for (std::size_t j = 0; j < nb && !run.done; ++j) run.test(i, j);
+  } else if (options.triangle_level == TriangleLevel::Flat ||
+             (options.triangle_level == TriangleLevel::Auto && na * nb <= options.flat_limit)) {
+    for (std::size_t i = begin; i < end && !run.done; ++i)
+      for (std::size_t j = 0; j < nb && !run.done; ++j) {
+        ++counters.aabb_tests;
+        if (boxes_within(p.box_a[i], p.box_b[j], p.margin)) run.test(i, j);
+      }
+  } else {
+    sweep_candidates(run, begin, end);
+  }
+  counters.triangle_tests += run.stats.tests;
+  counters.exact_fallbacks += run.stats.exact_fallbacks;
 }
 
 void merge_outcome(PairOutcome& into, PairOutcome&& later) {
