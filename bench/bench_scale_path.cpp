@@ -15,6 +15,7 @@
 #include "compare_workload.h"
 
 #include "cadclash/import.h"
+#include "cadclash/report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -42,12 +43,7 @@ struct PathRun {
 };
 
 void add(CollideCounters& into, const CollideCounters& c) {
-  into.aabb_tests += c.aabb_tests;
-  into.aabb_updates += c.aabb_updates;
-  into.instance_pairs += c.instance_pairs;
-  into.surface_pairs += c.surface_pairs;
-  into.triangle_tests += c.triangle_tests;
-  into.exact_fallbacks += c.exact_fallbacks;
+  for (const CounterField& f : kCounterFields) into.*f.member += c.*f.member;
 }
 
 PathRun run_path(Model& model, InstanceId nut, const cb::GeneratedPath& path, CollideOptions o, std::size_t stride) {
@@ -89,15 +85,9 @@ bool same_pairs(const std::vector<SurfacePairResult>& x, const std::vector<Surfa
 }
 
 bool same_counters(const CollideCounters& a, const CollideCounters& b) {
-  return a.aabb_tests == b.aabb_tests && a.aabb_updates == b.aabb_updates && a.triangle_tests == b.triangle_tests &&
-         a.surface_pairs == b.surface_pairs && a.exact_fallbacks == b.exact_fallbacks &&
-         a.instance_pairs == b.instance_pairs;
-}
-
-nlohmann::json counters_json(const CollideCounters& c) {
-  return {{"aabb_tests", c.aabb_tests},         {"aabb_updates", c.aabb_updates},
-          {"instance_pairs", c.instance_pairs}, {"surface_pairs", c.surface_pairs},
-          {"triangle_tests", c.triangle_tests}, {"exact_fallbacks", c.exact_fallbacks}};
+  for (const CounterField& f : kCounterFields)
+    if (a.*f.member != b.*f.member) return false;
+  return true;
 }
 
 int usage() {
