@@ -170,3 +170,23 @@ def test_model_bytes_match_the_json_report(as1, as1_path, cli_text):
         assert getattr(report.model, k) == model["bytes"][k] > 0
     assert cadclash.Report.from_json(report.to_json()).model == report.model
     assert report.model.bytes_per_triangle == report.model.total / report.model.triangle_count
+
+
+@pytest.mark.parametrize("preset,deflection,angular", [("coarse", 1.0, 0.8), ("normal", 0.1, 0.5),
+                                                      ("fine", 0.01, 0.25)])
+@pytest.mark.parametrize("lazy", [False, True])
+def test_presets_equal_their_explicit_deflections(as1_path, preset, deflection, angular, lazy):
+    """A preset is resolved once, before anything reads it (issue 19): load(preset=P) reports what
+    load(deflection=d, angular=a) of that preset reports, with and without lazy tessellation, and
+    the settings show the deflections in effect."""
+    import json
+    by_preset = json.loads(cadclash.Scene(cadclash.load(as1_path, preset=preset, lazy=lazy)).check().to_json())
+    explicit = json.loads(cadclash.Scene(cadclash.load(as1_path, deflection=deflection, angular=angular,
+                                                       lazy=lazy)).check().to_json())
+    assert by_preset["pairs"] == explicit["pairs"] and by_preset["pairs"]
+    assert by_preset["settings"]["preset"] == preset and explicit["settings"]["preset"] is None
+    for doc in (by_preset, explicit):
+        assert doc["settings"]["deflection"] == deflection
+        assert doc["settings"]["angular_deflection"] == angular
+        assert doc["settings"]["lazy"] == lazy
+    assert all(p[side]["deflection"] <= deflection for p in by_preset["pairs"] for side in ("a", "b"))
