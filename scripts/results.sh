@@ -13,7 +13,7 @@ cd "$root"
 
 # Configured as scripts/build.sh does, but only the programs this page runs are built: a whole tree
 # takes longer than the benchmarks.
-echo "results: building $build (bench_accuracy, bench_compare, test_triangle_predicates)"
+echo "results: building $build (bench_accuracy, bench_compare, bench_scale_path, test_triangle_predicates)"
 generator=()
 if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
@@ -22,7 +22,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
 else
   cmake -S "$root" -B "$build" -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_TESTS=ON >/dev/null
 fi
-cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates
+cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates bench_scale_path
 compare_built=no
 if cmake --build "$build" --target help | grep -q '^bench_compare:'; then
   if cmake --build "$build" -j "$(nproc)" --target bench_compare; then compare_built=yes
@@ -43,6 +43,9 @@ else
   rm -f "$out/compare.md"
   compare_status="skipped"
 fi
+
+echo "results: one part moving through a large scene (bench_scale_path)"
+"$build/bench/bench_scale_path" --data data/external --out "$out/scale.json" >"$out/scale.md"
 
 echo "results: numerical extremes (triangle test against the exact oracle)"
 "$build/tests/collide/test_triangle_predicates" --gtest_filter='Families/OracleAgreement.*' >"$out/extremes.log" 2>&1 || {
@@ -84,6 +87,7 @@ while IFS= read -r line || [ -n "$line" ]; do
       ;;
     @ACCURACY@) relink "$out/accuracy.md" ;;
     @EXTREMES@) cat "$out/extremes.md" ;;
+    @SCALE@) cat "$out/scale.md" ;;
     *) printf '%s\n' "$line" ;;
   esac
 done <"$docs/template.md" >"$page"
