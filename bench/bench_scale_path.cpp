@@ -1,11 +1,12 @@
 // Issue 16 items 4-6: one part moving through a large instanced scene, and the scene's one-shot cost.
-//   bench_scale_path [--data DIR] [--out FILE.json] [--copies N] [--deflection D] [--steps N]
+//   bench_scale_path [--data DIR] [--out FILE.json] [--series FILE.dat] [--copies N] [--deflection D] [--steps N]
 // The scene: N copies of as1-tu-203.stp (default 290: 5,220 instances, ~10 M instance triangles at
 // 0.001 mm) on a grid, sharing the parts (bench_compare's instanced scene). Copy 0's NUT::3 is
 // unscrewed off its bolt (bench_compare's "unscrew" path) while every other instance stays.
 // Measured, with the certified default, on 1 and 2 threads:
 // - build: Scene::build_hierarchies on one thread, model triangles per second;
-// - one-shot: one check of every instance pair of the scene;
+// - one-shot: one check of every instance pair, for 1, 3, 10, 30, 100 copies and the whole scene
+//   (--series writes "copies instance_triangles seconds_1 seconds_2" rows for the log-log plot);
 // - path: per step set_pose + check of the pairs with the nut (SceneSelection set_a = {nut}): median,
 //   90th percentile and largest step time; the reports must not depend on the thread count (the
 //   pairs and counters of every step are compared, and a difference is an error, exit 1);
@@ -99,14 +100,15 @@ bool same_counters(const CollideCounters& a, const CollideCounters& b) {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: bench_scale_path [--data DIR] [--out FILE.json] [--copies N] [--deflection D] [--steps N]\n");
+               "usage: bench_scale_path [--data DIR] [--out FILE.json] [--series FILE.dat] [--copies N] [--deflection D] "
+               "[--steps N]\n");
   return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string data = CADCLASH_DATA_DIR "/external", out;
+  std::string data = CADCLASH_DATA_DIR "/external", out, series_out;
   std::uint32_t copies = 290;
   double deflection = 0.001;
   int steps = 500;
@@ -116,6 +118,7 @@ int main(int argc, char** argv) {
     const std::string v = argv[++i];
     if (a == "--data") data = v;
     else if (a == "--out") out = v;
+    else if (a == "--series") series_out = v;
     else if (a == "--copies") copies = static_cast<std::uint32_t>(std::stoul(v));
     else if (a == "--deflection") deflection = std::stod(v);
     else if (a == "--steps") steps = std::stoi(v);
@@ -175,22 +178,43 @@ int main(int argc, char** argv) {
        fmt("%.1f", 1e-6 * static_cast<double>(model_triangles) / build_seconds) + " M model triangles per second.");
   line("");
 
-  // One-shot: every instance pair of the scene.
-  double one_shot[2] = {0.0, 0.0};
-  std::size_t one_shot_pairs = 0;
-  for (int threads : {1, 2}) {
-    Scene scene(scene_model);
-    scene.build_hierarchies(threads);
-    CollideOptions o;
-    o.threads = threads;
-    const auto t0 = std::chrono::steady_clock::now();
-    const Report r = scene.check(o);
-    one_shot[threads - 1] = seconds_since(t0);
-    one_shot_pairs = r.pairs.size();
-    j["one_shot"][std::to_string(threads)] = {{"seconds", one_shot[threads - 1]}, {"pairs", r.pairs.size()},
-                                              {"counters", counters_json(r.counters)}};
-    std::fprintf(stderr, "one-shot, %d thread(s): %.3f s\n", threads, one_shot[threads - 1]);
+  // One-shot: every instance pair, for a series of scene sizes up to the whole scene (the time vs
+  // triangles plot and the parallel efficiency of issue 16 item 5).
+  struct OneShot {
+    std::uint32_t copies = 0;
+    std::size_t instance_triangles = 0, pairs = 0;
+    double seconds[2] = {0.0, 0.0};
+  };
+  std::vector<OneShot> series;
+  for (std::uint32_t c : {1u, 3u, 10u, 30u, 100u, copies}) {
+    if (c > copies || (!series.empty() && series.back().copies >= c)) continue;
+    Model m = cb::instanced_grid(base, c);
+    OneShot row;
+    row.copies = c;
+    row.instance_triangles = cb::instance_triangle_count(m);
+    for (int threads : {1, 2}) {
+      Scene scene(m);
+      scene.build_hierarchies(threads);
+      CollideOptions o;
+      o.threads = threads;
+      const auto t0 = std::chrono::steady_clock::now();
+      const Report r = scene.check(o);
+      row.seconds[threads - 1] = seconds_since(t0);
+      row.pairs = r.pairs.size();
+      j["one_shot"][std::to_string(c)][std::to_string(threads)] = {
+          {"seconds", row.seconds[threads - 1]}, {"pairs", r.pairs.size()}, {"counters", counters_json(r.counters)}};
+      std::fprintf(stderr, "one-shot, %u copies, %d thread(s): %.3f s\n", c, threads, row.seconds[threads - 1]);
+    }
+    series.push_back(row);
   }
+  if (!series_out.empty()) {
+    std::ofstream dat(series_out);
+    dat << "# copies instance_triangles seconds_1_thread seconds_2_threads\n";
+    for (const OneShot& r : series)
+      dat << r.copies << ' ' << r.instance_triangles << ' ' << r.seconds[0] << ' ' << r.seconds[1] << '\n';
+  }
+  const double one_shot[2] = {series.back().seconds[0], series.back().seconds[1]};
+  const std::size_t one_shot_pairs = series.back().pairs;
 
   // The path through the big scene.
   const std::string nut_path = "/copy0/as1/L-BRACKET-ASSEMBLY::1/NUT-BOLT-ASSEMBLY::1/NUT::3";
@@ -240,6 +264,17 @@ int main(int argc, char** argv) {
   line("| path: instance pairs / triangle tests over all steps | " + std::to_string(runs[0].counters.instance_pairs) +
        " / " + std::to_string(runs[0].counters.triangle_tests) + " | " + std::to_string(runs[1].counters.instance_pairs) +
        " / " + std::to_string(runs[1].counters.triangle_tests) + " |");
+  line("");
+
+  line("One-shot query time by scene size (the same grid with fewer copies; parallel efficiency = "
+       "time on 1 thread / (2 x time on 2 threads)):");
+  line("");
+  line("| copies | instance triangles | reported pairs | 1 thread | 2 threads | parallel efficiency |");
+  line("|---:|---:|---:|---:|---:|---:|");
+  for (const OneShot& r : series)
+    line("| " + std::to_string(r.copies) + " | " + std::to_string(r.instance_triangles) + " | " +
+         std::to_string(r.pairs) + " | " + fmt("%.3f s", r.seconds[0]) + " | " + fmt("%.3f s", r.seconds[1]) + " | " +
+         fmt("%.0f %%", 100.0 * r.seconds[0] / (2.0 * r.seconds[1])) + " |");
   line("");
 
   // Table 2 on the as1 assembly alone: the same path, OAABB vs brute force, every 10th step.

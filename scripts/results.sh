@@ -45,7 +45,24 @@ else
 fi
 
 echo "results: one part moving through a large scene (bench_scale_path)"
-"$build/bench/bench_scale_path" --data data/external --out "$out/scale.json" >"$out/scale.md"
+"$build/bench/bench_scale_path" --data data/external --out "$out/scale.json" --series "$out/scale_series.dat" \
+  >"$out/scale.md"
+gnuplot <<GP
+set terminal svg size 640,420 font "sans,11"
+set output "$out/scale_series.svg"
+set logscale xy
+set xlabel "instance triangles"
+set ylabel "one-shot query (s)"
+set key top left
+set grid
+set fit quiet logfile "/dev/null"
+f(x) = a * x
+a = 1e-6
+fit f(x) "$out/scale_series.dat" using 2:3 via a
+plot "$out/scale_series.dat" using 2:3 with linespoints title "1 thread", \
+     "$out/scale_series.dat" using 2:4 with linespoints title "2 threads", \
+     f(x) with lines dashtype 2 title "linear growth (fit to 1 thread)"
+GP
 
 echo "results: numerical extremes (triangle test against the exact oracle)"
 "$build/tests/collide/test_triangle_predicates" --gtest_filter='Families/OracleAgreement.*' >"$out/extremes.log" 2>&1 || {
