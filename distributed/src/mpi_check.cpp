@@ -46,6 +46,28 @@ PartialCheck run_part(Scene& scene, const Model& model, const CollideOptions& o,
   return p;
 }
 
+// The rank's run of the plan's pairs. The costs count the triangles of the surfaces a rank has
+// tessellated, which differ between ranks: rank 0's split is broadcast (as run boundaries).
+std::vector<std::uint32_t> my_part(const CheckPlan& plan, int rank, int size, MPI_Comm comm) {
+  std::vector<unsigned> bounds(static_cast<std::size_t>(size) + 1, 0);
+  if (rank == 0) {
+    const std::vector<std::vector<std::uint32_t>> parts = split_by_cost(plan, size);
+    for (int r = 0; r < size; ++r)
+      bounds[static_cast<std::size_t>(r) + 1] =
+          bounds[static_cast<std::size_t>(r)] + static_cast<unsigned>(parts[static_cast<std::size_t>(r)].size());
+  }
+  check_mpi(MPI_Bcast(bounds.data(), size + 1, MPI_UNSIGNED, 0, comm), "MPI_Bcast", comm);
+  if (bounds.back() != plan.pairs.size()) {
+    std::fprintf(stderr, "cadclash check: rank %d planned %zu instance pairs, rank 0 %u: the replicas differ\n", rank,
+                 plan.pairs.size(), bounds.back());
+    MPI_Abort(comm, 1);
+  }
+  std::vector<std::uint32_t> mine;
+  for (unsigned k = bounds[static_cast<std::size_t>(rank)]; k < bounds[static_cast<std::size_t>(rank) + 1]; ++k)
+    mine.push_back(k);
+  return mine;
+}
+
 // Every rank's bytes on rank 0 (empty elsewhere).
 std::vector<std::vector<std::uint8_t>> gather_bytes(const std::vector<std::uint8_t>& mine, int rank, int size,
                                                     MPI_Comm comm) {
@@ -125,9 +147,8 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
-  const CheckPlan plan = scene.plan(o);  // the same on every replica
-  const std::vector<std::vector<std::uint32_t>> parts = split_by_cost(plan, size);
-  const std::vector<std::uint32_t>& mine = parts[static_cast<std::size_t>(rank)];
+  const CheckPlan plan = scene.plan(o);  // the same pairs on every replica
+  const std::vector<std::uint32_t> mine = my_part(plan, rank, size, comm);
   const auto t0 = std::chrono::steady_clock::now();
   const PartialCheck part = run_part(scene, model, o, plan, mine, rank, size, comm);
   RankStats stats;

@@ -2,9 +2,9 @@
 // the report one process gives.
 //
 // How (collide.h, "One check split over processes"): every rank imports the same files and builds
-// the same Scene (replicated: assembly, B-rep, poses); every rank computes the same plan (broad phase
-// and surface level: boxes only); the plan's instance pairs are split into contiguous runs of equal
-// estimated cost; each rank checks its run (check_part), tessellating only the surfaces its pairs
+// the same Scene (replicated: assembly, B-rep, poses); every rank computes the plan (broad phase and
+// surface level: boxes only; the same pairs everywhere); rank 0 splits its pairs into contiguous runs
+// of equal estimated cost; each rank checks its run (check_part), tessellating only the surfaces its pairs
 // reach (with lazy tessellation; otherwise the import already tessellated everything); rank 0 gathers
 // the parts and merges them in a fixed order. The merged Report equals Scene::check()'s in every
 // field a `--no-timings` report holds, for any number of ranks and threads (pairs, counters,
@@ -95,7 +95,8 @@ struct DistributedCheck {
   std::vector<RankStats> ranks;  // rank 0: one per rank; other ranks: empty
 };
 
-// Scene::check(options) over the ranks of `comm`. `history` (MergeHistory(surface count,
+// Scene::check(options) over the ranks of `comm`: the plan on every rank, rank 0's split (its cost
+// estimates count the triangles it holds) broadcast, a part per rank, the parts merged on rank 0. `history` (MergeHistory(surface count,
 // scene.memory()) before the first query) is used on rank 0 only. Preconditions: every rank's
 // scene is a replica (same model, selection and poses); options.memory_budget_bytes == 0.
 // A rank that runs out of memory (std::bad_alloc) or receives a fatal signal while checking prints
