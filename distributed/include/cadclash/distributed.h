@@ -102,7 +102,8 @@ struct DistributedCheck {
 // A rank that runs out of memory (std::bad_alloc) or receives a fatal signal while checking prints
 // (the one place this library prints: the process is about to die) which rank it is and the first of
 // its unfinished instance pairs, then the job is aborted (MPI_Abort): Open MPI 4.1 does not let the
-// other ranks continue without it.
+// other ranks continue without it. Testing aid: with CADCLASH_TEST_CRASH_RANK=r in the environment,
+// rank r raises SIGSEGV as its part starts.
 // `model` is the scene's model (instance paths for that message, part ids for the merge). Surfaces
 // tessellated by another rank get the achieved deflection on every rank: in `model` (the report's
 // "deflection" of a surface) and in the scene (Scene::note_deflection: the next query's reaches).
