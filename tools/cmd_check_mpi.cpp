@@ -39,20 +39,14 @@ Launch mpi_launch() {
 #if CADCLASH_HAS_MPI
 struct MpiCheck::State {
   std::vector<RankStats> ranks;  // rank 0: summed over the queries
-  int queries = 0;
-  void add(const std::vector<RankStats>& r) {
-    ++queries;
+  double merge_seconds = 0.0;
+  void add(const std::vector<RankStats>& r, double merge) {
+    merge_seconds += merge;
     if (ranks.empty()) {
       ranks = r;
       return;
     }
-    for (std::size_t i = 0; i < r.size(); ++i) {
-      ranks[i].instance_pairs += r[i].instance_pairs;
-      ranks[i].cost += r[i].cost;
-      ranks[i].triangles = r[i].triangles;
-      ranks[i].seconds += r[i].seconds;
-      ranks[i].peak_memory_bytes = std::max(ranks[i].peak_memory_bytes, r[i].peak_memory_bytes);
-    }
+    for (std::size_t i = 0; i < r.size(); ++i) add_stats(ranks[i], r[i]);
   }
 };
 
@@ -91,7 +85,7 @@ bool MpiCheck::same_input_everywhere(const Model& model, const std::vector<Diagn
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
   MergeHistory history(model.surfaces.size(), scene.memory());
   DistributedCheck c = check_distributed(scene, model, options, history, MPI_COMM_WORLD);
-  state_->add(c.ranks);
+  state_->add(c.ranks, c.merge_seconds);
   return std::move(c.report);
 }
 
@@ -99,7 +93,7 @@ std::vector<StepResult> MpiCheck::replay(Scene& scene, Model& model, std::span<c
                                          const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                          const std::string& file) {
   DistributedReplay r = replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD);
-  state_->add(r.ranks);
+  state_->add(r.ranks, r.merge_seconds);
   return std::move(r.steps);
 }
 
@@ -110,15 +104,17 @@ void MpiCheck::print_ranks(std::ostream& os) const {
   for (const RankStats& s : ranks) {
     os << "rank " << s.rank << " of " << size_ << ": " << s.instance_pairs << " instance pairs (estimated cost "
        << s.cost << "), " << s.triangles << " triangles, " << std::fixed << std::setprecision(3) << s.seconds
-       << " s, peak memory " << std::setprecision(1) << static_cast<double>(s.peak_memory_bytes) / (1024.0 * 1024.0)
-       << " MiB\n"
+       << " s (CPU " << s.cpu_seconds << " s; plan " << s.plan_seconds << " s), peak memory " << std::setprecision(1)
+       << static_cast<double>(s.peak_memory_bytes) / (1024.0 * 1024.0) << " MiB, results "
+       << static_cast<double>(s.result_bytes) / 1024.0 << " KiB\n"
        << std::defaultfloat;
     slowest = std::max(slowest, s.seconds);
     sum += s.seconds;
   }
   const double mean = sum / static_cast<double>(ranks.size());
   os << "load imbalance: slowest rank " << std::fixed << std::setprecision(3) << slowest << " s, mean " << mean
-     << " s (" << std::setprecision(2) << (mean > 0.0 ? slowest / mean : 1.0) << "x)\n"
+     << " s (" << std::setprecision(2) << (mean > 0.0 ? slowest / mean : 1.0) << "x); merge on rank 0 "
+     << std::setprecision(3) << state_->merge_seconds << " s\n"
      << std::defaultfloat;
 }
 

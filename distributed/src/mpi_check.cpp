@@ -4,6 +4,7 @@
 #include "mpi_faults.h"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <cassert>
 #include <chrono>
@@ -14,6 +15,12 @@
 
 namespace cadclash {
 namespace {
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 std::uint64_t peak_memory_bytes() {
   rusage ru{};
@@ -130,20 +137,43 @@ void share_deflections(Scene& scene, Model& model, std::vector<std::pair<Surface
 }
 
 std::vector<RankStats> gather_stats(const RankStats& mine, int rank, int size, MPI_Comm comm) {
-  const double v[5] = {static_cast<double>(mine.instance_pairs), static_cast<double>(mine.cost),
-                       static_cast<double>(mine.triangles), mine.seconds, static_cast<double>(mine.peak_memory_bytes)};
-  std::vector<double> all(rank == 0 ? 5 * static_cast<std::size_t>(size) : 0);
-  check_mpi(MPI_Gather(v, 5, MPI_DOUBLE, all.data(), 5, MPI_DOUBLE, 0, comm), "MPI_Gather", comm);
+  constexpr int kFields = 8;
+  const double v[kFields] = {static_cast<double>(mine.instance_pairs), static_cast<double>(mine.cost),
+                             static_cast<double>(mine.triangles),      mine.seconds,
+                             mine.plan_seconds,                        static_cast<double>(mine.result_bytes),
+                             static_cast<double>(mine.peak_memory_bytes), mine.cpu_seconds};
+  std::vector<double> all(rank == 0 ? kFields * static_cast<std::size_t>(size) : 0);
+  check_mpi(MPI_Gather(v, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, comm), "MPI_Gather", comm);
   std::vector<RankStats> out;
   for (int r = 0; rank == 0 && r < size; ++r) {
-    const double* x = all.data() + 5 * r;
-    out.push_back({r, static_cast<std::uint64_t>(x[0]), static_cast<std::uint64_t>(x[1]),
-                   static_cast<std::uint64_t>(x[2]), x[3], static_cast<std::uint64_t>(x[4])});
+    const double* x = all.data() + static_cast<std::ptrdiff_t>(kFields) * r;
+    RankStats s;
+    s.rank = r;
+    s.instance_pairs = static_cast<std::uint64_t>(x[0]);
+    s.cost = static_cast<std::uint64_t>(x[1]);
+    s.triangles = static_cast<std::uint64_t>(x[2]);
+    s.seconds = x[3];
+    s.plan_seconds = x[4];
+    s.result_bytes = static_cast<std::uint64_t>(x[5]);
+    s.peak_memory_bytes = static_cast<std::uint64_t>(x[6]);
+    s.cpu_seconds = x[7];
+    out.push_back(s);
   }
   return out;
 }
 
 }  // namespace
+
+void add_stats(RankStats& into, const RankStats& s) {
+  into.instance_pairs += s.instance_pairs;
+  into.cost += s.cost;
+  into.triangles = s.triangles;  // what it holds now
+  into.seconds += s.seconds;
+  into.cpu_seconds += s.cpu_seconds;
+  into.plan_seconds += s.plan_seconds;
+  into.result_bytes += s.result_bytes;
+  into.peak_memory_bytes = std::max(into.peak_memory_bytes, s.peak_memory_bytes);
+}
 
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& o, MergeHistory& history,
                                    MPI_Comm comm) {
@@ -152,9 +182,12 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
+  const auto t_plan = std::chrono::steady_clock::now();
   const CheckPlan plan = scene.plan(o);  // the same pairs on every replica
+  const double plan_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_plan).count();
   const std::vector<std::uint32_t> mine = my_part(plan, rank, size, comm);
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = process_cpu_seconds();
   const PartialCheck part = run_part(scene, model, o, plan, mine, rank, size, comm);
   RankStats stats;
   stats.rank = rank;
@@ -162,13 +195,18 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   for (std::uint32_t k : mine) stats.cost += plan.pairs[k].cost;
   stats.triangles = part.report.model_memory.triangle_count;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats.cpu_seconds = process_cpu_seconds() - cpu0;
+  stats.plan_seconds = plan_seconds;
+  const std::vector<std::uint8_t> my_bytes = partial_check_bytes(part);
+  stats.result_bytes = my_bytes.size();
   stats.peak_memory_bytes = peak_memory_bytes();
 
-  const std::vector<std::vector<std::uint8_t>> bytes = gather_bytes(partial_check_bytes(part), rank, size, comm);
+  const std::vector<std::vector<std::uint8_t>> bytes = gather_bytes(my_bytes, rank, size, comm);
   DistributedCheck out;
   out.ranks = gather_stats(stats, rank, size, comm);
   std::vector<std::pair<SurfaceId, double>> deflections;
   if (rank == 0) {
+    const auto t_merge = std::chrono::steady_clock::now();
     std::vector<PartialCheck> all;
     for (int r = 0; r < size; ++r) {
       std::string error;
@@ -182,6 +220,7 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
     MergedCheck merged = merge_parts(plan, all, model, history);
     out.report = std::move(merged.report);
     deflections = std::move(merged.new_deflections);
+    out.merge_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_merge).count();
   }
   share_deflections(scene, model, deflections, comm);
   return out;
@@ -229,16 +268,10 @@ DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const
     DistributedCheck c = check_distributed(scene, model, step_options, history, comm);
     if (rank == 0) {
       last_cut_by_time = !c.report.complete && c.report.stopped_by.find("time") != std::string::npos;
+      out.merge_seconds += c.merge_seconds;
       if (out.ranks.empty()) out.ranks = c.ranks;
       else
-        for (std::size_t r = 0; r < c.ranks.size(); ++r) {
-          RankStats& s = out.ranks[r];
-          s.instance_pairs += c.ranks[r].instance_pairs;
-          s.cost += c.ranks[r].cost;
-          s.triangles = c.ranks[r].triangles;
-          s.seconds += c.ranks[r].seconds;
-          s.peak_memory_bytes = std::max(s.peak_memory_bytes, c.ranks[r].peak_memory_bytes);
-        }
+        for (std::size_t r = 0; r < c.ranks.size(); ++r) add_stats(out.ranks[r], c.ranks[r]);
       out.steps.push_back({step, std::move(c.report)});
     }
   }

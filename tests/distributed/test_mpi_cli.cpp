@@ -146,6 +146,21 @@ TEST(MpiCli, CrashedRankIsNamedWithItsPairs) {
   EXPECT_FALSE(std::filesystem::exists(json)) << "a report was written although rank 1 died";
 }
 
+// A time budget that has run out before any rank starts: every instance pair is listed unexamined,
+// the same partial report as one process's, exit code 4.
+TEST(MpiCli, ExpiredTimeBudgetListsEveryPairUnexamined) {
+  REQUIRE_AS1();
+  const std::string args = "check '" + as1_path() + "' --lazy --time-budget 1e-9 --no-timings --json ";
+  const Outcome one = run(0, args + "'" + scratch("budget_one.json") + "'");
+  ASSERT_EQ(one.code, 4) << one.err;
+  const Outcome two = run(2, args + "'" + scratch("budget_np2.json") + "'");
+  EXPECT_EQ(two.code, 4) << two.err;
+  const std::string json = slurp(scratch("budget_np2.json"));
+  EXPECT_TRUE(json == slurp(scratch("budget_one.json"))) << json;
+  EXPECT_NE(json.find("\"stopped_by\": \"time budget\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"/as1/PLATE\""), std::string::npos) << json;  // in unexamined_pairs
+}
+
 TEST(MpiCli, MemoryBudgetIsAUsageError) {
   REQUIRE_AS1();
   const Outcome r = run(2, "check '" + as1_path() + "' --memory-budget 10");

@@ -82,8 +82,14 @@ struct RankStats {
   std::uint64_t cost = 0;            // their estimated cost (PlannedPair::cost)
   std::uint64_t triangles = 0;       // triangles its scene holds afterwards (model_memory.triangle_count)
   double seconds = 0.0;              // wall time of its check_part() calls
+  double cpu_seconds = 0.0;          // CPU time of the process (all its threads) during them
+  double plan_seconds = 0.0;         // wall time of its plan() calls (every rank plans every pair)
+  std::uint64_t result_bytes = 0;    // bytes of its results sent to rank 0
   std::uint64_t peak_memory_bytes = 0;  // the process's peak resident set (getrusage)
 };
+
+// `s` added to `into`: sums, except triangles (the latest) and peak memory (the larger).
+void add_stats(RankStats& into, const RankStats& s);
 
 #if CADCLASH_HAS_MPI
 // ---------------------------------------------------------------------------------------------
@@ -93,6 +99,7 @@ struct RankStats {
 struct DistributedCheck {
   Report report;                // rank 0: the merged report; other ranks: empty
   std::vector<RankStats> ranks;  // rank 0: one per rank; other ranks: empty
+  double merge_seconds = 0.0;    // rank 0: reading the parts and merging them
 };
 
 // Scene::check(options) over the ranks of `comm`: the plan on every rank, rank 0's split (its cost
@@ -116,6 +123,7 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
 struct DistributedReplay {
   std::vector<StepResult> steps;  // rank 0
   std::vector<RankStats> ranks;   // rank 0
+  double merge_seconds = 0.0;     // rank 0, summed over the steps
 };
 DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                      const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
