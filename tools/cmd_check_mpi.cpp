@@ -7,6 +7,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace cadclash::cli {
@@ -40,6 +41,9 @@ Launch mpi_launch() {
 struct MpiCheck::State {
   std::vector<RankStats> ranks;  // rank 0: summed over the queries
   double merge_seconds = 0.0;
+  // One history for every check() of the scene (--repeat): what an earlier query tessellated or
+  // built is not counted again, as in one process.
+  std::optional<MergeHistory> history;
   void add(const std::vector<RankStats>& r, double merge) {
     merge_seconds += merge;
     if (ranks.empty()) {
@@ -83,8 +87,8 @@ bool MpiCheck::same_input_everywhere(const Model& model, const std::vector<Diagn
 }
 
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
-  MergeHistory history(model.surfaces.size(), scene.memory());
-  DistributedCheck c = check_distributed(scene, model, options, history, MPI_COMM_WORLD);
+  if (!state_->history) state_->history.emplace(model.surfaces.size(), scene.memory());
+  DistributedCheck c = check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD);
   state_->add(c.ranks, c.merge_seconds);
   return std::move(c.report);
 }

@@ -54,8 +54,9 @@ void merge_surfaces(const CheckPlan& plan, std::span<const PartialCheck> parts, 
   Report& r = out.report;
   std::vector<std::uint32_t> first_need(model.surfaces.size(), static_cast<std::uint32_t>(plan.needed.size()));
   for (std::uint32_t i = 0; i < plan.needed.size(); ++i) first_need[plan.needed[i]] = i;
+  const std::map<SurfaceId, SurfaceWork> all = union_of(parts);  // `failed` points into it
   std::vector<const SurfaceWork*> failed;
-  for (const auto& [sid, w] : union_of(parts)) {
+  for (const auto& [sid, w] : all) {
     if (w.asked && !h.tessellated[sid]) {
       ++r.counters.tessellated_surfaces;  // one process asks what has no triangles, failed before or not
       if (w.error) failed.push_back(&w);

@@ -98,6 +98,13 @@ TEST(MpiCli, As1ExactSameReport) {
   expect_identical("check '" + as1_path() + "' --lazy --exact --threads 1", false);
 }
 
+// The second query of a prepared scene (--repeat 2) counts nothing the first one tessellated or built,
+// whichever rank did it.
+TEST(MpiCli, As1RepeatedQuerySameReport) {
+  REQUIRE_AS1();
+  expect_identical("check '" + as1_path() + "' --lazy --repeat 2", false);
+}
+
 // The rod of as1 moved over eight steps (CSV written from the imported poses), lazily tessellated at
 // a coarse deflection: steps reuse faces other ranks tessellated.
 TEST(MpiCli, As1TrajectorySameReport) {
@@ -144,6 +151,30 @@ TEST(MpiCli, CrashedRankIsNamedWithItsPairs) {
   EXPECT_NE(r.err.find("before finishing its "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(" x /as1/"), std::string::npos) << r.err;  // its pairs, by instance path
   EXPECT_FALSE(std::filesystem::exists(json)) << "a report was written although rank 1 died";
+}
+
+// Faces that cannot be meshed, met by pairs on several ranks: their errors (naming the file and the
+// STEP #id or face) are listed once, in the order one process lists them; exit code 1 as there.
+TEST(MpiCli, UnmeshableFacesReportedAsInOneProcess) {
+  std::string files;
+  for (const char* name : {"mesh_fail_degenerate.step", "mesh_fail_bowtie.brep"})
+    for (const char* copy : {"a_", "b_", "c_"}) {
+      const std::string to = scratch(std::string(copy) + name);
+      std::filesystem::copy_file(std::string(CADCLASH_DATA_DIR) + "/cad/" + name, to,
+                                 std::filesystem::copy_options::overwrite_existing);
+      files += " '" + to + "'";
+    }
+  const std::string args = "check" + files + " --lazy --no-timings --json ";
+  const Outcome one = run(0, args + "'" + scratch("bad_one.json") + "'");
+  ASSERT_EQ(one.code, 1) << one.err;
+  const std::string json = slurp(scratch("bad_one.json"));
+  ASSERT_NE(json.find("#132"), std::string::npos) << json;  // the degenerate STEP face, by its id
+  for (int ranks : {2, 3}) {
+    const Outcome r = run(ranks, args + "'" + scratch("bad_np.json") + "'");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_TRUE(slurp(scratch("bad_np.json")) == json) << ranks << " ranks:\n" << slurp(scratch("bad_np.json"));
+    EXPECT_TRUE(r.out == one.out) << ranks << " ranks";
+  }
 }
 
 // A time budget that has run out before any rank starts: every instance pair is listed unexamined,

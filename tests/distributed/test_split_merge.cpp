@@ -177,6 +177,23 @@ TEST(SplitMerge, As1LazyTrajectory) {
   }
 }
 
+// Faces that cannot be meshed (lazily, so during the check), reached by pairs on several parts: each
+// error once, in one process's order (by part, then first need).
+TEST(SplitMerge, UnmeshableFacesOnceInOrder) {
+  const std::string cad = std::string(CADCLASH_DATA_DIR) + "/cad/";
+  std::vector<std::string> files;
+  for (int copy = 0; copy < 3; ++copy)
+    for (const char* name : {"mesh_fail_degenerate.step", "mesh_fail_bowtie.brep"}) files.push_back(cad + name);
+  ImportOptions io;
+  io.lazy = true;
+  const ImportResult r = import_files(files, io);
+  ASSERT_GE(r.model.instances.size(), 6u);
+  for (int parts : {2, 3, 4}) expect_same_as_one_process(r.model, CollideOptions{}, parts);
+  Model m = r.model;
+  Scene scene(m);
+  EXPECT_GE(scene.check().diagnostics.size(), 6u);  // the scene does reach the failing faces
+}
+
 // 56 copies of as1 (1008 instances) split over 4 parts.
 TEST(SplitMerge, ThousandInstances) {
   REQUIRE_AS1();
