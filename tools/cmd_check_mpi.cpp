@@ -2,6 +2,8 @@
 
 #include "cadclash/distributed.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <functional>
@@ -116,6 +118,11 @@ void MpiCheck::print_ranks(std::ostream& os) const {
     sum += s.seconds;
   }
   const double mean = sum / static_cast<double>(ranks.size());
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);  // Linux: KiB
+  os << "rank 0 after merging and writing the report: peak memory " << std::fixed << std::setprecision(1)
+     << static_cast<double>(ru.ru_maxrss) / 1024.0 << " MiB\n"
+     << std::defaultfloat;
   os << "load imbalance: slowest rank " << std::fixed << std::setprecision(3) << slowest << " s, mean " << mean
      << " s (" << std::setprecision(2) << (mean > 0.0 ? slowest / mean : 1.0) << "x); merge on rank 0 "
      << std::setprecision(3) << state_->merge_seconds << " s\n"

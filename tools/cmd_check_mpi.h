@@ -72,8 +72,9 @@ class MpiCheck {
   std::vector<StepResult> replay(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                  const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                  const std::string& file);
-  // Rank 0: one line per rank (instance pairs, estimated cost, triangles, seconds, peak memory) and
-  // the load imbalance, over the queries run so far.
+  // Rank 0: one line per rank (instance pairs, estimated cost, triangles, seconds, peak memory at the
+  // end of its part, bytes sent), rank 0's peak after merging and writing, and the load imbalance
+  // and merge time, over the queries run so far.
   void print_ranks(std::ostream& os) const;
   // Rank 0's exit code, on every rank.
   int agree(int code);
