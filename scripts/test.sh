@@ -7,9 +7,10 @@ jobs=$(nproc)
 "$root/scripts/setup.sh"
 
 echo "== Release build and all tests"
-# Explicit ON: the demo shares this build tree and turns tests off in it.
+# Explicit ON: the demo shares this build tree and turns tests off in it. With MPI: the mpirun tests
+# (tests/distributed) run in this pass; the sanitizer build below stays without it.
 "$root/scripts/build.sh" "$root/build" -DCADCLASH_BUILD_TESTS=ON -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_EXAMPLES=ON \
-  -DCADCLASH_BUILD_PYTHON=ON
+  -DCADCLASH_BUILD_PYTHON=ON -DCADCLASH_WITH_MPI=ON
 ctest --test-dir "$root/build" --output-on-failure --no-tests=error -j "$jobs"
 
 if [ "${CADCLASH_SKIP_SANITIZERS:-0}" != 1 ]; then

@@ -1,5 +1,6 @@
 // cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
 #include "cli_common.h"
+#include "cmd_check_mpi.h"
 #include "html_report.h"
 
 #include "cadclash/report.h"
@@ -11,8 +12,11 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <functional>
 #include <map>
 #include <memory>
+#include <span>
+#include <streambuf>
 #include <optional>
 #include <sstream>
 
@@ -234,13 +238,21 @@ struct CheckOutcome {
   Report shown;                         // what --html shows: the query, or a trajectory's last step
 };
 
+// How the queries run: in this process, or split over the ranks of an MPI job (cmd_check_mpi.h).
+struct Runner {
+  std::function<Report(const CollideOptions&)> check;
+  std::function<std::vector<StepResult>(std::span<const TrajectoryRow>, const CollideOptions&, std::vector<Diagnostic>&,
+                                        const std::string&)>
+      replay;
+};
+
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
 // stdout, the results into `report`.
-CheckOutcome check_once(const CheckOptions& o, const Model& m, Scene& scene, const CollideOptions& copt,
+CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run, const CollideOptions& copt,
                         CheckReport& report) {
   CheckOutcome out;
-  Report r = scene.check(copt);
-  for (int k = 1; k < o.repeat; ++k) r = scene.check(copt);  // a prepared scene: BVHs already built
+  Report r = run.check(copt);
+  for (int k = 1; k < o.repeat; ++k) r = run.check(copt);  // a prepared scene: BVHs already built
   out.diagnostics = r.diagnostics;
   ClassCounts n;
   n.add(r);
@@ -258,11 +270,11 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, Scene& scene, con
 }
 
 // The trajectory replayed on the prepared scene: one line per step on stdout, each step into `report`.
-CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, Scene& scene, const std::vector<TrajectoryRow>& rows,
-                              const CollideOptions& copt, CheckReport& report) {
+CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runner& run,
+                              const std::vector<TrajectoryRow>& rows, const CollideOptions& copt, CheckReport& report) {
   CheckOutcome out;
   std::vector<Diagnostic> ds;
-  std::vector<StepResult> steps = replay_trajectory(scene, rows, copt, ds, o.path_csv);
+  std::vector<StepResult> steps = run.replay(rows, copt, ds, o.path_csv);
   print_diagnostics(ds);
   report.trajectory = o.path_csv;
   for (const StepResult& s : steps) {
@@ -296,32 +308,15 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, Scene& scen
   return out;
 }
 
-int run_check(const CheckOptions& o) {
-  if (!o.html.empty() && !html_report_available()) {
-    std::cerr << "cadclash check: --html needs a build with the viewer (CMake option CADCLASH_HTML_VIEWER=ON)\n";
-    return kExitUsage;
-  }
-  ImportResult imported = import_inputs(o.in);
+// The query (or trajectory) run, printed and written: the rest of `cadclash check`. Under MPI only
+// rank 0 (`primary`) writes files.
+int finish_check(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
+                 const Runner& runner, Scene& scene, const CollideOptions& copt, bool primary) {
   Model& m = imported.model;
-  if (m.instances.empty()) {
-    std::cerr << "cadclash check: no instances to check\n";
-    return kExitInputError;
-  }
-  std::vector<TrajectoryRow> rows;
-  if (!o.path_csv.empty()) {
-    std::optional<std::vector<TrajectoryRow>> read = read_trajectory(o.path_csv);
-    if (!read) return kExitInputError;
-    rows = std::move(*read);
-  }
-  const std::optional<SceneSelection> sel = scene_selection(m, o);
-  if (!sel) return kExitInputError;
-  const CollideOptions copt = collide_options(o);
-  Scene scene(m, *sel);
-
   CheckReport report;
   report.files = o.in.files;
   report.settings = report_settings_of(o, copt);
-  CheckOutcome run = rows.empty() ? check_once(o, m, scene, copt, report) : check_trajectory(o, m, scene, rows, copt, report);
+  CheckOutcome run = rows.empty() ? check_once(o, m, runner, copt, report) : check_trajectory(o, m, runner, rows, copt, report);
   print_diagnostics(run.diagnostics);
   const bool input_error = has_error(imported.diagnostics) || has_error(run.diagnostics);
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
@@ -331,7 +326,7 @@ int run_check(const CheckOptions& o) {
     std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
   const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
-  if (!o.json.empty()) {
+  if (primary && !o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);
     f << report_text(j);
     if (!f) {
@@ -339,11 +334,84 @@ int run_check(const CheckOptions& o) {
       return kExitInputError;
     }
   }
-  if (!o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
+  if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
     return kExitInputError;
   if (input_error) return kExitInputError;
   if (o.fail_on_collision && run.collision) return kExitCollision;  // a definite finding, partial report or not
   return run.stopped_by.empty() ? kExitOk : kExitBudget;
+}
+
+// The check of what was imported: in this process, or split over the ranks of `mpi` when given.
+int check_imported(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
+                   [[maybe_unused]] MpiCheck* mpi) {
+  Model& m = imported.model;
+  if (m.instances.empty()) {
+    std::cerr << "cadclash check: no instances to check\n";
+    return kExitInputError;
+  }
+  const std::optional<SceneSelection> sel = scene_selection(m, o);
+  if (!sel) return kExitInputError;
+  const CollideOptions copt = collide_options(o);
+  Scene scene(m, *sel);
+  Runner runner{[&](const CollideOptions& c) { return scene.check(c); },
+                [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
+                    const std::string& file) { return replay_trajectory(scene, r, c, ds, file); }};
+  bool primary = true;
+#if CADCLASH_HAS_MPI
+  if (mpi != nullptr) {
+    primary = mpi->rank() == 0;
+    runner.check = [&](const CollideOptions& c) { return mpi->check(scene, m, c); };
+    runner.replay = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
+                        const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
+  }
+#endif
+  return finish_check(o, imported, rows, runner, scene, copt, primary);
+}
+
+int run_check(const CheckOptions& o, const Launch& launch) {
+  if (!o.html.empty() && !html_report_available()) {
+    std::cerr << "cadclash check: --html needs a build with the viewer (CMake option CADCLASH_HTML_VIEWER=ON)\n";
+    return kExitUsage;
+  }
+  if (launch.by_mpirun && o.memory_budget_mb > 0.0) {
+    std::cerr << "cadclash check: --memory-budget keeps the longest prefix of all instance pairs that fits; it "
+                 "cannot be split over MPI ranks (use --time-budget, or one process)\n";
+    return kExitUsage;
+  }
+  ImportResult imported = import_inputs(o.in);
+  std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
+  if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
+#if CADCLASH_HAS_MPI
+  if (launch.by_mpirun) {
+    // MPI starts after the import: the isolated CAD readers fork, which MPI transports dislike. Every
+    // rank must have read the same input before any collective, or the ranks would wait for each other.
+    MpiCheck mpi;
+    const std::string trajectory = rows ? std::to_string(rows->size()) + " trajectory rows" : "unreadable trajectory";
+    if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) return kExitInputError;
+    const int code = rows ? check_imported(o, imported, *rows, &mpi) : kExitInputError;
+    if (mpi.rank() == 0) mpi.print_ranks(std::cerr);
+    return mpi.agree(code);
+  }
+#endif
+  if (!rows) return kExitInputError;
+  return check_imported(o, imported, *rows, nullptr);
+}
+
+// `cadclash check`, in one process or as one rank of an MPI job (every rank imports, rank 0 reports).
+int run_check_launched(const CheckOptions& o) {
+  const Launch launch = mpi_launch();
+  if (!launch.by_mpirun) return run_check(o, launch);
+#if CADCLASH_HAS_MPI
+  SilentRank quiet(launch.rank != 0);
+  return run_check(o, launch);
+#else
+  if (launch.size == 1) return run_check(o, launch);
+  if (launch.rank == 0)
+    std::cerr << "cadclash check: started by mpirun with " << launch.size
+              << " processes, but this cadclash was built without MPI (CMake option CADCLASH_WITH_MPI): every "
+                 "process would check everything\n";
+  return kExitUsage;
+#endif
 }
 
 }  // namespace
@@ -394,7 +462,7 @@ void register_check(CLI::App& app) {
   cmd->add_option("--select-b", o->select_b, "... against instances under these paths (set B)");
   cmd->add_option("--exclude-under", o->exclude_under, "Skip pairs whose instances are both under this sub-assembly path");
   cmd->callback([o] {
-    const int code = run_check(*o);
+    const int code = run_check_launched(*o);
     if (code != kExitOk) throw CLI::RuntimeError(code);
   });
 }

@@ -36,8 +36,9 @@ class Deadline {
 };
 
 // require_triangles (collide.h) that stops asking the sources once `deadline` has expired; surfaces
-// not reached keep has_triangles == false and get no diagnostic.
+// not reached keep has_triangles == false and get no diagnostic. `failed`, when given, receives the
+// surface of each returned diagnostic, in the same order.
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces, double deflection,
-                                          const Deadline& deadline);
+                                          const Deadline& deadline, std::vector<SurfaceId>* failed = nullptr);
 
 }  // namespace cadclash::detail

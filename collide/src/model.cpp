@@ -77,7 +77,8 @@ std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceI
 }
 
 std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const SurfaceId> surfaces,
-                                                  double deflection, const Deadline& deadline) {
+                                                  double deflection, const Deadline& deadline,
+                                                  std::vector<SurfaceId>* failed) {
   // Group the missing surfaces by part: a source is thread-safe across parts, not within one.
   std::map<PartId, std::vector<SurfaceId>> by_part;
   for (SurfaceId s : surfaces) {
@@ -87,6 +88,7 @@ std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const 
   }
   std::vector<std::pair<PartId, std::vector<SurfaceId>>> work(by_part.begin(), by_part.end());
   std::vector<std::vector<Diagnostic>> errors(work.size());
+  std::vector<std::vector<SurfaceId>> failed_ids(work.size());
 
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t w = 0; w < static_cast<std::ptrdiff_t>(work.size()); ++w) {
@@ -104,11 +106,14 @@ std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const 
         surf.has_triangles = true;
       } else {
         errors[static_cast<std::size_t>(w)].push_back(std::move(error));
+        failed_ids[static_cast<std::size_t>(w)].push_back(s);
       }
     }
   }
   std::vector<Diagnostic> out;
   for (auto& e : errors) out.insert(out.end(), e.begin(), e.end());
+  if (failed != nullptr)
+    for (const auto& f : failed_ids) failed->insert(failed->end(), f.begin(), f.end());
   return out;
 }
 

@@ -6,7 +6,7 @@
 #include <cassert>
 
 namespace cadclash {
-namespace {
+namespace detail {
 
 void set_schedule(Schedule s) {
   switch (s) {
@@ -16,11 +16,42 @@ void set_schedule(Schedule s) {
   }
 }
 
-}  // namespace
+SceneMemory scene_memory(const SceneData& s) {
+  SceneMemory m;
+  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid) {
+    if (!s.bvh_ready[sid]) continue;
+    const TriangleMesh& mesh = s.model.surfaces[sid].mesh;
+    m.triangles += mesh.triangles.size() * sizeof(mesh.triangles[0]);
+    m.vertices += mesh.vertices.size() * sizeof(mesh.vertices[0]);
+    m.hierarchies += bvh_heap_bytes(s.bvh[sid]);
+    m.triangle_count += mesh.triangles.size();
+  }
+  // Every surface has its slot (exact root box, sizes, pointers) and ready flag, built or not.
+  m.hierarchies += s.bvh.size() * (sizeof(SurfaceBvh) + sizeof(s.bvh_ready[0]));
+  m.instances = s.poses.size() * sizeof(Pose) + s.world_box.size() * sizeof(Aabb) + s.dirty.size() +
+                s.in_a.size() + s.in_b.size() + s.instance_tree.bytes();
+  return m;
+}
 
-struct Scene::Impl : detail::SceneData {
-  using SceneData::SceneData;
-};
+void narrow_stages(SceneData& s, QueryState& q) {
+  CollideTimings& time = q.report.timings;
+  auto t = std::chrono::steady_clock::now();
+  surface_level_stage(s, q);  // which of their surfaces can meet
+  time.surface_level = seconds_since(t);
+  t = std::chrono::steady_clock::now();
+  tessellation_stage(s, q);  // triangles and BVHs for exactly those surfaces
+  time.tessellation = seconds_since(t);
+  t = std::chrono::steady_clock::now();
+  triangle_level_stage(s, q);  // what their triangles say
+  decision_stage(s, q);        // what that proves about the exact faces
+  containment_stage(s, q);     // whole instances inside others
+  time.triangle_level = seconds_since(t);
+  results_stage(s, q);  // the kept prefix, in a fixed order
+  q.report.model_memory = scene_memory(s);
+  time.total = seconds_since(q.t0);
+}
+
+}  // namespace detail
 
 Scene::Scene(Model& model, SceneSelection selection) : impl_(std::make_unique<Impl>(model, std::move(selection))) {}
 Scene::~Scene() = default;
@@ -49,48 +80,17 @@ std::size_t Scene::build_hierarchies(int threads) {
   return detail::build_trees(s, all, threads > 0 ? threads : omp_get_max_threads(), detail::Deadline{}).size();
 }
 
-SceneMemory Scene::memory() const {
-  const detail::SceneData& s = *impl_;
-  SceneMemory m;
-  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid) {
-    if (!s.bvh_ready[sid]) continue;
-    const TriangleMesh& mesh = s.model.surfaces[sid].mesh;
-    m.triangles += mesh.triangles.size() * sizeof(mesh.triangles[0]);
-    m.vertices += mesh.vertices.size() * sizeof(mesh.vertices[0]);
-    m.hierarchies += detail::bvh_heap_bytes(s.bvh[sid]);
-    m.triangle_count += mesh.triangles.size();
-  }
-  // Every surface has its slot (exact root box, sizes, pointers) and ready flag, built or not.
-  m.hierarchies += s.bvh.size() * (sizeof(detail::SurfaceBvh) + sizeof(s.bvh_ready[0]));
-  m.instances = s.poses.size() * sizeof(Pose) + s.world_box.size() * sizeof(Aabb) + s.dirty.size() +
-                s.in_a.size() + s.in_b.size() + s.instance_tree.bytes();
-  return m;
-}
+SceneMemory Scene::memory() const { return detail::scene_memory(*impl_); }
 
 Report Scene::check(const CollideOptions& o) {
   assert(o.tolerance >= 0.0 && o.clearance >= 0.0 && o.time_budget_seconds >= 0.0);
   detail::SceneData& s = *impl_;
   detail::QueryState q(o, std::chrono::steady_clock::now());
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-  set_schedule(o.schedule);
-  CollideTimings& time = q.report.timings;
-
+  detail::set_schedule(o.schedule);
   detail::broad_phase_stage(s, q);  // which instance pairs can meet
-  time.broad = detail::seconds_since(q.t0);
-  auto t = std::chrono::steady_clock::now();
-  detail::surface_level_stage(s, q);  // which of their surfaces can meet
-  time.surface_level = detail::seconds_since(t);
-  t = std::chrono::steady_clock::now();
-  detail::tessellation_stage(s, q);  // triangles and BVHs for exactly those surfaces
-  time.tessellation = detail::seconds_since(t);
-  t = std::chrono::steady_clock::now();
-  detail::triangle_level_stage(s, q);  // what their triangles say
-  detail::decision_stage(s, q);        // what that proves about the exact faces
-  detail::containment_stage(s, q);     // whole instances inside others
-  time.triangle_level = detail::seconds_since(t);
-  detail::results_stage(s, q);  // the kept prefix, in a fixed order
-  q.report.model_memory = memory();
-  time.total = detail::seconds_since(q.t0);
+  q.report.timings.broad = detail::seconds_since(q.t0);
+  detail::narrow_stages(s, q);
   return std::move(q.report);
 }
 

@@ -39,6 +39,7 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   bvh.resize(model.surfaces.size());
   bvh_ready.assign(model.surfaces.size(), 0);
   refined.resize(model.surfaces.size());
+  noted_deflection.assign(model.surfaces.size(), -1.0);
   in_a.assign(n, selection.set_a.empty() ? 1 : 0);
   in_b.assign(n, selection.set_b.empty() ? 1 : 0);
   for (InstanceId i : selection.set_a) {
@@ -65,6 +66,7 @@ Aabb SceneData::surface_box(SurfaceId s) const {
 double SceneData::deflection(SurfaceId s) const {
   const Surface& surf = model.surfaces[s];
   if (surf.has_triangles) return surf.deflection;
+  if (noted_deflection[s] >= 0.0) return noted_deflection[s];  // tessellated by another process
   // Not tessellated yet (lazy): it will be meshed at its source's load deflection.
   const SurfaceSource* source = model.parts[surf.part].source.get();
   return std::max(surf.deflection, source != nullptr ? source->default_deflection() : 0.0);

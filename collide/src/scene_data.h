@@ -37,6 +37,8 @@ struct SceneData {
   std::vector<RefinedSurface> refined;  // finer faces made for refinement, kept for later queries
   OutlineCache outlines;                // surfaces' outlines made by the decision stage, likewise
   std::vector<char> in_a, in_b;
+  // Per surface: the deflection another process tessellated it at (Scene::note_deflection); < 0: none.
+  std::vector<double> noted_deflection;
   std::set<std::pair<InstanceId, InstanceId>> excluded;
   std::unordered_map<std::string, InstanceId> by_path;
 
@@ -89,6 +91,7 @@ struct QueryState {
 
   // Lazy tessellation: what this query asked for, made, and built (released past the cutoff).
   std::vector<SurfaceId> asked, tessellated, built;
+  std::vector<SurfaceId> failed;  // the surface of each tessellation diagnostic in report.diagnostics
   std::vector<double> old_deflection;  // parallel to `tessellated`
 
   // Triangle level, per task.
@@ -115,5 +118,8 @@ inline std::uint64_t result_bytes(const SurfacePairResult& r) {
   return sizeof(r) + r.triangle_pairs.size() * sizeof(r.triangle_pairs[0]);
 }
 void add(CollideCounters& into, const CollideCounters& c);
+inline std::uint64_t mesh_bytes(const TriangleMesh& m) {
+  return m.vertices.size() * sizeof(m.vertices[0]) + m.triangles.size() * sizeof(m.triangles[0]);
+}
 
 }  // namespace cadclash::detail

@@ -38,4 +38,16 @@ void containment_stage(const SceneData& s, QueryState& q);
 //    partial marker), and what was built past the memory budget released again.
 void results_stage(SceneData& s, QueryState& q);
 
+// Stages 2-7 in order, with their timings and the model memory after them: check() after its broad
+// phase, check_part() after taking its pairs from the plan.
+void narrow_stages(SceneData& s, QueryState& q);
+void set_schedule(Schedule s);
+SceneMemory scene_memory(const SceneData& s);
+
 }  // namespace cadclash::detail
+
+namespace cadclash {
+struct Scene::Impl : detail::SceneData {
+  using SceneData::SceneData;
+};
+}  // namespace cadclash

@@ -16,10 +16,6 @@ constexpr std::size_t kBudgetRound = 64;
 // Fewer work items than this run on the calling thread: waking a team costs more than they do.
 constexpr std::ptrdiff_t kMinParallel = 4;
 
-std::uint64_t mesh_bytes(const TriangleMesh& m) {
-  return m.vertices.size() * sizeof(Vec3) + m.triangles.size() * sizeof(m.triangles[0]);
-}
-
 // Triangles for the surfaces of one round that have none yet; charged to their first pair.
 void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wave) {
   Model& model = s.model;
@@ -31,7 +27,7 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
       before.push_back(model.surfaces[sid].deflection);
     }
   if (missing.empty()) return;
-  std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.deadline);
+  std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.deadline, &q.failed);
   q.report.diagnostics.insert(q.report.diagnostics.end(), ds.begin(), ds.end());
   q.asked.insert(q.asked.end(), missing.begin(), missing.end());
   for (std::size_t i = 0; i < missing.size(); ++i) {

@@ -295,6 +295,55 @@ struct SceneSelection {
 };
 
 
+// ---------------------------------------------------------------------------------------------
+// One check split over processes (cadclash/distributed.h runs it under MPI)
+// ---------------------------------------------------------------------------------------------
+// check(o) = plan(o), check_part(o, plan, part) for parts covering the plan's pairs (each on its own
+// replica of the scene: same model, same poses), and a merge (cadclash/distributed.h) that adds the
+// parts' per-instance-pair results and counters and counts per-surface work (tessellation, BVHs,
+// refinement) once, as one process would have. Each part tessellates only the surfaces its pairs
+// reach.
+
+// One broad-phase instance pair of a plan and its estimated cost.
+struct PlannedPair {
+  InstanceId a = kInvalidId, b = kInvalidId;  // a < b
+  // Triangles under the pair's OAABB: summed over its candidate surface pairs, both surfaces'
+  // triangles (all surfaces of both parts when their boxes nest: containment), a surface not
+  // tessellated yet counted as kUntessellatedCost triangles. An estimate for splitting work only.
+  std::uint64_t cost = 0;
+};
+inline constexpr std::uint64_t kUntessellatedCost = 64;
+
+struct CheckPlan {
+  std::vector<PlannedPair> pairs;  // the broad phase's instance pairs, sorted (check()'s order)
+  CollideCounters broad;           // the broad phase's own work (world-box updates, sweep tests); instance_pairs 0
+  std::vector<SurfaceId> needed;   // surfaces the pairs reach, in order of first need (as check() tessellates them)
+  double seconds = 0.0;            // time plan() took
+};
+
+// What a check_part() did to one surface, for a merge to count it once over all parts.
+struct SurfaceWork {
+  SurfaceId surface = kInvalidId;
+  bool asked = false;        // it had no triangles and was given to its source (tessellated_surfaces)
+  bool tessellated = false;  // ... and got them, at `deflection`; mesh_bytes charged
+  bool built = false;        // its hierarchy was built by this query; bvh_bytes charged
+  bool refined = false;      // meshed finer for refinement by this query (refined_surfaces)
+  double deflection = 0.0;
+  std::uint64_t mesh_bytes = 0, bvh_bytes = 0;
+  SceneMemory held;          // when built: what it adds to Scene::memory() (triangles, vertices, hierarchy)
+  std::optional<Diagnostic> error;  // asked and not tessellated: why
+};
+
+struct PartialCheck {
+  // check()'s report restricted to the part's instance pairs: results, unexamined pairs, stopped_by,
+  // complete, timings, and counters summed over those pairs (instance_pairs = their number) without
+  // the plan's broad phase and without tessellated_surfaces and refined_surfaces (see `surfaces`);
+  // memory_charged without the surfaces' mesh and BVH bytes; diagnostics empty (in `surfaces`);
+  // model_memory this process's.
+  Report report;
+  std::vector<SurfaceWork> surfaces;  // ascending surface id
+};
+
 // A prepared scene: per-surface BVHs and instance world boxes are built once; each check() updates
 // only the instances moved by set_pose since the last check.
 // The model must outlive the scene; the scene writes only surfaces' triangles (lazy tessellation).
@@ -320,6 +369,22 @@ class Scene {
 
   // The bytes held now (see SceneMemory).
   SceneMemory memory() const;
+
+  // The broad phase and the object and surface levels of check(options), nothing tessellated or
+  // tested: the instance pairs check() would examine, with cost estimates. Updates the world boxes of
+  // the instances moved since the last check, as check() does. Ignores the budgets.
+  CheckPlan plan(const CollideOptions& options);
+
+  // check(options) restricted to plan.pairs[k] for k in `part` (see PartialCheck).
+  // Preconditions: `plan` is this scene's last plan(options) and no set_pose since; `part` ascending,
+  // each k < plan.pairs.size(); options.memory_budget_bytes == 0 (a budget over a prefix of all pairs
+  // cannot be split).
+  PartialCheck check_part(const CollideOptions& options, const CheckPlan& plan, std::span<const std::uint32_t> part);
+
+  // Surface `s`, which has no triangles here, was tessellated by another process at `deflection`:
+  // search reaches use it, as they would in the process that holds its triangles. Precondition:
+  // s < model.surfaces.size().
+  void note_deflection(SurfaceId s, double deflection);
 
  private:
   struct Impl;

@@ -1,0 +1,132 @@
+// One check split over processes (collide.h, "One check split over processes"): the plan every
+// process computes, the part one process checks, and what it did per surface for the merge.
+#include "scene_stages.h"
+
+#include <omp.h>
+
+#include <cassert>
+#include <map>
+
+namespace cadclash {
+namespace {
+
+std::uint64_t triangles_of(const detail::SceneData& s, SurfaceId sid) {
+  const Surface& surf = s.model.surfaces[sid];
+  return surf.has_triangles ? surf.mesh.triangles.size() : kUntessellatedCost;
+}
+
+// Each pair's estimated cost (PlannedPair::cost) from its candidate surface pairs.
+std::vector<PlannedPair> costed_pairs(const detail::SceneData& s, const detail::QueryState& q) {
+  std::vector<PlannedPair> out(q.pairs.size());
+  for (std::size_t k = 0; k < q.pairs.size(); ++k) {
+    const detail::InstancePair& ip = q.pairs[k];
+    PlannedPair& p = out[k];
+    p.a = ip.a;
+    p.b = ip.b;
+    for (std::size_t t = q.first_task[k]; t < q.first_task[k + 1]; ++t)
+      p.cost += triangles_of(s, q.tasks[t].sa) + triangles_of(s, q.tasks[t].sb);
+    if (ip.containment)
+      for (InstanceId i : {ip.a, ip.b}) {
+        const PartId part = s.model.instances[i].part;
+        for (SurfaceId sid = s.first(part); sid < s.end(part); ++sid) p.cost += triangles_of(s, sid);
+      }
+  }
+  return out;
+}
+
+// What the query did per surface (SurfaceWork), and its surfaces' bytes taken out of the charge.
+std::vector<SurfaceWork> surface_work(const detail::SceneData& s, detail::QueryState& q,
+                                      const std::vector<char>& attempted_before) {
+  const Model& model = s.model;
+  std::map<SurfaceId, SurfaceWork> work;
+  auto at = [&](SurfaceId sid) -> SurfaceWork& {
+    SurfaceWork& w = work[sid];
+    w.surface = sid;
+    return w;
+  };
+  for (SurfaceId sid : q.asked) at(sid).asked = true;
+  for (SurfaceId sid : q.tessellated) {
+    SurfaceWork& w = at(sid);
+    w.tessellated = true;
+    w.deflection = model.surfaces[sid].deflection;
+    w.mesh_bytes = detail::mesh_bytes(model.surfaces[sid].mesh);
+  }
+  for (SurfaceId sid : q.built) {
+    SurfaceWork& w = at(sid);
+    const TriangleMesh& mesh = model.surfaces[sid].mesh;
+    w.built = true;
+    w.bvh_bytes = detail::bvh_heap_bytes(s.bvh[sid]);
+    w.held.triangles = mesh.triangles.size() * sizeof(mesh.triangles[0]);
+    w.held.vertices = mesh.vertices.size() * sizeof(mesh.vertices[0]);
+    w.held.hierarchies = w.bvh_bytes;
+    w.held.triangle_count = mesh.triangles.size();
+  }
+  assert(q.failed.size() == q.report.diagnostics.size());
+  for (std::size_t i = 0; i < q.failed.size(); ++i) at(q.failed[i]).error = q.report.diagnostics[i];
+  // refine_surfaces counts a face when its source meshed it finer than its triangles.
+  for (SurfaceId sid = 0; sid < s.refined.size(); ++sid)
+    if (!attempted_before[sid] && s.refined[sid].attempted &&
+        s.refined[sid].surface.deflection < model.surfaces[sid].deflection)
+      at(sid).refined = true;
+  std::vector<SurfaceWork> out;
+  out.reserve(work.size());
+  for (auto& [sid, w] : work) {
+    q.report.memory_charged -= w.mesh_bytes + w.bvh_bytes;
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
+}  // namespace
+
+CheckPlan Scene::plan(const CollideOptions& options) {
+  detail::SceneData& s = *impl_;
+  CollideOptions o = options;  // the plan is boxes only: no budget cuts it
+  o.time_budget_seconds = 0.0;
+  o.memory_budget_bytes = 0;
+  detail::QueryState q(o, std::chrono::steady_clock::now());
+  q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  detail::set_schedule(o.schedule);
+  detail::broad_phase_stage(s, q);
+  detail::surface_level_stage(s, q);
+  CheckPlan plan;
+  plan.broad = q.report.counters;
+  plan.broad.instance_pairs = 0;  // each part counts its own
+  plan.pairs = costed_pairs(s, q);
+  plan.needed = std::move(q.needed);
+  plan.seconds = detail::seconds_since(q.t0);
+  return plan;
+}
+
+PartialCheck Scene::check_part(const CollideOptions& o, const CheckPlan& plan, std::span<const std::uint32_t> part) {
+  assert(o.tolerance >= 0.0 && o.clearance >= 0.0 && o.time_budget_seconds >= 0.0);
+  assert(o.memory_budget_bytes == 0);
+  detail::SceneData& s = *impl_;
+  detail::QueryState q(o, std::chrono::steady_clock::now());
+  q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  detail::set_schedule(o.schedule);
+  q.pairs.resize(part.size());
+  for (std::size_t i = 0; i < part.size(); ++i) {
+    assert(part[i] < plan.pairs.size() && (i == 0 || part[i - 1] < part[i]));
+    q.pairs[i].a = plan.pairs[part[i]].a;
+    q.pairs[i].b = plan.pairs[part[i]].b;
+  }
+  q.report.counters.instance_pairs = part.size();
+  std::vector<char> attempted(s.refined.size());
+  for (std::size_t i = 0; i < s.refined.size(); ++i) attempted[i] = s.refined[i].attempted ? 1 : 0;
+  detail::narrow_stages(s, q);
+  PartialCheck out;
+  out.surfaces = surface_work(s, q, attempted);
+  q.report.counters.tessellated_surfaces = 0;
+  q.report.counters.refined_surfaces = 0;
+  q.report.diagnostics.clear();
+  out.report = std::move(q.report);
+  return out;
+}
+
+void Scene::note_deflection(SurfaceId s, double deflection) {
+  assert(s < impl_->noted_deflection.size());
+  impl_->noted_deflection[s] = deflection;
+}
+
+}  // namespace cadclash

@@ -1,0 +1,138 @@
+#include "cmd_check_mpi.h"
+
+#include "cadclash/distributed.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+namespace cadclash::cli {
+namespace {
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  if (v == nullptr || *v == '\0') return fallback;
+  char* end = nullptr;
+  const long x = std::strtol(v, &end, 10);
+  return (end != nullptr && *end == '\0' && x >= 0 && x < (1L << 30)) ? static_cast<int>(x) : fallback;
+}
+
+}  // namespace
+
+Launch mpi_launch() {
+  Launch l;
+  for (const auto& [rank_var, size_var] : {std::pair{"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"},
+                                           std::pair{"PMI_RANK", "PMI_SIZE"}}) {
+    const int size = env_int(size_var, -1);
+    if (size < 1) continue;
+    l.by_mpirun = true;
+    l.size = size;
+    l.rank = env_int(rank_var, 0);
+    break;
+  }
+  return l;
+}
+
+#if CADCLASH_HAS_MPI
+struct MpiCheck::State {
+  std::vector<RankStats> ranks;  // rank 0: summed over the queries
+  double merge_seconds = 0.0;
+  // One history for every check() of the scene (--repeat): what an earlier query tessellated or
+  // built is not counted again, as in one process.
+  std::optional<MergeHistory> history;
+  void add(const std::vector<RankStats>& r, double merge) {
+    merge_seconds += merge;
+    if (ranks.empty()) {
+      ranks = r;
+      return;
+    }
+    for (std::size_t i = 0; i < r.size(); ++i) add_stats(ranks[i], r[i]);
+  }
+};
+
+MpiCheck::MpiCheck() : state_(std::make_unique<State>()) {
+  int provided = 0;
+  // OpenMP threads inside a rank never call MPI: the main thread does every call.
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+}
+
+MpiCheck::~MpiCheck() { MPI_Finalize(); }
+
+bool MpiCheck::same_input_everywhere(const Model& model, const std::vector<Diagnostic>& diagnostics,
+                                     const std::string& extra) {
+  std::ostringstream what;
+  what << model.instances.size() << " instances, " << model.parts.size() << " parts, " << model.surfaces.size()
+       << " surfaces, " << diagnostics.size() << " import diagnostics, " << extra;
+  std::string text = what.str();
+  for (const Diagnostic& d : diagnostics) text += '\n' + format_diagnostic(d);
+  const unsigned long long mine = std::hash<std::string>{}(text);
+  std::vector<unsigned long long> all(static_cast<std::size_t>(size_));
+  MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, all.data(), 1, MPI_UNSIGNED_LONG_LONG, MPI_COMM_WORLD);
+  bool same = true;
+  for (int r = 1; r < size_; ++r) {
+    if (all[static_cast<std::size_t>(r)] == all[0]) continue;
+    same = false;
+    if (rank_ == 0)
+      std::cerr << "cadclash check: rank " << r << " read the input differently from rank 0 (rank 0: " << what.str()
+                << "): are the files the same on every host?\n";
+  }
+  return same;
+}
+
+Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
+  if (!state_->history) state_->history.emplace(model.surfaces.size(), scene.memory());
+  DistributedCheck c = check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD);
+  state_->add(c.ranks, c.merge_seconds);
+  return std::move(c.report);
+}
+
+std::vector<StepResult> MpiCheck::replay(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
+                                         const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
+                                         const std::string& file) {
+  DistributedReplay r = replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD);
+  state_->add(r.ranks, r.merge_seconds);
+  return std::move(r.steps);
+}
+
+void MpiCheck::print_ranks(std::ostream& os) const {
+  const std::vector<RankStats>& ranks = state_->ranks;
+  if (ranks.empty()) return;
+  double slowest = 0.0, sum = 0.0;
+  for (const RankStats& s : ranks) {
+    os << "rank " << s.rank << " of " << size_ << ": " << s.instance_pairs << " instance pairs (estimated cost "
+       << s.cost << "), " << s.triangles << " triangles, " << std::fixed << std::setprecision(3) << s.seconds
+       << " s (CPU " << s.cpu_seconds << " s; plan " << s.plan_seconds << " s), peak memory " << std::setprecision(1)
+       << static_cast<double>(s.peak_memory_bytes) / (1024.0 * 1024.0) << " MiB, results "
+       << static_cast<double>(s.result_bytes) / 1024.0 << " KiB\n"
+       << std::defaultfloat;
+    slowest = std::max(slowest, s.seconds);
+    sum += s.seconds;
+  }
+  const double mean = sum / static_cast<double>(ranks.size());
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);  // Linux: KiB
+  os << "rank 0 after merging and writing the report: peak memory " << std::fixed << std::setprecision(1)
+     << static_cast<double>(ru.ru_maxrss) / 1024.0 << " MiB\n"
+     << std::defaultfloat;
+  os << "load imbalance: slowest rank " << std::fixed << std::setprecision(3) << slowest << " s, mean " << mean
+     << " s (" << std::setprecision(2) << (mean > 0.0 ? slowest / mean : 1.0) << "x); merge on rank 0 "
+     << std::setprecision(3) << state_->merge_seconds << " s\n"
+     << std::defaultfloat;
+}
+
+int MpiCheck::agree(int code) {
+  MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return code;
+}
+#endif
+
+}  // namespace cadclash::cli

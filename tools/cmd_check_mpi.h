@@ -1,0 +1,89 @@
+// `cadclash check` under mpirun: the MPI session, the split check and the per-rank lines
+// (cadclash/distributed.h does the work). MpiCheck exists with CADCLASH_WITH_MPI only.
+#pragma once
+
+#include "cadclash/collide.h"
+
+#include <cstdint>
+#include <iostream>
+#include <streambuf>
+#include <memory>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace cadclash::cli {
+
+// This process's rank and the job's size as the launcher (mpirun) set them in the environment,
+// read before MPI starts; size 1 and rank 0 when not launched by mpirun.
+struct Launch {
+  int rank = 0;
+  int size = 1;
+  bool by_mpirun = false;
+};
+Launch mpi_launch();
+
+// Where a rank's output goes: rank 0 (or a single process) prints, the other ranks of an MPI job
+// stay silent (they run the same code on their replica).
+class SilentRank {
+ public:
+  explicit SilentRank(bool on) {
+    if (!on) return;
+    out_ = std::cout.rdbuf(&null_);
+    err_ = std::cerr.rdbuf(&null_);
+  }
+  ~SilentRank() {
+    if (out_ != nullptr) std::cout.rdbuf(out_);
+    if (err_ != nullptr) std::cerr.rdbuf(err_);
+  }
+  SilentRank(const SilentRank&) = delete;
+  SilentRank& operator=(const SilentRank&) = delete;
+
+ private:
+  struct : std::streambuf {
+    int overflow(int c) override { return c; }
+  } null_;
+  std::streambuf* out_ = nullptr;
+  std::streambuf* err_ = nullptr;
+};
+
+class MpiCheck;
+#if CADCLASH_HAS_MPI
+// One MPI session (MPI_Init_thread on construction, MPI_Finalize on destruction) and the distributed
+// forms of the queries. Every rank calls every method in the same order (collectives).
+class MpiCheck {
+ public:
+  MpiCheck();
+  ~MpiCheck();
+  MpiCheck(const MpiCheck&) = delete;
+  MpiCheck& operator=(const MpiCheck&) = delete;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+  // True when every rank imported the same model with the same diagnostics. Else, on rank 0, says on
+  // stderr which rank read what (a file missing or different on its host).
+  // `extra`: what else every rank read (the trajectory), in words.
+  bool same_input_everywhere(const Model& model, const std::vector<Diagnostic>& diagnostics, const std::string& extra);
+  // Scene::check split over the ranks; the merged report on rank 0 (empty elsewhere).
+  Report check(Scene& scene, Model& model, const CollideOptions& options);
+  // replay_trajectory split over the ranks; the steps on rank 0.
+  std::vector<StepResult> replay(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
+                                 const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
+                                 const std::string& file);
+  // Rank 0: one line per rank (instance pairs, estimated cost, triangles, seconds, peak memory at the
+  // end of its part, bytes sent), rank 0's peak after merging and writing, and the load imbalance
+  // and merge time, over the queries run so far.
+  void print_ranks(std::ostream& os) const;
+  // Rank 0's exit code, on every rank.
+  int agree(int code);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+  int rank_ = 0, size_ = 1;
+};
+#endif
+
+}  // namespace cadclash::cli
