@@ -1,0 +1,117 @@
+// cadclash/review.h — the clash review of a report: stable clash ids, the diff against a baseline
+// report, approvals, and grouping (docs/review.md; the report's `clashes` and `review`).
+//
+// A clash is one instance pair of a query with all its reported surface pairs. Everything here
+// works on the report's structs (cadclash/report.h): a report read back from JSON reviews exactly as
+// the query it was written from, so the CLI, the Python bindings and any later merge of partial
+// reports share one definition.
+//
+// Contracts:
+// - clash_id() depends only on the two instance paths and the two part names (never on STEP #ids,
+//   array indices, coordinates, the thread count or the order the sides are given in).
+// - Functions here never print and never throw; untrusted text (an approvals file) gives a
+//   ReportError naming the JSON pointer of the problem.
+// - Dates are ISO "YYYY-MM-DD" strings compared as text; `today` is always given by the caller
+//   (the CLI: --today, else the UTC date), so a review is reproducible.
+// Depends on cadclash::report only.
+#pragma once
+
+#include "cadclash/report.h"
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cadclash {
+
+// The clash id of an instance pair: the first 12 hex digits (48 bits, lower case) of the 64-bit
+// FNV-1a hash of "cadclash-clash-1" NUL path₁ NUL part₁ NUL path₂ NUL part₂, where side 1 is the
+// side whose (path, part) is smaller in byte order. clash_id(a, pa, b, pb) == clash_id(b, pb, a, pa).
+std::string clash_id(std::string_view instance_a, std::string_view part_a, std::string_view instance_b,
+                     std::string_view part_b);
+
+// The key of a surface pair within its clash, the sides in the clash's order: each side
+// "f<face index>" followed by ":<name>" when the file named the face (STEP face names, OBJ groups)
+// with anything but "#<digits>" (an exporter's entity id, which renumbering changes), or "part" for
+// a containment; joined by " x " ("f12 x f3:TOP").
+std::string surface_pair_key(const ReportSide& first, const ReportSide& second);
+
+// Severity order of the classes for a clash's worst class: penetrating > containment > undecided >
+// touching > clearance. Returns the more severe of the two.
+ContactClass worse_class(ContactClass x, ContactClass y);
+
+// True for the classes --fail-on-collision counts (all but clearance).
+bool collision_class(ContactClass c);
+
+// How clashes are grouped (ReportClash::group): "instance" (the clash's own "path x path"),
+// "part" ("part x part", the part names in clash order) or "subassembly" (the deepest assembly path
+// holding both instances; "/" when they share none).
+inline constexpr std::array<std::string_view, 3> kGroupBy{"instance", "part", "subassembly"};
+
+// The clashes of `q`: one per instance pair, in the order of each pair's first surface pair; sides
+// ordered as clash_id() orders them; status New; not approved; `group` per `group_by`.
+// Precondition: group_by is one of kGroupBy.
+std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group_by = "instance");
+
+// Sets each clash's status against `baseline` (clashes_of() the baseline report's query): New when
+// its id is not there; Changed when its worst class, the set of its surface-pair keys or one of
+// their classes differs, or its max_penetration moved by more than `depth_change` mm; else Active.
+// Appends every baseline clash whose id is gone, status Resolved, with its last data (`pair` -1).
+void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportClash>& baseline, double depth_change);
+
+// Glob over instance paths and part names: `*` any run of characters except '/', `**` any run
+// including '/', `?` one character except '/'; anything else matches itself.
+bool glob_match(std::string_view pattern, std::string_view text);
+
+// Whether `a` (an id, or a rule of globs applied to the sides in either order) covers `c`, and its
+// `classes` (when given) hold c's worst class. Expiry is not looked at here.
+bool approval_matches(const Approval& a, const ReportClash& c);
+
+// Applies `approvals` (in file order; `file` names them in ApprovalUse::source) to the clashes not
+// resolved: each gets the first unexpired approval that matches it. An approval whose `expires` is
+// before `today` is expired and applies to nothing. Returns what became of every approval.
+// Precondition: `today` is YYYY-MM-DD (iso_date).
+std::vector<ApprovalUse> apply_approvals(std::vector<ReportClash>& clashes, const std::vector<Approval>& approvals,
+                                         const std::string& file, const std::string& today);
+
+// True when `d` is YYYY-MM-DD (month 01-12, day 01-31).
+bool iso_date(std::string_view d);
+
+// ---------------------------------------------------------------------------------------------
+// The whole review, and what it means for --fail-on-collision
+// ---------------------------------------------------------------------------------------------
+
+struct ReviewOptions {
+  std::string group_by = "instance";  // one of kGroupBy
+  double depth_change = 0.01;         // mm: a smaller move of max_penetration keeps a clash active
+  std::string baseline_file;          // recorded in the review; "" = none
+  std::string approvals_file;         // recorded in the review and in ApprovalUse::source
+  std::string today;                  // YYYY-MM-DD; needed (and recorded) only with approvals
+};
+
+// clashes_of(current), diffed against `baseline` when given, approvals applied.
+// Preconditions: o.group_by is in kGroupBy; o.today is a date when approvals are given.
+ClashReview review_query(const QueryReport& current, const QueryReport* baseline, const std::vector<Approval>& approvals,
+                         const ReviewOptions& o);
+
+// True when a clash that is not resolved and not approved has a collision class.
+bool unapproved_collision(const ClashReview& r);
+
+// ---------------------------------------------------------------------------------------------
+// The approvals file (docs/review.md): {"schema": "cadclash-approvals", "version": 1, "approvals": [...]}
+// ---------------------------------------------------------------------------------------------
+
+inline constexpr std::string_view kApprovalsSchema = "cadclash-approvals";
+inline constexpr int kApprovalsVersion = 1;
+
+struct ApprovalsReadResult {
+  std::vector<Approval> approvals;   // meaningful only when !error
+  std::optional<ReportError> error;  // the first problem, with its JSON pointer
+};
+// Parses an approvals file's text. Never throws.
+ApprovalsReadResult approvals_from_json(std::string_view text);
+// The file's text: 2-space indent, one trailing newline; approvals_from_json() reads it back equal.
+std::string approvals_text(const std::vector<Approval>& approvals);
+
+}  // namespace cadclash
