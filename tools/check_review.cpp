@@ -38,8 +38,13 @@ void add_review_options(CLI::App& cmd, ReviewCliOptions& o) {
   cmd.add_option("--today", o.today, "The date approvals expire against, YYYY-MM-DD (default: today, UTC)")
       ->check([](const std::string& d) { return iso_date(d) ? std::string() : "expected a date YYYY-MM-DD"; });
   std::vector<std::string> groups(kGroupBy.begin(), kGroupBy.end());
-  cmd.add_option("--group-by", o.group_by, "Group clashes by instance pair, part pair or common sub-assembly")
+  cmd.add_option("--group-by", o.group_by,
+                 "Group clashes by instance pair, part pair, common sub-assembly, or place (space: clusters of "
+                 "clashes within --cluster-distance)")
       ->check(CLI::IsMember(groups));
+  cmd.add_option("--cluster-distance", o.cluster_distance,
+                 "With --group-by space: clashes whose contact boxes come this close (mm) share a cluster")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option("--depth-change", o.depth_change,
                  "A clash whose max penetration moved by more than this (mm) since the baseline is changed")
       ->check(CLI::NonNegativeNumber);
@@ -63,6 +68,7 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
   ReviewInputs in;
   in.options.group_by = o.group_by;
   in.options.depth_change = o.depth_change;
+  in.options.cluster_distance = o.cluster_distance;
   in.options.baseline_file = o.baseline;
   in.options.approvals_file = o.approvals;
   if (!o.baseline.empty()) {

@@ -18,6 +18,7 @@ struct ReviewCliOptions {
   std::string approvals;  // an approvals file (docs/review.md)
   std::string today;      // YYYY-MM-DD; "" = today's UTC date
   std::string group_by = "instance";
+  double cluster_distance = 10.0;  // mm, with --group-by space
   double depth_change = 0.01;  // mm
   bool expand = false;         // list every surface pair under its clash even on a terminal
 };

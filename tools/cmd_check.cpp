@@ -252,7 +252,13 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, Scene& scene, con
   for (int k = 1; k < o.repeat; ++k) r = scene.check(copt);  // a prepared scene: BVHs already built
   out.diagnostics = r.diagnostics;
   report.query = query_report(m, r);
-  report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, review.options);
+  ReviewOptions ro = review.options;
+  if (ro.group_by == "space") {  // where each pair meets: the boxes the clusters are made of
+    std::vector<Pose> poses;
+    for (const Instance& i : m.instances) poses.push_back(i.pose);
+    ro.pair_boxes = contact_boxes(m, poses, r);
+  }
+  report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, ro);
   out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
   if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
   if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";

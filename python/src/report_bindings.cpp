@@ -108,6 +108,8 @@ void bind_report(pyb::module_& m) {
              const std::string& group_by, double depth_change) {
             if (!r.query) throw pyb::value_error("a trajectory report has no clashes to review");
             if (baseline && !baseline->query) throw pyb::value_error("a trajectory report cannot be a baseline");
+            if (group_by == "space")
+              throw pyb::value_error("group_by='space' needs the model's geometry: use `cadclash check --group-by space`");
             if (std::find(kGroupBy.begin(), kGroupBy.end(), group_by) == kGroupBy.end())
               throw pyb::value_error("group_by must be 'instance', 'part' or 'subassembly', not '" + group_by + "'");
             if (depth_change < 0) throw pyb::value_error("depth_change must be >= 0");

@@ -2,6 +2,7 @@
 #include "cadclash/report.h"
 #include "cadclash/review.h"
 
+#include <algorithm>
 #include <limits>
 #include <utility>
 
@@ -248,6 +249,13 @@ ReportClash read_clash(const Json& j, const std::string& p) {
   c.max_penetration = number(field(j, p, "max_penetration"), p + "/max_penetration");
   c.min_distance = number(field(j, p, "min_distance"), p + "/min_distance", true);
   c.group = text(field(j, p, "group"), p + "/group");
+  const Json& box = field(j, p, "box");
+  if (!box.is_null()) {
+    if (!box.is_array() || box.size() != 6) fail(p + "/box", "expected [min x, y, z, max x, y, z] or null");
+    std::array<double, 6> v{};
+    for (std::size_t k = 0; k < 6; ++k) v[k] = number(box[k], p + "/box/" + std::to_string(k));
+    c.box = v;
+  }
   const Json& approval = field(j, p, "approval");
   if (!approval.is_null()) c.approval = integer(approval, p + "/approval", 0, INT64_MAX);
   const std::string ps = p + "/surface_pairs";
@@ -274,6 +282,9 @@ ClashReview read_review(const Json& j, const QueryReport& query) {
   r.approvals_file = string_or_null(field(rv, "/review", "approvals_file"), "/review/approvals_file");
   r.today = string_or_null(field(rv, "/review", "today"), "/review/today");
   r.group_by = text(field(rv, "/review", "group_by"), "/review/group_by");
+  if (std::find(kGroupBy.begin(), kGroupBy.end(), r.group_by) == kGroupBy.end())
+    fail("/review/group_by", "unknown grouping '" + r.group_by + "' (one of instance, part, subassembly, space)");
+  r.cluster_distance = number(field(rv, "/review", "cluster_distance"), "/review/cluster_distance");
   const Json& approvals = array(field(rv, "/review", "approvals"), "/review/approvals");
   for (std::size_t k = 0; k < approvals.size(); ++k) {
     const std::string pk = "/review/approvals/" + std::to_string(k);

@@ -281,6 +281,7 @@ nlohmann::json clashes_json(const ClashReview& r) {
                      {"max_penetration", c.max_penetration},
                      {"min_distance", number_or_null(c.min_distance)},
                      {"group", c.group},
+                     {"box", c.box ? nlohmann::json(*c.box) : nlohmann::json(nullptr)},
                      {"approval", c.approval < 0 ? nlohmann::json(nullptr) : nlohmann::json(c.approval)},
                      {"surface_pairs", std::move(sp)}};
     out.push_back(std::move(j));
@@ -315,6 +316,7 @@ nlohmann::json review_json(const ClashReview& r) {
           {"approvals_file", string_or_null(r.approvals_file)},
           {"today", string_or_null(r.today)},
           {"group_by", r.group_by},
+          {"cluster_distance", r.cluster_distance},
           {"summary", std::move(counts)},
           {"approvals", std::move(approvals)}};
 }

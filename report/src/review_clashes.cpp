@@ -49,8 +49,12 @@ bool entity_id_name(const std::string& name) {
 
 std::string face_label(const ReportSide& s) {
   if (s.whole_part) return "part";
-  std::string out = "f" + std::to_string(s.face_index);
-  if (!s.source_name.empty() && !entity_id_name(s.source_name)) out += ":" + s.source_name;
+  std::string out = "f";
+  out += std::to_string(s.face_index);
+  if (!s.source_name.empty() && !entity_id_name(s.source_name)) {
+    out += ':';
+    out += s.source_name;
+  }
   return out;
 }
 
@@ -96,8 +100,10 @@ ContactClass worse_class(ContactClass x, ContactClass y) { return severity(y) > 
 
 bool collision_class(ContactClass c) { return c != ContactClass::Clearance; }
 
-std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group_by) {
+std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group_by,
+                                    std::span<const std::array<double, 6>> pair_boxes, double cluster_distance) {
   assert(std::find(kGroupBy.begin(), kGroupBy.end(), group_by) != kGroupBy.end());
+  assert(pair_boxes.empty() || pair_boxes.size() == q.pairs.size());
   std::vector<ReportClash> out;
   std::map<std::pair<std::string, std::string>, std::size_t> index;  // (instance a, instance b) as reported
   for (std::size_t k = 0; k < q.pairs.size(); ++k) {
@@ -123,8 +129,20 @@ std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group
     c.max_penetration = std::max(c.max_penetration, p.penetration);
     c.min_distance = std::min(c.min_distance, p.distance);
     c.surface_pairs.push_back({surface_pair_key(first, second), static_cast<std::int64_t>(k), p.contact, p.penetration, p.distance});
+    if (!pair_boxes.empty()) {
+      const std::array<double, 6>& b = pair_boxes[k];
+      if (!c.box) c.box = b;
+      for (int a = 0; a < 3; ++a) {
+        (*c.box)[a] = std::min((*c.box)[a], b[a]);
+        (*c.box)[a + 3] = std::max((*c.box)[a + 3], b[a + 3]);
+      }
+    }
   }
-  for (ReportClash& c : out) c.group = group_of(c, group_by);
+  if (group_by == "space") {
+    cluster_clashes(out, cluster_distance);
+  } else {
+    for (ReportClash& c : out) c.group = group_of(c, group_by);
+  }
   return out;
 }
 
@@ -163,9 +181,14 @@ ClashReview review_query(const QueryReport& current, const QueryReport* baseline
   r.baseline = o.baseline_file;
   r.approvals_file = o.approvals_file;
   r.group_by = o.group_by;
-  r.clashes = clashes_of(current, o.group_by);
+  const bool space = o.group_by == "space";
+  r.cluster_distance = space ? o.cluster_distance : 0.0;
+  r.clashes = clashes_of(current, o.group_by, o.pair_boxes, o.cluster_distance);
   if (baseline) {
-    std::vector<ReportClash> before = clashes_of(*baseline, o.group_by);
+    // Grouped by instance pair for the resolved ones: the baseline's clusters mean nothing now.
+    std::vector<ReportClash> before = clashes_of(*baseline, space ? "instance" : o.group_by);
+    if (space)
+      for (ReportClash& c : before) c.group = "resolved";
     diff_clashes(r.clashes, before, o.depth_change);
   }
   if (!o.approvals_file.empty() || !approvals.empty()) {

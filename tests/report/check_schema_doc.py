@@ -138,7 +138,8 @@ def main() -> int:
                 {"a": "/as1/**", "b": "**/BOLT", "part_a": "*", "part_b": "bolt", "classes": ["touching"],
                  "expires": "2027-01-01", **common},
                 {"id": "000000000000", "expires": "2020-01-01", **common}]}))
-            return [as1, "--no-timings", "--baseline", outs[2], "--approvals", approvals, "--today", "2026-06-01"]
+            return [as1, "--no-timings", "--baseline", outs[2], "--approvals", approvals, "--today", "2026-06-01",
+                    "--group-by", "space"]
 
         for k, args in enumerate([*runs, None]):
             args = args if args is not None else review_run()

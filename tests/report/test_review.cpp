@@ -110,6 +110,39 @@ TEST(Clashes, SubassemblyGroupIsTheDeepestCommonAssembly) {
   EXPECT_EQ(c[2].group, "/");
 }
 
+TEST(Space, ClustersChainWithinTheDistanceAndNumberInClashOrder) {
+  std::vector<ReportClash> c(5);
+  c[0].box = std::array<double, 6>{0, 0, 0, 1, 1, 1};
+  c[1].box = std::array<double, 6>{10, 0, 0, 11, 1, 1};   // far from everything
+  c[2].box = std::array<double, 6>{1.5, 0, 0, 2.5, 1, 1};  // 0.5 from c[0]
+  c[4].box = std::array<double, 6>{3, 0.5, 0, 4, 1, 1};    // 0.5 from c[2] only: chained to c[0]
+  cluster_clashes(c, 0.6);
+  EXPECT_EQ(c[0].group, "cluster 1");
+  EXPECT_EQ(c[1].group, "cluster 2");
+  EXPECT_EQ(c[2].group, "cluster 1");
+  EXPECT_EQ(c[3].group, "cluster 3");  // no box: alone
+  EXPECT_EQ(c[4].group, "cluster 1");
+  cluster_clashes(c, 0.4);
+  EXPECT_EQ(c[2].group, "cluster 3");
+  EXPECT_EQ(c[4].group, "cluster 5");
+  // Off in y and z too: the distance is box to box in 3D, not along x alone.
+  c[2].box = std::array<double, 6>{1.5, 3, 0, 2.5, 4, 1};
+  cluster_clashes(c, 0.6);
+  EXPECT_EQ(c[2].group, "cluster 3");
+}
+
+TEST(Space, ClashBoxIsTheUnionOfItsPairs) {
+  const QueryReport q = query({pair("/a", 1, "/b", 1, ContactClass::Touching), pair("/a", 2, "/b", 2, ContactClass::Touching),
+                               pair("/a", 3, "/c", 1, ContactClass::Touching)});
+  const std::vector<std::array<double, 6>> boxes{{0, 0, 0, 1, 1, 1}, {-1, 2, 0, 0, 3, 0}, {50, 50, 50, 51, 51, 51}};
+  const std::vector<ReportClash> c = clashes_of(q, "space", boxes, 1.0);
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(*c[0].box, (std::array<double, 6>{-1, 0, 0, 1, 3, 1}));
+  EXPECT_EQ(c[0].group, "cluster 1");
+  EXPECT_EQ(c[1].group, "cluster 2");
+  EXPECT_FALSE(clashes_of(q)[0].box);
+}
+
 TEST(Baseline, EveryStatus) {
   const QueryReport before = query({pair("/a", 1, "/b", 1, ContactClass::Touching),      // stays: active
                                     pair("/a", 2, "/c", 1, ContactClass::Touching),      // turns penetrating

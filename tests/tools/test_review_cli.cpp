@@ -161,6 +161,31 @@ TEST(ReviewCli, TwoRunsEveryStatusApprovalsAndFailOnCollision) {
   EXPECT_EQ(run_cadclash("check " + q(moved) + " --approvals " + q(all) + " --today 2026-07-01 --fail-on-collision").code, 3);
 }
 
+TEST(ReviewCli, SpatialClustersAreDeterministic) {
+  const nlohmann::json one = check(q(kAs1) + " --group-by space --cluster-distance 1 --threads 1", scratch("space1.json"));
+  const CliRun two = run_cadclash("check " + q(kAs1) + " --group-by space --cluster-distance 1 --threads 2 --no-timings --json " +
+                                  q(scratch("space2.json")));
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_EQ(slurp(scratch("space1.json")), slurp(scratch("space2.json")));
+  std::set<std::string> clusters;
+  for (const nlohmann::json& c : one["clashes"]) {
+    ASSERT_TRUE(c["box"].is_array()) << c.dump();
+    for (int k = 0; k < 3; ++k) EXPECT_LE(c["box"][k].get<double>(), c["box"][k + 3].get<double>());
+    clusters.insert(c["group"]);
+  }
+  EXPECT_GT(clusters.size(), 1u);  // as1's two brackets and the rod are more than 1 mm apart
+  EXPECT_LT(clusters.size(), one["clashes"].size());
+  EXPECT_EQ(one["review"]["cluster_distance"], 1.0);
+  // Everything within a kilometre: one cluster.
+  const nlohmann::json all = check(q(kAs1) + " --group-by space --cluster-distance 1e6", scratch("space3.json"));
+  for (const nlohmann::json& c : all["clashes"]) EXPECT_EQ(c["group"], "cluster 1");
+  // A bolt shares a cluster with its nut and with the bracket it holds.
+  std::map<std::string, std::string> group;
+  for (const nlohmann::json& c : one["clashes"]) group[c["a"]["instance"].get<std::string>() + " x " + c["b"]["instance"].get<std::string>()] = c["group"];
+  EXPECT_EQ(group.at("/as1/L-BRACKET-ASSEMBLY::1/NUT-BOLT-ASSEMBLY::1/BOLT x /as1/L-BRACKET-ASSEMBLY::1/NUT-BOLT-ASSEMBLY::1/NUT::3"),
+            group.at("/as1/L-BRACKET-ASSEMBLY::1/L-BRACKET x /as1/L-BRACKET-ASSEMBLY::1/NUT-BOLT-ASSEMBLY::1/BOLT"));
+}
+
 std::string boxes() {
   const std::string d = std::string(CADCLASH_DATA_DIR) + "/collide/";
   return q(d + "box_a.obj") + " " + q(d + "box_overlap.obj") + " " + q(d + "box_touch.obj");

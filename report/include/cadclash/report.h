@@ -247,6 +247,9 @@ struct ReportClash {
   double max_penetration = 0.0;
   double min_distance = 0.0;  // +infinity: null
   std::string group;          // the group it belongs to (ClashReview::group_by)
+  // World box of where the two meet (review.h: contact_boxes), for the viewer and spatial groups;
+  // nullopt when not known (a resolved clash, or a review without the model).
+  std::optional<std::array<double, 6>> box;
   std::int64_t approval = -1;  // index into ClashReview::approvals; -1: not approved
   std::vector<ClashSurfacePair> surface_pairs;
 };
@@ -273,7 +276,8 @@ struct ClashReview {
   std::string baseline;   // the baseline report's file; empty: none (every clash is new)
   std::string approvals_file;  // empty: none
   std::string today;      // YYYY-MM-DD the expiries were judged by; empty without approvals
-  std::string group_by = "instance";  // instance | part | subassembly
+  std::string group_by = "instance";  // instance | part | subassembly | space
+  double cluster_distance = 0.0;      // mm, with group_by "space"
   std::vector<ReportClash> clashes;   // current clashes in the order of their first pair, then resolved ones
   std::vector<ApprovalUse> approvals;
 };

@@ -18,7 +18,9 @@
 
 #include "cadclash/report.h"
 
+#include <array>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,14 +47,30 @@ ContactClass worse_class(ContactClass x, ContactClass y);
 bool collision_class(ContactClass c);
 
 // How clashes are grouped (ReportClash::group): "instance" (the clash's own "path x path"),
-// "part" ("part x part", the part names in clash order) or "subassembly" (the deepest assembly path
-// holding both instances; "/" when they share none).
-inline constexpr std::array<std::string_view, 3> kGroupBy{"instance", "part", "subassembly"};
+// "part" ("part x part", the part names in clash order), "subassembly" (the deepest assembly path
+// holding both instances; "/" when they share none) or "space" ("cluster <k>": clashes whose boxes
+// come within ReviewOptions::cluster_distance of each other, chained; k counts from 1 in clash order;
+// a clash without a box is a cluster of its own).
+inline constexpr std::array<std::string_view, 4> kGroupBy{"instance", "part", "subassembly", "space"};
 
 // The clashes of `q`: one per instance pair, in the order of each pair's first surface pair; sides
-// ordered as clash_id() orders them; status New; not approved; `group` per `group_by`.
-// Precondition: group_by is one of kGroupBy.
-std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group_by = "instance");
+// ordered as clash_id() orders them; status New; not approved; `group` per `group_by` ("space"
+// without boxes: every clash its own cluster). `pair_boxes`, when not empty, holds one world box
+// per pair of `q` (contact_boxes()); a clash's box is the union of its pairs' boxes.
+// Preconditions: group_by is one of kGroupBy; pair_boxes is empty or has q.pairs.size() entries.
+std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group_by = "instance",
+                                    std::span<const std::array<double, 6>> pair_boxes = {}, double cluster_distance = 0.0);
+
+// Where each pair of `r` meets, in world coordinates at `poses` (one per instance of `model`): per
+// axis, the overlap of the two surfaces' world boxes, or the gap between them when they do not
+// overlap (a clearance pair). A whole-part side (containment) uses its part's surfaces' box.
+// Preconditions: every id in `r` is valid for `model`; poses.size() == model.instances.size().
+std::vector<std::array<double, 6>> contact_boxes(const Model& model, std::span<const Pose> poses, const Report& r);
+
+// Gives clashes whose boxes come within `distance` (mm, box to box) of each other one group,
+// "cluster <k>", chaining (single linkage); k counts from 1 in clash order. Sorts on the boxes'
+// lower x and sweeps, so well-separated scenes cost about n log n.
+void cluster_clashes(std::vector<ReportClash>& clashes, double distance);
 
 // Sets each clash's status against `baseline` (clashes_of() the baseline report's query): New when
 // its id is not there; Changed when its worst class, the set of its surface-pair keys or one of
@@ -84,7 +102,9 @@ bool iso_date(std::string_view d);
 
 struct ReviewOptions {
   std::string group_by = "instance";  // one of kGroupBy
+  double cluster_distance = 10.0;     // mm, with group_by "space"
   double depth_change = 0.01;         // mm: a smaller move of max_penetration keeps a clash active
+  std::vector<std::array<double, 6>> pair_boxes;  // contact_boxes() of the current query; empty: unknown
   std::string baseline_file;          // recorded in the review; "" = none
   std::string approvals_file;         // recorded in the review and in ApprovalUse::source
   std::string today;                  // YYYY-MM-DD; needed (and recorded) only with approvals
