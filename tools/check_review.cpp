@@ -3,10 +3,13 @@
 
 #include "cli_common.h"
 
+#include "cadclash/interference.h"
+
 #include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <unistd.h>
 
@@ -49,6 +52,9 @@ void add_review_options(CLI::App& cmd, ReviewCliOptions& o) {
                  "A clash whose max penetration moved by more than this (mm) since the baseline is changed")
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--expand", o.expand, "List every surface pair under its clash, also on a terminal");
+  cmd.add_flag("--volume", o.volume,
+               "Interference volume, depth and centroid of each penetrating or containment clash (Boolean common "
+               "of the two B-rep solids; docs/review.md)");
 }
 
 std::string utc_today() {
@@ -61,8 +67,9 @@ std::string utc_today() {
 }
 
 std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool trajectory) {
-  if (trajectory && (!o.baseline.empty() || !o.approvals.empty())) {
-    std::cerr << "cadclash check: --baseline and --approvals review one query; a --path report has no clashes\n";
+  if (trajectory && (!o.baseline.empty() || !o.approvals.empty() || o.volume || o.group_by != "instance")) {
+    std::cerr << "cadclash check: --baseline, --approvals, --group-by and --volume review one query; a --path report "
+                 "has no clashes\n";
     return std::nullopt;
   }
   ReviewInputs in;
@@ -105,6 +112,18 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
   return in;
 }
 
+void measure_clashes(const Model& m, ClashReview& r) {
+  std::map<std::string, InstanceId> by_path;
+  for (InstanceId i = 0; i < m.instances.size(); ++i) by_path.emplace(m.instances[i].path, i);
+  for (ReportClash& c : r.clashes) {
+    if (c.status == ClashStatus::Resolved ||
+        (c.worst != ContactClass::Penetrating && c.worst != ContactClass::Containment))
+      continue;
+    const InterferenceResult v = measure_interference(m, by_path.at(c.instance_a), by_path.at(c.instance_b));
+    c.interference = ClashInterference{v.measured, v.note, v.volume, v.depth, {v.centroid.x(), v.centroid.y(), v.centroid.z()}};
+  }
+}
+
 std::vector<const ReportClash*> clash_of_pairs(const ClashReview& r, std::size_t pairs) {
   std::vector<const ReportClash*> out(pairs, nullptr);
   for (const ReportClash& c : r.clashes)
@@ -120,6 +139,10 @@ std::string clash_heading(const ClashReview& r, const ReportClash& c) {
   s << "  " << contact_class_name(c.worst);
   if (c.max_penetration > 0) s << ", max penetration " << fmt_mm(c.max_penetration);
   s << ", " << c.surface_pairs.size() << " surface pair" << (c.surface_pairs.size() == 1 ? "" : "s");
+  if (c.interference && c.interference->measured)
+    s << ", interference " << fmt_mm(c.interference->volume) << " mm3, depth " << fmt_mm(c.interference->depth) << " mm";
+  else if (c.interference)
+    s << ", no volume: " << c.interference->note;
   if (r.group_by != "instance") s << "  [group " << c.group << "]";
   return s.str();
 }

@@ -21,6 +21,7 @@ struct ReviewCliOptions {
   double cluster_distance = 10.0;  // mm, with --group-by space
   double depth_change = 0.01;  // mm
   bool expand = false;         // list every surface pair under its clash even on a terminal
+  bool volume = false;         // measure the interference of penetrating and containment clashes
 };
 
 // Adds --baseline, --approvals, --today, --group-by, --depth-change and --expand to `cmd`.
@@ -40,6 +41,10 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
 
 // Today's date in UTC, YYYY-MM-DD.
 std::string utc_today();
+
+// With --volume: the Boolean common of each current penetrating or containment clash's two solids
+// (cadclash/interference.h) into its `interference`.
+void measure_clashes(const Model& m, ClashReview& r);
 
 // For each pair index of the query, its clash in `r` (nullptr for none).
 std::vector<const ReportClash*> clash_of_pairs(const ClashReview& r, std::size_t pairs);

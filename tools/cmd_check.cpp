@@ -259,6 +259,7 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, Scene& scene, con
     ro.pair_boxes = contact_boxes(m, poses, r);
   }
   report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, ro);
+  if (o.review.volume) measure_clashes(m, *report.review);
   out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
   if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
   if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";

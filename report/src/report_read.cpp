@@ -256,6 +256,22 @@ ReportClash read_clash(const Json& j, const std::string& p) {
     for (std::size_t k = 0; k < 6; ++k) v[k] = number(box[k], p + "/box/" + std::to_string(k));
     c.box = v;
   }
+  const Json& measure = field(j, p, "interference");
+  if (!measure.is_null()) {
+    const std::string pi = p + "/interference";
+    ClashInterference i;
+    i.measured = boolean(field(measure, pi, "measured"), pi + "/measured");
+    i.note = string_or_null(field(measure, pi, "note"), pi + "/note");
+    i.volume = number(field(measure, pi, "volume"), pi + "/volume");
+    i.depth = number(field(measure, pi, "depth"), pi + "/depth");
+    const Json& centroid = field(measure, pi, "centroid");
+    if (!centroid.is_null()) {
+      if (!centroid.is_array() || centroid.size() != 3) fail(pi + "/centroid", "expected [x, y, z] or null");
+      for (std::size_t k = 0; k < 3; ++k) i.centroid[k] = number(centroid[k], pi + "/centroid/" + std::to_string(k));
+    }
+    if (centroid.is_null() != (i.volume <= 0)) fail(pi + "/centroid", "is null exactly when the volume is 0");
+    c.interference = i;
+  }
   const Json& approval = field(j, p, "approval");
   if (!approval.is_null()) c.approval = integer(approval, p + "/approval", 0, INT64_MAX);
   const std::string ps = p + "/surface_pairs";

@@ -263,6 +263,15 @@ nlohmann::json approval_json(const Approval& a) {
   return j;
 }
 
+static nlohmann::json interference_json(const std::optional<ClashInterference>& i) {
+  if (!i) return nullptr;
+  return {{"measured", i->measured},
+          {"note", string_or_null(i->note)},
+          {"volume", i->volume},
+          {"depth", i->depth},
+          {"centroid", i->volume > 0 ? nlohmann::json(i->centroid) : nlohmann::json(nullptr)}};
+}
+
 nlohmann::json clashes_json(const ClashReview& r) {
   nlohmann::json out = nlohmann::json::array();
   for (const ReportClash& c : r.clashes) {
@@ -282,6 +291,7 @@ nlohmann::json clashes_json(const ClashReview& r) {
                      {"min_distance", number_or_null(c.min_distance)},
                      {"group", c.group},
                      {"box", c.box ? nlohmann::json(*c.box) : nlohmann::json(nullptr)},
+                     {"interference", interference_json(c.interference)},
                      {"approval", c.approval < 0 ? nlohmann::json(nullptr) : nlohmann::json(c.approval)},
                      {"surface_pairs", std::move(sp)}};
     out.push_back(std::move(j));

@@ -33,6 +33,7 @@ SECTIONS = {
     "Clash": "clash",
     "ClashSide": "clash_side",
     "ClashSurfacePair": "clash_pair",
+    "ClashInterference": "interference",
     "`review`": "review",
     "`review.summary`": "review_summary",
     "ApprovalUse": "approval_use",
@@ -97,6 +98,8 @@ def collect(report: dict, seen: dict) -> None:
         seen.setdefault("values", set()).add(c["status"])
         for p in c["surface_pairs"]:
             add("clash_pair", p)
+        if c["interference"] is not None:
+            add("interference", c["interference"])
     if "review" in report:
         add("review", report["review"])
         add("review_summary", report["review"]["summary"])
@@ -122,6 +125,7 @@ def main() -> int:
         [as1, "--exact"],
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
+        [boxes[0], boxes[1], "--volume"],
     ]
     seen: dict = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -186,6 +186,36 @@ TEST(ReviewCli, SpatialClustersAreDeterministic) {
             group.at("/as1/L-BRACKET-ASSEMBLY::1/L-BRACKET x /as1/L-BRACKET-ASSEMBLY::1/NUT-BOLT-ASSEMBLY::1/BOLT"));
 }
 
+TEST(ReviewCli, VolumeOfPenetratingClashes) {
+  // The plate pushed 0.05 mm up into the two brackets standing on it: each overlap is a slab 0.05 thick.
+  const std::string pushed = scratch("as1_plate_up.stp");
+  rewrite(kAs1, pushed, "PLATE 0 0 0.05");
+  const nlohmann::json j = check(q(pushed) + " --volume --group-by space", scratch("volume.json"));
+  int measured = 0;
+  for (const nlohmann::json& c : j["clashes"]) {
+    if (c["class"] != "penetrating") {
+      EXPECT_TRUE(c["interference"].is_null()) << c.dump();
+      continue;
+    }
+    const nlohmann::json& v = c["interference"];
+    ASSERT_TRUE(v["measured"].get<bool>()) << v.dump();
+    EXPECT_NEAR(v["depth"].get<double>(), 0.05, 1e-6) << c["id"];
+    EXPECT_GT(v["volume"].get<double>(), 0.0);
+    for (int k = 0; k < 3; ++k) {  // the centroid lies where the surfaces meet
+      EXPECT_GE(v["centroid"][k].get<double>(), c["box"][k].get<double>() - 1e-6) << c["id"] << " axis " << k;
+      EXPECT_LE(v["centroid"][k].get<double>(), c["box"][k + 3].get<double>() + 1e-6) << c["id"] << " axis " << k;
+    }
+    ++measured;
+  }
+  EXPECT_EQ(measured, 2);  // the two L-brackets
+  // Mesh parts have no solid: the clash says so.
+  const std::string d = std::string(CADCLASH_DATA_DIR) + "/collide/";
+  const nlohmann::json mesh = check(q(d + "box_a.obj") + " " + q(d + "box_overlap.obj") + " --volume", scratch("mesh_volume.json"));
+  ASSERT_EQ(mesh["clashes"].size(), 1u);
+  EXPECT_FALSE(mesh["clashes"][0]["interference"]["measured"].get<bool>());
+  EXPECT_EQ(mesh["clashes"][0]["interference"]["note"], "part box_a is not a B-rep part (a mesh): no solid to intersect");
+}
+
 std::string boxes() {
   const std::string d = std::string(CADCLASH_DATA_DIR) + "/collide/";
   return q(d + "box_a.obj") + " " + q(d + "box_overlap.obj") + " " + q(d + "box_touch.obj");

@@ -132,10 +132,14 @@ export function showClash(box, review, pairIndex, onChange) {
   if (!a) button = '<button id="approve-clash" type="button">approve clash</button>';
   else if (review.canUnapprove(k)) button = '<button id="unapprove-clash" type="button">unapprove</button>';
   else button = '<span class="muted">approved by a rule of the file</span>';
+  const v = c.interference;
+  const measure = !v ? '' : v.measured
+    ? ` · interference ${Number(v.volume.toPrecision(4))} mm³, depth ${Number(v.depth.toPrecision(4))} mm`
+    : ` · no volume: ${escapeHtml(v.note)}`;
   box.hidden = false;
   box.innerHTML =
     `clash <b data-field="clash-id">${escapeHtml(c.id)}</b> <span data-field="clash-status">${escapeHtml(c.status)}</span>, ` +
-    `${escapeHtml(c.class)}, ${c.surface_pairs.length} surface pairs · ` +
+    `${escapeHtml(c.class)}, ${c.surface_pairs.length} surface pairs${measure} · ` +
     `<span data-field="clash-approval">${escapeHtml(what)}</span> ${button}`;
   const approve = box.querySelector('#approve-clash');
   if (approve) approve.addEventListener('click', () => {

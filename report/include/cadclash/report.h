@@ -238,6 +238,15 @@ struct ClashSurfacePair {
   double distance = 0.0;  // +infinity: null
 };
 
+// The Boolean common of a clash's two solids (`cadclash check --volume`; cadclash/interference.h).
+struct ClashInterference {
+  bool measured = false;  // false: `note` says why not (a mesh, not a closed solid, an OCCT failure)
+  std::string note;
+  double volume = 0.0;  // mm^3
+  double depth = 0.0;   // mm: smallest extent of the common's oriented box
+  std::array<double, 3> centroid{};  // world; meaningful when volume > 0
+};
+
 // One clash: an instance pair with its surface pairs, the sides in canonical order (review.h).
 struct ReportClash {
   std::string id;  // 12 hex digits (review.h: clash_id)
@@ -250,6 +259,7 @@ struct ReportClash {
   // World box of where the two meet (review.h: contact_boxes), for the viewer and spatial groups;
   // nullopt when not known (a resolved clash, or a review without the model).
   std::optional<std::array<double, 6>> box;
+  std::optional<ClashInterference> interference;  // with --volume, for penetrating and containment clashes
   std::int64_t approval = -1;  // index into ClashReview::approvals; -1: not approved
   std::vector<ClashSurfacePair> surface_pairs;
 };
