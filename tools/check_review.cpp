@@ -16,14 +16,6 @@
 namespace cadclash::cli {
 namespace {
 
-std::optional<std::string> read_file(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return std::nullopt;
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 std::string fmt_mm(double v) {
   if (!std::isfinite(v)) return "-";
   std::ostringstream s;
@@ -32,6 +24,14 @@ std::string fmt_mm(double v) {
 }
 
 }  // namespace
+
+std::optional<std::string> read_text_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return std::nullopt;
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
 
 void add_review_options(CLI::App& cmd, ReviewCliOptions& o) {
   cmd.add_option("--baseline", o.baseline,
@@ -79,7 +79,7 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
   in.options.baseline_file = o.baseline;
   in.options.approvals_file = o.approvals;
   if (!o.baseline.empty()) {
-    const std::optional<std::string> text = read_file(o.baseline);
+    const std::optional<std::string> text = read_text_file(o.baseline);
     if (!text) {
       std::cerr << o.baseline << ": error: cannot open the baseline report\n";
       return std::nullopt;
@@ -96,7 +96,7 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
     in.baseline = std::move(*read.report.query);
   }
   if (!o.approvals.empty()) {
-    const std::optional<std::string> text = read_file(o.approvals);
+    const std::optional<std::string> text = read_text_file(o.approvals);
     if (!text) {
       std::cerr << o.approvals << ": error: cannot open the approvals file\n";
       return std::nullopt;

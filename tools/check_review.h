@@ -39,6 +39,9 @@ struct ReviewInputs {
 // has no clashes: any review option is then refused.
 std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool trajectory);
 
+// The whole file at `path`; nullopt when it cannot be opened.
+std::optional<std::string> read_text_file(const std::string& path);
+
 // Today's date in UTC, YYYY-MM-DD.
 std::string utc_today();
 

@@ -7,7 +7,6 @@
 #include <iostream>
 #include <memory>
 #include <set>
-#include <sstream>
 
 namespace cadclash::cli {
 namespace {
@@ -22,17 +21,9 @@ struct ApproveOptions {
   std::string output;
 };
 
-std::optional<std::string> read_file(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return std::nullopt;
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // The report's current clashes: its review's when written, else grouped from its pairs.
 std::optional<std::vector<ReportClash>> report_clashes(const std::string& path) {
-  const std::optional<std::string> text = read_file(path);
+  const std::optional<std::string> text = read_text_file(path);
   if (!text) {
     std::cerr << path << ": error: cannot open the report\n";
     return std::nullopt;
@@ -55,7 +46,7 @@ std::optional<std::vector<ReportClash>> report_clashes(const std::string& path) 
 // The approvals already in `path` (none when it does not exist yet).
 std::optional<std::vector<Approval>> existing_approvals(const std::string& path) {
   if (!std::filesystem::exists(path)) return std::vector<Approval>{};
-  const std::optional<std::string> text = read_file(path);
+  const std::optional<std::string> text = read_text_file(path);
   if (!text) {
     std::cerr << path << ": error: cannot open the approvals file\n";
     return std::nullopt;

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <tuple>
@@ -245,6 +246,29 @@ TEST(ReviewCli, BadInputsNameTheFileAndField) {
   r = run_cadclash("check " + boxes() + " --path " + q(path) + " --baseline " + q(not_report));
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("a --path report has no clashes"), std::string::npos) << r.err;
+}
+
+// stdout of `cadclash ARGS` run on a pseudo-terminal (util-linux `script`), or nullopt without it.
+std::optional<std::string> on_terminal(const std::string& args) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) return std::nullopt;
+  const std::string out = scratch("tty.txt");
+  const std::string inner = std::string(CADCLASH_EXE) + " " + args;
+  const std::string cmd = "script -qec \"" + inner + "\" /dev/null > '" + out + "' 2>&1 < /dev/null";
+  if (std::system(cmd.c_str()) != 0) return std::nullopt;
+  return slurp(out);
+}
+
+TEST(ReviewCli, TableCollapsesToClashesOnATerminalOnly) {
+  const std::string piped = run_cadclash("check " + boxes() + " --no-timings").out;
+  const std::optional<std::string> tty = on_terminal("check " + boxes() + " --no-timings");
+  if (!tty) GTEST_SKIP() << "util-linux script is not available";
+  const std::string row_header = "class       decided by";
+  EXPECT_NE(piped.find(row_header), std::string::npos) << piped;  // piped: every surface pair listed
+  EXPECT_EQ(tty->find(row_header), std::string::npos) << *tty;    // terminal: the clash headings only
+  EXPECT_NE(tty->find("  clash "), std::string::npos) << *tty;
+  const std::optional<std::string> expanded = on_terminal("check " + boxes() + " --no-timings --expand");
+  ASSERT_TRUE(expanded);
+  EXPECT_NE(expanded->find(row_header), std::string::npos) << *expanded;
 }
 
 TEST(ReviewCli, ApproveExtendsTheFileOnceAndRefusesUnknownIds) {
