@@ -116,7 +116,7 @@ void measure_clashes(const Model& m, ClashReview& r) {
   std::map<std::string, InstanceId> by_path;
   for (InstanceId i = 0; i < m.instances.size(); ++i) by_path.emplace(m.instances[i].path, i);
   for (ReportClash& c : r.clashes) {
-    if (c.status == ClashStatus::Resolved ||
+    if (!current_clash(c) ||
         (c.worst != ContactClass::Penetrating && c.worst != ContactClass::Containment))
       continue;
     const InterferenceResult v = measure_interference(m, by_path.at(c.instance_a), by_path.at(c.instance_b));
@@ -148,18 +148,19 @@ std::string clash_heading(const ClashReview& r, const ReportClash& c) {
 }
 
 void print_review(const ClashReview& r, std::ostream& os) {
-  std::size_t n[4] = {0, 0, 0, 0}, approved = 0;
+  std::size_t n[5] = {0, 0, 0, 0, 0}, approved = 0;
   for (const ReportClash& c : r.clashes) {
     ++n[static_cast<int>(c.status)];
     approved += c.approval >= 0;
   }
-  os << "\nclashes: " << r.clashes.size() - n[3] << " (new " << n[0] << ", active " << n[1] << ", changed " << n[2]
+  os << "\nclashes: " << n[0] + n[1] + n[2] << " (new " << n[0] << ", active " << n[1] << ", changed " << n[2]
      << "; approved " << approved << ")";
   if (!r.baseline.empty()) os << ", resolved since the baseline: " << n[3];
+  if (n[4] > 0) os << ", not examined by this partial run: " << n[4];
   os << '\n';
   for (const ReportClash& c : r.clashes)
-    if (c.status == ClashStatus::Resolved)
-      os << "  resolved " << c.id << "  " << c.instance_a << "  x  " << c.instance_b << "  (was " << contact_class_name(c.worst)
+    if (!current_clash(c))
+      os << "  " << clash_status_name(c.status) << " " << c.id << "  " << c.instance_a << "  x  " << c.instance_b << "  (was " << contact_class_name(c.worst)
          << ", " << c.surface_pairs.size() << " surface pairs)\n";
   for (const ApprovalUse& u : r.approvals) {
     if (!u.expired && u.matched > 0) continue;

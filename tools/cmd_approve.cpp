@@ -39,7 +39,7 @@ std::optional<std::vector<ReportClash>> report_clashes(const std::string& path) 
   }
   std::vector<ReportClash> out;
   for (ReportClash& c : read.report.review ? read.report.review->clashes : clashes_of(*read.report.query))
-    if (c.status != ClashStatus::Resolved) out.push_back(std::move(c));
+    if (current_clash(c)) out.push_back(std::move(c));
   return out;
 }
 
@@ -127,7 +127,7 @@ void register_approve(CLI::App& app) {
   cmd->footer("Exit codes: 0 written; 1 a file could not be read or written, or an --id is not in the report; 2 usage error.\n"
               "The approvals file format and the rules' glob syntax: docs/review.md.");
   cmd->add_option("report", o->report, "A `cadclash check --json` report (not needed for a rule)");
-  cmd->add_flag("--all", o->all, "Approve every clash of the report (not the resolved ones)");
+  cmd->add_flag("--all", o->all, "Approve every current clash of the report (not resolved or unexamined ones)");
   cmd->add_option("--id", o->ids, "Approve these clash ids");
   cmd->add_option("--a", o->rule_a, "A rule instead: instance path glob of one side (default **)");
   cmd->add_option("--b", o->rule_b, "... and of the other side (default **)");

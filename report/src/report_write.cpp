@@ -236,6 +236,7 @@ const char* clash_status_name(ClashStatus s) {
     case ClashStatus::Active: return "active";
     case ClashStatus::Changed: return "changed";
     case ClashStatus::Resolved: return "resolved";
+    case ClashStatus::Unexamined: return "unexamined";
     case ClashStatus::New: break;
   }
   return "new";

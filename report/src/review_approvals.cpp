@@ -63,7 +63,7 @@ std::vector<ApprovalUse> apply_approvals(std::vector<ReportClash>& clashes, cons
   }
   for (ReportClash& c : clashes) {
     c.approval = -1;
-    if (c.status == ClashStatus::Resolved) continue;
+    if (!current_clash(c)) continue;
     for (std::size_t k = 0; k < uses.size(); ++k)
       if (!uses[k].expired && approval_matches(uses[k].approval, c)) {
         c.approval = static_cast<std::int64_t>(k);

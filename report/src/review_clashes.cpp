@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <set>
 #include <utility>
 
 namespace cadclash {
@@ -146,7 +147,17 @@ std::vector<ReportClash> clashes_of(const QueryReport& q, std::string_view group
   return out;
 }
 
-void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportClash>& baseline, double depth_change) {
+bool current_clash(const ReportClash& c) {
+  return c.status == ClashStatus::New || c.status == ClashStatus::Active || c.status == ClashStatus::Changed;
+}
+
+void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportClash>& baseline, double depth_change,
+                  std::span<const std::array<std::string, 2>> unexamined) {
+  std::set<std::pair<std::string, std::string>> not_examined;
+  for (const auto& [a, b] : unexamined) {
+    not_examined.emplace(a, b);
+    not_examined.emplace(b, a);
+  }
   std::map<std::string, const ReportClash*> before;
   for (const ReportClash& b : baseline) before.emplace(b.id, &b);
   std::map<std::string, bool> seen;
@@ -168,7 +179,7 @@ void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportCla
   for (const ReportClash& b : baseline) {
     if (seen.count(b.id)) continue;
     ReportClash r = b;
-    r.status = ClashStatus::Resolved;
+    r.status = not_examined.count({b.instance_a, b.instance_b}) ? ClashStatus::Unexamined : ClashStatus::Resolved;
     r.approval = -1;
     for (ClashSurfacePair& s : r.surface_pairs) s.pair = -1;
     current.push_back(std::move(r));
@@ -189,7 +200,7 @@ ClashReview review_query(const QueryReport& current, const QueryReport* baseline
     std::vector<ReportClash> before = clashes_of(*baseline, space ? "instance" : o.group_by);
     if (space)
       for (ReportClash& c : before) c.group = "resolved";
-    diff_clashes(r.clashes, before, o.depth_change);
+    diff_clashes(r.clashes, before, o.depth_change, current.unexamined_pairs);
   }
   if (!o.approvals_file.empty() || !approvals.empty()) {
     r.today = o.today;
@@ -200,7 +211,7 @@ ClashReview review_query(const QueryReport& current, const QueryReport* baseline
 
 bool unapproved_collision(const ClashReview& r) {
   for (const ReportClash& c : r.clashes)
-    if (c.status != ClashStatus::Resolved && c.approval < 0 && collision_class(c.worst)) return true;
+    if (current_clash(c) && c.approval < 0 && collision_class(c.worst)) return true;
   return false;
 }
 

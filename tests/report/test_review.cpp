@@ -162,6 +162,18 @@ TEST(Baseline, EveryStatus) {
   for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(r.clashes[k].status, expected[k]) << k;
   EXPECT_EQ(r.clashes[5].instance_b, "/f");
   EXPECT_EQ(r.clashes[5].surface_pairs[0].pair, -1);  // last data only
+  // A partial run that did not examine /a x /f does not call its clash resolved.
+  QueryReport partial = after;
+  partial.unexamined_pairs = {{"/f", "/a"}};
+  const ClashReview p = review_query(partial, &before, {}, {});
+  EXPECT_EQ(p.clashes[5].status, ClashStatus::Unexamined);
+  EXPECT_FALSE(current_clash(p.clashes[5]));
+  EXPECT_EQ(check_report_json([&] {
+              CheckReport doc;
+              doc.query = partial;
+              doc.review = p;
+              return doc;
+            }())["review"]["summary"]["unexamined"], 1);
   // A depth move within --depth-change keeps the clash active.
   ReviewOptions loose;
   loose.depth_change = 0.5;
@@ -296,7 +308,7 @@ TEST(ReportReview, InconsistentReviewIsRefusedWithItsPointer) {
   EXPECT_EQ(error_of(bad), "/clashes/0/surface_pairs/0/pair: names no entry of /pairs");
   bad = j;
   bad["clashes"][1]["status"] = "fixed";
-  EXPECT_EQ(error_of(bad), "/clashes/1/status: unknown clash status 'fixed' (one of new, active, changed, resolved)");
+  EXPECT_EQ(error_of(bad), "/clashes/1/status: unknown clash status 'fixed' (one of new, active, changed, resolved, unexamined)");
   bad = j;
   bad["review"]["summary"]["new"] = 5;
   EXPECT_EQ(error_of(bad), "/review: does not match the clashes and approvals");

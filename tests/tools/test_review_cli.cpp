@@ -91,6 +91,26 @@ TEST(ReviewCli, RenumberedStepKeepsEveryClashId) {
   EXPECT_TRUE(base["review"]["baseline"].is_null());
 }
 
+TEST(ReviewCli, APartialRunCallsNothingResolvedThatItDidNotExamine) {
+  const nlohmann::json full = check(q(kAs1), scratch("full.json"));
+  const CliRun r = run_cadclash("check " + q(kAs1) + " --memory-budget 1 --no-timings --baseline " + q(scratch("full.json")) +
+                                " --json " + q(scratch("partial.json")));
+  ASSERT_EQ(r.code, 4) << r.err;  // the budget ran out: a partial report
+  const nlohmann::json partial = read_json(scratch("partial.json"));
+  ASSERT_FALSE(partial["unexamined_pairs"].empty());
+  const nlohmann::json& s = partial["review"]["summary"];
+  EXPECT_EQ(s["resolved"], 0);
+  EXPECT_GT(s["unexamined"].get<int>(), 0);
+  EXPECT_EQ(s["active"].get<int>() + s["unexamined"].get<int>(), static_cast<int>(full["clashes"].size()));
+  std::set<std::pair<std::string, std::string>> unexamined;
+  for (const nlohmann::json& u : partial["unexamined_pairs"]) {
+    unexamined.emplace(u["a"], u["b"]);
+    unexamined.emplace(u["b"], u["a"]);
+  }
+  for (const nlohmann::json& c : partial["clashes"])
+    EXPECT_EQ(c["status"] == "unexamined", unexamined.count({c["a"]["instance"], c["b"]["instance"]}) == 1) << c["id"];
+}
+
 TEST(ReviewCli, TwoRunsEveryStatusApprovalsAndFailOnCollision) {
   const std::string base_json = scratch("base.json");
   const nlohmann::json base = check(q(kAs1), base_json);

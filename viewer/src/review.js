@@ -39,7 +39,7 @@ export class ReviewState {
 
   approve(k, by, reason) {
     const c = this.clashes[k];
-    if (c.status === 'resolved' || this.approvalOf(k)) return;
+    if (!REVIEW_FILTERS.includes(c.status) || this.approvalOf(k)) return;
     this.added.set(c.id, { id: c.id, reason, by, date: this.today });
   }
 
@@ -68,7 +68,7 @@ export class ReviewState {
   counts() {
     const n = Object.fromEntries(REVIEW_FILTERS.map((f) => [f, 0]));
     this.clashes.forEach((c, k) => {
-      if (c.status === 'resolved') return;
+      if (!REVIEW_FILTERS.includes(c.status)) return;  // resolved, unexamined: no pairs now
       ++n[c.status];
       ++n[this.approvalOf(k) ? 'approved' : 'unapproved'];
     });
@@ -83,10 +83,12 @@ export function fillReviewBar(bar, review, onChange) {
     return;
   }
   const resolved = review.clashes.filter((c) => c.status === 'resolved').length;
+  const unexamined = review.clashes.filter((c) => c.status === 'unexamined').length;
   bar.innerHTML =
     `<div>clashes: ${REVIEW_FILTERS.map((f) => `<label><input type="checkbox" data-review="${f}" checked>${f} ` +
       `<span class="count" data-review-count="${f}"></span></label>`).join(' ')}` +
-    (resolved ? ` <span class="muted">· ${resolved} resolved</span>` : '') + '</div>' +
+    (resolved ? ` <span class="muted">· ${resolved} resolved</span>` : '') +
+    (unexamined ? ` <span class="muted">· ${unexamined} not examined (partial run)</span>` : '') + '</div>' +
     '<div class="review-line"><input id="review-by" placeholder="your name" aria-label="approved by">' +
     '<input id="review-reason" placeholder="reason for approving" aria-label="reason">' +
     '<button id="export-approvals" type="button">export approvals</button></div>';

@@ -220,12 +220,14 @@ struct StepReport {
 // ---------------------------------------------------------------------------------------------
 
 // A clash's status against a baseline report: new (not in it), active (unchanged), changed (worst
-// class, a surface pair's class, or the depth changed), resolved (in the baseline, gone now).
-enum class ClashStatus : std::uint8_t { New, Active, Changed, Resolved };
-// Returns "new", "active", "changed" or "resolved".
+// class, a surface pair's class, or the depth changed), resolved (in the baseline, gone now),
+// unexamined (in the baseline, its instance pair not examined by this partial run: unknown now).
+enum class ClashStatus : std::uint8_t { New, Active, Changed, Resolved, Unexamined };
+// Returns "new", "active", "changed", "resolved" or "unexamined".
 const char* clash_status_name(ClashStatus s);
 template <> struct EnumNames<ClashStatus> {
-  static constexpr std::array values{ClashStatus::New, ClashStatus::Active, ClashStatus::Changed, ClashStatus::Resolved};
+  static constexpr std::array values{ClashStatus::New, ClashStatus::Active, ClashStatus::Changed, ClashStatus::Resolved,
+                                     ClashStatus::Unexamined};
   static const char* name(ClashStatus s) { return clash_status_name(s); }
 };
 

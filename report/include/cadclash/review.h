@@ -75,8 +75,13 @@ void cluster_clashes(std::vector<ReportClash>& clashes, double distance);
 // Sets each clash's status against `baseline` (clashes_of() the baseline report's query): New when
 // its id is not there; Changed when its worst class, the set of its surface-pair keys or one of
 // their classes differs, or its max_penetration moved by more than `depth_change` mm; else Active.
-// Appends every baseline clash whose id is gone, status Resolved, with its last data (`pair` -1).
-void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportClash>& baseline, double depth_change);
+// Appends every baseline clash whose id is gone with its last data (`pair` -1): status Unexamined
+// when its instance pair is in `unexamined` (a partial run did not look at it), else Resolved.
+void diff_clashes(std::vector<ReportClash>& current, const std::vector<ReportClash>& baseline, double depth_change,
+                  std::span<const std::array<std::string, 2>> unexamined = {});
+
+// True for the clashes of this run's pairs (new, active, changed); false for resolved and unexamined.
+bool current_clash(const ReportClash& c);
 
 // Glob over instance paths and part names: `*` any run of characters except '/', `**` any run
 // including '/', `?` one character except '/'; anything else matches itself.
@@ -86,8 +91,8 @@ bool glob_match(std::string_view pattern, std::string_view text);
 // `classes` (when given) hold c's worst class. Expiry is not looked at here.
 bool approval_matches(const Approval& a, const ReportClash& c);
 
-// Applies `approvals` (in file order; `file` names them in ApprovalUse::source) to the clashes not
-// resolved: each gets the first unexpired approval that matches it. An approval whose `expires` is
+// Applies `approvals` (in file order; `file` names them in ApprovalUse::source) to the current
+// clashes (current_clash): each gets the first unexpired approval that matches it. An approval whose `expires` is
 // before `today` is expired and applies to nothing. Returns what became of every approval.
 // Precondition: `today` is YYYY-MM-DD (iso_date).
 std::vector<ApprovalUse> apply_approvals(std::vector<ReportClash>& clashes, const std::vector<Approval>& approvals,
@@ -115,7 +120,7 @@ struct ReviewOptions {
 ClashReview review_query(const QueryReport& current, const QueryReport* baseline, const std::vector<Approval>& approvals,
                          const ReviewOptions& o);
 
-// True when a clash that is not resolved and not approved has a collision class.
+// True when a current clash (current_clash) that is not approved has a collision class.
 bool unapproved_collision(const ClashReview& r);
 
 // ---------------------------------------------------------------------------------------------
