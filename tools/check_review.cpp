@@ -165,8 +165,13 @@ void print_review(const ClashReview& r, std::ostream& os) {
   for (const ApprovalUse& u : r.approvals) {
     if (!u.expired && u.matched > 0) continue;
     const Approval& a = u.approval;
-    os << "  " << (u.expired ? "expired" : "stale") << " approval " << u.source << ": "
-       << (a.id.empty() ? (a.a.empty() ? "**" : a.a) + " x " + (a.b.empty() ? "**" : a.b) : "id " + a.id);
+    os << "  " << (u.expired ? "expired" : "stale") << " approval " << u.source << ": ";
+    if (!a.id.empty()) {
+      os << "id " << a.id;
+    } else {
+      os << (a.a.empty() ? "**" : a.a) << (a.part_a.empty() ? "" : " (part " + a.part_a + ")") << " x "
+         << (a.b.empty() ? "**" : a.b) << (a.part_b.empty() ? "" : " (part " + a.part_b + ")");
+    }
     if (u.expired) os << " (expired " << a.expires << ")";
     else os << " matches no clash";
     os << '\n';
