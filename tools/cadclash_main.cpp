@@ -1,4 +1,5 @@
 // cadclash — which surfaces of which parts intersect or touch?
+#include "check_review.h"
 #include "cli_common.h"
 
 int main(int argc, char** argv) {
@@ -8,6 +9,7 @@ int main(int argc, char** argv) {
   cadclash::cli::register_info(app);
   cadclash::cli::register_tessellate(app);
   cadclash::cli::register_check(app);
+  cadclash::cli::register_approve(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

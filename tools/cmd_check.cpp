@@ -1,4 +1,5 @@
 // cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
+#include "check_review.h"
 #include "cli_common.h"
 #include "cmd_check_mpi.h"
 #include "html_report.h"
@@ -41,7 +42,7 @@ struct CheckOptions {
   std::string json;
   std::string html;
   bool no_timings = false;
-  bool fail_on_collision = false;
+  bool fail_on_collision = false;  // approved clashes (--approvals) never count
   bool brute_force = false;
   bool no_containment = false;
   bool exact = false;
@@ -50,6 +51,7 @@ struct CheckOptions {
   std::string schedule = "guided";
   std::string triangle_level = "auto";
   std::vector<std::string> select_a, select_b, exclude_under;
+  ReviewCliOptions review;
 };
 
 bool path_under(const std::string& path, const std::string& prefix) {
@@ -134,18 +136,25 @@ std::string fmt(double v) {
   return s.str();
 }
 
-void print_table(const Model& m, const Report& r, std::ostream& os) {
+// The pairs under one heading per instance pair (its clash's id, status and worst class); with
+// `collapse`, the headings alone.
+void print_table(const Model& m, const Report& r, const ClashReview& review, bool collapse, std::ostream& os) {
+  const std::vector<const ReportClash*> clash = clash_of_pairs(review, r.pairs.size());
   InstanceId ca = kInvalidId, cb = kInvalidId;
-  for (const SurfacePairResult& p : r.pairs) {
+  for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+    const SurfacePairResult& p = r.pairs[k];
     if (p.instance_a != ca || p.instance_b != cb) {
       ca = p.instance_a;
       cb = p.instance_b;
       const Instance& a = m.instances[ca];
       const Instance& b = m.instances[cb];
       os << '\n' << a.path << " (" << m.parts[a.part].name << ")  x  " << b.path << " (" << m.parts[b.part].name << ")\n";
-      os << "  " << std::left << std::setw(12) << "class" << std::setw(12) << "decided by" << std::setw(11)
-         << "distance" << std::setw(34) << "surface A" << "surface B\n";
+      if (clash[k]) os << "  " << clash_heading(review, *clash[k]) << '\n';
+      if (!collapse)
+        os << "  " << std::left << std::setw(12) << "class" << std::setw(12) << "decided by" << std::setw(11)
+           << "distance" << std::setw(34) << "surface A" << "surface B\n";
     }
+    if (collapse) continue;
     auto side = [&](SurfaceId s) {
       if (s == kInvalidId) return std::string("(whole part)");
       return m.surfaces[s].name + " [" + source_label(m.surfaces[s]) + "]";
@@ -249,22 +258,29 @@ struct Runner {
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
 // stdout, the results into `report`.
 CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run, const CollideOptions& copt,
-                        CheckReport& report) {
+                        const ReviewInputs& review, CheckReport& report) {
   CheckOutcome out;
   Report r = run.check(copt);
   for (int k = 1; k < o.repeat; ++k) r = run.check(copt);  // a prepared scene: BVHs already built
   out.diagnostics = r.diagnostics;
-  ClassCounts n;
-  n.add(r);
-  out.collision = n.collision();
+  report.query = query_report(m, r);
+  ReviewOptions ro = review.options;
+  if (ro.group_by == "space") {  // where each pair meets: the boxes the clusters are made of
+    std::vector<Pose> poses;
+    for (const Instance& i : m.instances) poses.push_back(i.pose);
+    ro.pair_boxes = contact_boxes(m, poses, r);
+  }
+  report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, ro);
+  if (o.review.volume) measure_clashes(m, *report.review);
+  out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
   if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
   if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
-  print_table(m, r, std::cout);
+  print_table(m, r, *report.review, collapse_clashes(o.review), std::cout);
   print_summary(r, !o.no_timings, std::cout);
+  print_review(*report.review, std::cout);
   if (o.fast) std::cout << "fast mode: classes from the triangles' deflection band, not certified on the exact faces\n";
   print_partial(m, r, std::cout);
   if (!r.complete) out.stopped_by = r.stopped_by;
-  report.query = query_report(m, r);
   out.shown = std::move(r);
   return out;
 }
@@ -311,12 +327,14 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
 // The query (or trajectory) run, printed and written: the rest of `cadclash check`. Under MPI only
 // rank 0 (`primary`) writes files.
 int finish_check(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
-                 const Runner& runner, Scene& scene, const CollideOptions& copt, bool primary) {
+                 const Runner& runner, Scene& scene, const CollideOptions& copt, bool primary,
+                 const ReviewInputs& review) {
   Model& m = imported.model;
   CheckReport report;
   report.files = o.in.files;
   report.settings = report_settings_of(o, copt);
-  CheckOutcome run = rows.empty() ? check_once(o, m, runner, copt, report) : check_trajectory(o, m, runner, rows, copt, report);
+  CheckOutcome run = rows.empty() ? check_once(o, m, runner, copt, review, report)
+                                  : check_trajectory(o, m, runner, rows, copt, report);
   print_diagnostics(run.diagnostics);
   const bool input_error = has_error(imported.diagnostics) || has_error(run.diagnostics);
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
@@ -343,7 +361,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
 
 // The check of what was imported: in this process, or split over the ranks of `mpi` when given.
 int check_imported(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
-                   [[maybe_unused]] MpiCheck* mpi) {
+                   const ReviewInputs& review, [[maybe_unused]] MpiCheck* mpi) {
   Model& m = imported.model;
   if (m.instances.empty()) {
     std::cerr << "cadclash check: no instances to check\n";
@@ -365,7 +383,7 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
                         const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
   }
 #endif
-  return finish_check(o, imported, rows, runner, scene, copt, primary);
+  return finish_check(o, imported, rows, runner, scene, copt, primary, review);
 }
 
 int run_check(const CheckOptions& o, const Launch& launch) {
@@ -378,6 +396,9 @@ int run_check(const CheckOptions& o, const Launch& launch) {
                  "cannot be split over MPI ranks (use --time-budget, or one process)\n";
     return kExitUsage;
   }
+  // Before the import: a bad baseline or approvals file should not cost a long import first.
+  const std::optional<ReviewInputs> review = load_review_inputs(o.review, !o.path_csv.empty());
+  if (!review) return kExitInputError;
   ImportResult imported = import_inputs(o.in);
   std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
   if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
@@ -388,13 +409,13 @@ int run_check(const CheckOptions& o, const Launch& launch) {
     MpiCheck mpi;
     const std::string trajectory = rows ? std::to_string(rows->size()) + " trajectory rows" : "unreadable trajectory";
     if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) return kExitInputError;
-    const int code = rows ? check_imported(o, imported, *rows, &mpi) : kExitInputError;
+    const int code = rows ? check_imported(o, imported, *rows, *review, &mpi) : kExitInputError;
     if (mpi.rank() == 0) mpi.print_ranks(std::cerr);
     return mpi.agree(code);
   }
 #endif
   if (!rows) return kExitInputError;
-  return check_imported(o, imported, *rows, nullptr);
+  return check_imported(o, imported, *rows, *review, nullptr);
 }
 
 // `cadclash check`, in one process or as one rank of an MPI job (every rank imports, rank 0 reports).
@@ -443,7 +464,7 @@ void register_check(CLI::App& app) {
   cmd->add_option("--html", o->html, "Write a self-contained HTML report with a 3D view here (docs/viewer.md)");
   cmd->add_flag("--no-timings", o->no_timings, "Leave timings out (the report is then identical for any thread count)");
   cmd->add_flag("--fail-on-collision", o->fail_on_collision,
-                "Exit 3 when a penetrating, touching, containment or undecided pair is found");
+                "Exit 3 when a penetrating, touching, containment or undecided pair is found (not counting approved clashes)");
   cmd->add_flag("--brute-force", o->brute_force, "Test every triangle pair, no OAABB culling (for comparison)");
   cmd->add_flag("--no-containment", o->no_containment, "Skip the point-in-part containment test");
   CLI::Option* exact = cmd->add_flag(
@@ -461,6 +482,7 @@ void register_check(CLI::App& app) {
   cmd->add_option("--select-a", o->select_a, "Check only instances under these paths (set A) ...");
   cmd->add_option("--select-b", o->select_b, "... against instances under these paths (set B)");
   cmd->add_option("--exclude-under", o->exclude_under, "Skip pairs whose instances are both under this sub-assembly path");
+  add_review_options(*cmd, o->review);
   cmd->callback([o] {
     const int code = run_check_launched(*o);
     if (code != kExitOk) throw CLI::RuntimeError(code);

@@ -120,6 +120,9 @@ nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Repo
   for (const char* key : {"settings", "summary"}) j[key] = meta.value(key, nlohmann::json::object());
   j["files"] = meta.value("files", nlohmann::json::array());
   j["diagnostics"] = meta.value("diagnostics", nlohmann::json::array());
+  // The clash review (cadclash/review.h), for the page's clash list: absent for a trajectory.
+  if (meta.contains("clashes")) j["clashes"] = meta["clashes"];
+  if (meta.contains("review")) j["review"] = meta["review"];
   // A partial report (bad input dropped, or a budget ran out) must say so on the page too.
   j["complete"] = meta.value("complete", true);
   j["stopped_by"] = meta.value("stopped_by", nlohmann::json(nullptr));

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import os
-from typing import Iterable, List, Optional, Tuple, Union
+from typing import Any, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -14,6 +14,8 @@ from ._types import Counters, InputError, ModelMemory, PairResult, Replay, Repor
 __all__ = ["Scene", "collide", "replay"]
 
 InstanceKey = Union[int, str, Instance]
+# A rigid 4x4 matrix (anything NumPy reads as 4x4), or (translation, quaternion (qw, qx, qy, qz)).
+PoseLike = Union[np.ndarray, Sequence[Sequence[float]], Tuple[Sequence[float], Sequence[float]]]
 
 
 def _report(model: Model, raw, settings=None) -> Report:
@@ -102,7 +104,7 @@ class Scene:
         self._core = _core.SceneCore(model, _select(model, select_a, "select_a"), _select(model, select_b, "select_b"),
                                      [tuple(p) for p in (exclude_pairs or [])], list(exclude or []))
 
-    def set_transform(self, instance: InstanceKey, transform) -> None:
+    def set_transform(self, instance: InstanceKey, transform: PoseLike) -> None:
         """Moves an instance (id, path or Instance) to an absolute part-local → world pose: a rigid 4x4
         matrix (array-like), or ``(translation, quaternion)`` with (tx, ty, tz) in mm and (qw, qx, qy,
         qz) normalised here. ValueError for a matrix that is not a rotation + translation; KeyError /
@@ -123,7 +125,7 @@ class Scene:
         """True while ``check()`` or ``replay()`` of this scene runs in some thread."""
         return self._core.running
 
-    def check(self, options: Optional[CollideOptions] = None, **kwargs) -> Report:
+    def check(self, options: Optional[CollideOptions] = None, **kwargs: Any) -> Report:
         """Reports penetrating, touching, clearance and containment pairs at the current poses.
         Options as a ``CollideOptions`` and/or keyword arguments (see ``CollideOptions``). The query
         runs with the GIL released, so other Python threads keep running; the result does not depend
@@ -137,7 +139,7 @@ class Scene:
 
 
 def collide(model: Model, a: InstanceKey, b: InstanceKey, options: Optional[CollideOptions] = None,
-            **kwargs) -> Report:
+            **kwargs: Any) -> Report:
     """One-off query of two different instances (ids, paths or Instances) at their imported poses;
     tessellates exactly the lazy surfaces it needs. Runs with the GIL released. ValueError if a == b."""
     o = _to_core(_resolve(options, kwargs))
@@ -146,7 +148,7 @@ def collide(model: Model, a: InstanceKey, b: InstanceKey, options: Optional[Coll
 
 
 def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[CollideOptions] = None,
-           **kwargs) -> Replay:
+           **kwargs: Any) -> Replay:
     """Replays a trajectory CSV (``step,instance_path,tx,ty,tz,qw,qx,qy,qz``; absolute world poses;
     optional header; '#' comments) on ``scene``: rows with equal consecutive step numbers are
     applied together, then the scene is checked. The scene keeps the last poses afterwards.

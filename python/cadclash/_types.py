@@ -5,8 +5,11 @@ stays valid after they are gone.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, make_dataclass
-from typing import Iterator, List, Optional, Tuple
+import datetime
+import json
+import os
+from dataclasses import dataclass, field, make_dataclass, replace
+from typing import Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -244,9 +247,64 @@ class Report:
 
     @property
     def collision(self) -> bool:
-        """True when a penetrating, touching, containment or undecided pair was found (the CLI's
-        ``--fail-on-collision`` condition: an undecided pair may be a contact)."""
-        return any(p.contact != "clearance" for p in self.pairs)
+        """True when a penetrating, touching, containment or undecided pair was found in a clash
+        no approval covers (the CLI's ``--fail-on-collision`` condition: an undecided pair may be a
+        contact; see ``review()`` for approvals)."""
+        review = self._review()
+        if review is None:
+            return any(p.contact != "clearance" for p in self.pairs)
+        return any(c["status"] != "resolved" and c["approval"] is None and c["class"] != "clearance"
+                   for c in review["clashes"])
+
+    def _review(self) -> Optional[dict]:
+        if self._document is None:
+            return None
+        text = self._document._review_json()
+        return None if text is None else json.loads(text)
+
+    @property
+    def clashes(self) -> List[dict]:
+        """The report's ``clashes`` (docs/report-schema.md, "Clash"; docs/review.md): one dict per
+        instance pair with its stable ``id``, ``status``, worst ``class``, ``approval`` and
+        ``surface_pairs`` (``pair`` indexes ``pairs``). Every clash is "new" until ``review()`` is
+        given a baseline. ValueError for a Report built by hand."""
+        review = self._review()
+        if review is None:
+            raise ValueError("this report has no JSON document, hence no clashes")
+        return review["clashes"]
+
+    @property
+    def review_summary(self) -> dict:
+        """The report's ``review`` object: baseline, approvals file, today, group_by, counts per
+        status (``summary``) and what became of each approval."""
+        review = self._review()
+        if review is None:
+            raise ValueError("this report has no JSON document, hence no review")
+        return review["review"]
+
+    def review(self, baseline: Optional["Report"] = None, approvals: Optional[Union[str, "os.PathLike"]] = None,
+               today: Optional[str] = None, group_by: str = "instance", depth_change: float = 0.01,
+               baseline_file: str = "") -> "Report":
+        """This report with its clashes reviewed as ``cadclash check --baseline --approvals`` does
+        (docs/review.md): statuses against ``baseline`` (another Report, e.g. ``Report.from_json``
+        of yesterday's file), the approvals file at ``approvals`` applied with expiries judged on
+        ``today`` (YYYY-MM-DD; default the UTC date), clashes grouped by ``group_by``. Returns a
+        new Report; ``to_json()`` then writes the review. ValueError naming the JSON pointer for a
+        bad approvals file."""
+        if self._document is None:
+            raise ValueError("this report has no JSON document to review")
+        if baseline is not None and baseline._document is None:
+            raise ValueError("the baseline has no JSON document")
+        text, name = None, ""
+        if approvals is not None:
+            name = os.fspath(approvals)
+            with open(name, encoding="utf-8") as f:
+                text = f.read()
+        if today is None:
+            today = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
+        doc = self._document.reviewed(None if baseline is None else baseline._document, text, name,
+                                      baseline_file, today, group_by, depth_change)
+        return replace(self, _document=doc)
 
     def summary(self) -> dict:
         """Counts per class, like the ``summary`` object of the CLI's JSON report."""

@@ -2,6 +2,11 @@
 // tables the pure-Python package takes its counter fields and enum names from.
 #include "convert.h"
 
+#include "cadclash/review.h"
+
+#include <algorithm>
+#include <optional>
+
 #include <pybind11/stl.h>
 
 namespace cadclash::py {
@@ -93,9 +98,49 @@ void bind_report(pyb::module_& m) {
              r.query = std::move(query);
              r.diagnostics = std::move(diagnostics);
              r.complete = complete;
+             r.review = review_query(*r.query, nullptr, {}, {});  // as `cadclash check` without review options
              return r;
            }),
            pyb::arg("files"), pyb::arg("settings"), pyb::arg("query"), pyb::arg("diagnostics"), pyb::arg("complete"))
+      .def(
+          "reviewed",
+          [](const CheckReport& r, const CheckReport* baseline, const std::optional<std::string>& approvals_text,
+             const std::string& approvals_file, const std::string& baseline_file, const std::string& today,
+             const std::string& group_by, double depth_change) {
+            if (!r.query) throw pyb::value_error("a trajectory report has no clashes to review");
+            if (baseline && !baseline->query) throw pyb::value_error("a trajectory report cannot be a baseline");
+            if (group_by == "space")
+              throw pyb::value_error("group_by='space' needs the model's geometry: use `cadclash check --group-by space`");
+            if (std::find(kGroupBy.begin(), kGroupBy.end(), group_by) == kGroupBy.end())
+              throw pyb::value_error("group_by must be 'instance', 'part' or 'subassembly', not '" + group_by + "'");
+            if (depth_change < 0) throw pyb::value_error("depth_change must be >= 0");
+            std::vector<Approval> approvals;
+            ReviewOptions o;
+            o.group_by = group_by;
+            o.depth_change = depth_change;
+            o.baseline_file = baseline_file;
+            if (approvals_text) {
+              ApprovalsReadResult read = approvals_from_json(*approvals_text);
+              if (read.error)
+                throw pyb::value_error((approvals_file.empty() ? std::string("approvals") : approvals_file) + ": " +
+                                       format_report_error(*read.error));
+              approvals = std::move(read.approvals);
+              if (!iso_date(today)) throw pyb::value_error("today must be a date YYYY-MM-DD, not '" + today + "'");
+              o.approvals_file = approvals_file;
+              o.today = today;
+            }
+            CheckReport out = r;
+            out.review = review_query(*r.query, baseline ? &*baseline->query : nullptr, approvals, o);
+            return out;
+          },
+          pyb::arg("baseline"), pyb::arg("approvals_text"), pyb::arg("approvals_file"), pyb::arg("baseline_file"),
+          pyb::arg("today"), pyb::arg("group_by"), pyb::arg("depth_change"),
+          "A copy with the clash review redone (cadclash/review.h: review_query).")
+      .def("_review_json",
+           [](const CheckReport& r) -> pyb::object {
+             if (!r.review) return pyb::none();
+             return pyb::str(nlohmann::json{{"clashes", clashes_json(*r.review)}, {"review", review_json(*r.review)}}.dump());
+           })
       .def_static(
           "trajectory",
           [](std::vector<std::string> files, ReportSettings settings, std::string trajectory,

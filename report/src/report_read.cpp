@@ -1,6 +1,8 @@
 // The report's reader: JSON back into CheckReport, with the JSON pointer of the first problem.
 #include "cadclash/report.h"
+#include "cadclash/review.h"
 
+#include <algorithm>
 #include <limits>
 #include <utility>
 
@@ -199,6 +201,134 @@ QueryReport read_query(const Json& j, const std::string& p) {
   return q;
 }
 
+std::string date_field(const Json& j, const std::string& path) {
+  const std::string d = text(j, path);
+  if (!iso_date(d)) fail(path, "expected a date YYYY-MM-DD, got '" + d + "'");
+  return d;
+}
+
+Approval read_approval(const Json& j, const std::string& p) {
+  Approval a;
+  object(j, p);
+  const bool rule = j.contains("a") || j.contains("b") || j.contains("part_a") || j.contains("part_b");
+  if (j.contains("id")) {
+    if (rule) fail(p, "names both a clash id and instance/part globs; give one");
+    a.id = text(j["id"], p + "/id");
+    if (a.id.empty()) fail(p + "/id", "is empty");
+  } else if (!rule) {
+    fail(p, "names neither a clash `id` nor globs `a`/`b`/`part_a`/`part_b`");
+  }
+  for (auto [key, member] : {std::pair{"a", &Approval::a}, {"b", &Approval::b}, {"part_a", &Approval::part_a},
+                             {"part_b", &Approval::part_b}})
+    if (j.contains(key)) a.*member = text(j[key], p + "/" + key);
+  if (a.a == "**") a.a.clear();
+  if (a.b == "**") a.b.clear();
+  if (j.contains("classes")) {
+    const Json& c = array(j["classes"], p + "/classes");
+    for (std::size_t k = 0; k < c.size(); ++k)
+      a.classes.push_back(named<ContactClass>(c[k], p + "/classes/" + std::to_string(k), "contact class"));
+  }
+  a.reason = text(field(j, p, "reason"), p + "/reason");
+  a.by = text(field(j, p, "by"), p + "/by");
+  a.date = date_field(field(j, p, "date"), p + "/date");
+  if (j.contains("expires")) a.expires = date_field(j["expires"], p + "/expires");
+  return a;
+}
+
+ReportClash read_clash(const Json& j, const std::string& p) {
+  ReportClash c;
+  c.id = text(field(j, p, "id"), p + "/id");
+  c.status = named<ClashStatus>(field(j, p, "status"), p + "/status", "clash status");
+  const Json& a = field(j, p, "a");
+  const Json& b = field(j, p, "b");
+  c.instance_a = text(field(a, p + "/a", "instance"), p + "/a/instance");
+  c.part_a = text(field(a, p + "/a", "part"), p + "/a/part");
+  c.instance_b = text(field(b, p + "/b", "instance"), p + "/b/instance");
+  c.part_b = text(field(b, p + "/b", "part"), p + "/b/part");
+  c.worst = named<ContactClass>(field(j, p, "class"), p + "/class", "contact class");
+  c.max_penetration = number(field(j, p, "max_penetration"), p + "/max_penetration");
+  c.min_distance = number(field(j, p, "min_distance"), p + "/min_distance", true);
+  c.group = text(field(j, p, "group"), p + "/group");
+  const Json& box = field(j, p, "box");
+  if (!box.is_null()) {
+    if (!box.is_array() || box.size() != 6) fail(p + "/box", "expected [min x, y, z, max x, y, z] or null");
+    std::array<double, 6> v{};
+    for (std::size_t k = 0; k < 6; ++k) v[k] = number(box[k], p + "/box/" + std::to_string(k));
+    c.box = v;
+  }
+  const Json& measure = field(j, p, "interference");
+  if (!measure.is_null()) {
+    const std::string pi = p + "/interference";
+    ClashInterference i;
+    i.measured = boolean(field(measure, pi, "measured"), pi + "/measured");
+    i.note = string_or_null(field(measure, pi, "note"), pi + "/note");
+    i.volume = number(field(measure, pi, "volume"), pi + "/volume");
+    i.depth = number(field(measure, pi, "depth"), pi + "/depth");
+    const Json& centroid = field(measure, pi, "centroid");
+    if (!centroid.is_null()) {
+      if (!centroid.is_array() || centroid.size() != 3) fail(pi + "/centroid", "expected [x, y, z] or null");
+      for (std::size_t k = 0; k < 3; ++k) i.centroid[k] = number(centroid[k], pi + "/centroid/" + std::to_string(k));
+    }
+    if (centroid.is_null() != (i.volume <= 0)) fail(pi + "/centroid", "is null exactly when the volume is 0");
+    c.interference = i;
+  }
+  const Json& approval = field(j, p, "approval");
+  if (!approval.is_null()) c.approval = integer(approval, p + "/approval", 0, INT64_MAX);
+  const std::string ps = p + "/surface_pairs";
+  const Json& sp = array(field(j, p, "surface_pairs"), ps);
+  for (std::size_t k = 0; k < sp.size(); ++k) {
+    const std::string pk = ps + "/" + std::to_string(k);
+    ClashSurfacePair s;
+    s.key = text(field(sp[k], pk, "key"), pk + "/key");
+    const Json& pair = field(sp[k], pk, "pair");
+    if (!pair.is_null()) s.pair = integer(pair, pk + "/pair", 0, INT64_MAX);
+    s.contact = named<ContactClass>(field(sp[k], pk, "class"), pk + "/class", "contact class");
+    s.penetration = number(field(sp[k], pk, "penetration"), pk + "/penetration");
+    s.distance = number(field(sp[k], pk, "distance"), pk + "/distance", true);
+    c.surface_pairs.push_back(std::move(s));
+  }
+  return c;
+}
+
+// `clashes` and `review` (written together); their pair indices must name pairs of `query`.
+ClashReview read_review(const Json& j, const QueryReport& query) {
+  ClashReview r;
+  const Json& rv = object(field(j, "", "review"), "/review");
+  r.baseline = string_or_null(field(rv, "/review", "baseline"), "/review/baseline");
+  r.approvals_file = string_or_null(field(rv, "/review", "approvals_file"), "/review/approvals_file");
+  r.today = string_or_null(field(rv, "/review", "today"), "/review/today");
+  r.group_by = text(field(rv, "/review", "group_by"), "/review/group_by");
+  if (std::find(kGroupBy.begin(), kGroupBy.end(), r.group_by) == kGroupBy.end())
+    fail("/review/group_by", "unknown grouping '" + r.group_by + "' (one of instance, part, subassembly, space)");
+  r.cluster_distance = number(field(rv, "/review", "cluster_distance"), "/review/cluster_distance");
+  const Json& approvals = array(field(rv, "/review", "approvals"), "/review/approvals");
+  for (std::size_t k = 0; k < approvals.size(); ++k) {
+    const std::string pk = "/review/approvals/" + std::to_string(k);
+    ApprovalUse u;
+    u.approval = read_approval(field(approvals[k], pk, "approval"), pk + "/approval");
+    u.source = text(field(approvals[k], pk, "source"), pk + "/source");
+    const std::string state = text(field(approvals[k], pk, "state"), pk + "/state");
+    u.expired = state == "expired";
+    u.matched = count(field(approvals[k], pk, "matched"), pk + "/matched");
+    if (state != (u.expired ? "expired" : u.matched == 0 ? "stale" : "used"))
+      fail(pk + "/state", "does not match `matched` and the expiry");
+    r.approvals.push_back(std::move(u));
+  }
+  const Json& clashes = array(field(j, "", "clashes"), "/clashes");
+  for (std::size_t k = 0; k < clashes.size(); ++k) {
+    const std::string pk = "/clashes/" + std::to_string(k);
+    ReportClash c = read_clash(clashes[k], pk);
+    if (c.approval >= static_cast<std::int64_t>(r.approvals.size()))
+      fail(pk + "/approval", "names no entry of /review/approvals");
+    for (std::size_t s = 0; s < c.surface_pairs.size(); ++s)
+      if (c.surface_pairs[s].pair >= static_cast<std::int64_t>(query.pairs.size()))
+        fail(pk + "/surface_pairs/" + std::to_string(s) + "/pair", "names no entry of /pairs");
+    r.clashes.push_back(std::move(c));
+  }
+  if (!agrees(review_json(r), rv)) fail("/review", "does not match the clashes and approvals");
+  return r;
+}
+
 CheckReport read_report(const Json& j) {
   CheckReport r;
   object(j, "");
@@ -221,6 +351,10 @@ CheckReport read_report(const Json& j) {
     r.stopped_by = string_or_null(field(j, "", "stopped_by"), "/stopped_by");
   } else {
     r.query = read_query(j, "");
+  }
+  if (j.contains("clashes") || j.contains("review")) {
+    if (!r.query) fail("/clashes", "a report with a trajectory has no clashes");
+    r.review = read_review(j, *r.query);
   }
   r.diagnostics = strings(field(j, "", "diagnostics"), "/diagnostics");
   r.complete = boolean(field(j, "", "complete"), "/complete");
@@ -249,6 +383,15 @@ ReportReadResult check_report_from_json(std::string_view text) {
     return out;
   }
   return check_report_from_parsed(j);
+}
+
+std::optional<ReportError> approval_from_json(const nlohmann::json& j, const std::string& path, Approval& out) {
+  try {
+    out = read_approval(j, path);
+  } catch (const ReadFailure& f) {
+    return f.error;
+  }
+  return std::nullopt;
 }
 
 std::optional<ReportError> provenance_from_json(const nlohmann::json& j, Surface& s) {

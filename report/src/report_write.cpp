@@ -207,6 +207,107 @@ nlohmann::json provenance_json(const Surface& s) {
   return j;
 }
 
+const char* clash_status_name(ClashStatus s) {
+  switch (s) {
+    case ClashStatus::Active: return "active";
+    case ClashStatus::Changed: return "changed";
+    case ClashStatus::Resolved: return "resolved";
+    case ClashStatus::Unexamined: return "unexamined";
+    case ClashStatus::New: break;
+  }
+  return "new";
+}
+
+nlohmann::json approval_json(const Approval& a) {
+  nlohmann::json j = nlohmann::json::object();
+  if (!a.id.empty()) {
+    j["id"] = a.id;
+  } else {
+    j["a"] = a.a.empty() ? std::string("**") : a.a;
+    j["b"] = a.b.empty() ? std::string("**") : a.b;
+    if (!a.part_a.empty()) j["part_a"] = a.part_a;
+    if (!a.part_b.empty()) j["part_b"] = a.part_b;
+  }
+  if (!a.classes.empty()) {
+    nlohmann::json c = nlohmann::json::array();
+    for (ContactClass k : a.classes) c.push_back(contact_class_name(k));
+    j["classes"] = std::move(c);
+  }
+  j["reason"] = a.reason;
+  j["by"] = a.by;
+  j["date"] = a.date;
+  if (!a.expires.empty()) j["expires"] = a.expires;
+  return j;
+}
+
+static nlohmann::json interference_json(const std::optional<ClashInterference>& i) {
+  if (!i) return nullptr;
+  return {{"measured", i->measured},
+          {"note", string_or_null(i->note)},
+          {"volume", i->volume},
+          {"depth", i->depth},
+          {"centroid", i->volume > 0 ? nlohmann::json(i->centroid) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json clashes_json(const ClashReview& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ReportClash& c : r.clashes) {
+    nlohmann::json sp = nlohmann::json::array();
+    for (const ClashSurfacePair& p : c.surface_pairs)
+      sp.push_back({{"key", p.key},
+                    {"pair", p.pair < 0 ? nlohmann::json(nullptr) : nlohmann::json(p.pair)},
+                    {"class", contact_class_name(p.contact)},
+                    {"penetration", p.penetration},
+                    {"distance", number_or_null(p.distance)}});
+    nlohmann::json j{{"id", c.id},
+                     {"status", clash_status_name(c.status)},
+                     {"a", {{"instance", c.instance_a}, {"part", c.part_a}}},
+                     {"b", {{"instance", c.instance_b}, {"part", c.part_b}}},
+                     {"class", contact_class_name(c.worst)},
+                     {"max_penetration", c.max_penetration},
+                     {"min_distance", number_or_null(c.min_distance)},
+                     {"group", c.group},
+                     {"box", c.box ? nlohmann::json(*c.box) : nlohmann::json(nullptr)},
+                     {"interference", interference_json(c.interference)},
+                     {"approval", c.approval < 0 ? nlohmann::json(nullptr) : nlohmann::json(c.approval)},
+                     {"surface_pairs", std::move(sp)}};
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+nlohmann::json review_json(const ClashReview& r) {
+  nlohmann::json counts = nlohmann::json::object();
+  for (ClashStatus s : EnumNames<ClashStatus>::values) counts[clash_status_name(s)] = 0;
+  std::size_t approved = 0;
+  for (const ReportClash& c : r.clashes) {
+    counts[clash_status_name(c.status)] = counts[clash_status_name(c.status)].get<std::size_t>() + 1;
+    approved += c.approval >= 0;
+  }
+  counts["approved"] = approved;
+  counts["clashes"] = r.clashes.size();
+  nlohmann::json approvals = nlohmann::json::array();
+  std::size_t stale = 0, expired = 0;
+  for (const ApprovalUse& u : r.approvals) {
+    const char* state = u.expired ? "expired" : u.matched == 0 ? "stale" : "used";
+    stale += !u.expired && u.matched == 0;
+    expired += u.expired;
+    approvals.push_back({{"approval", approval_json(u.approval)},
+                         {"source", u.source},
+                         {"state", state},
+                         {"matched", u.matched}});
+  }
+  counts["stale_approvals"] = stale;
+  counts["expired_approvals"] = expired;
+  return {{"baseline", string_or_null(r.baseline)},
+          {"approvals_file", string_or_null(r.approvals_file)},
+          {"today", string_or_null(r.today)},
+          {"group_by", r.group_by},
+          {"cluster_distance", r.cluster_distance},
+          {"summary", std::move(counts)},
+          {"approvals", std::move(approvals)}};
+}
+
 nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions& o) {
   nlohmann::json j;
   j["schema"] = kCheckReportSchema;
@@ -226,6 +327,10 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
     j["steps"] = std::move(steps);
     j["steps_not_checked"] = r.steps_not_checked;
     j["stopped_by"] = string_or_null(r.stopped_by);
+  }
+  if (r.review) {
+    j["clashes"] = clashes_json(*r.review);
+    j["review"] = review_json(*r.review);
   }
   j["diagnostics"] = r.diagnostics;
   j["complete"] = r.complete;

@@ -1,4 +1,5 @@
 """Report.to_json / Report.from_json against `cadclash check --json`, byte for byte."""
+import json
 import os
 import subprocess
 
@@ -106,7 +107,11 @@ def test_diagnostics_are_parsed_back(tmp_path, data_dir):
 def test_malformed_reports_name_the_json_path(boxes):
     text = cadclash.Scene(cadclash.load([str(b) for b in boxes])).check(clearance=1.0).to_json()
     assert '"class": "clearance"' in text
+    bad = json.loads(text)
+    bad["pairs"][0]["class"] = "nearby"  # (the text's first "class" is now in `clashes`, which sorts first)
     with pytest.raises(ValueError, match=r"/pairs/0/class: unknown contact class 'nearby'"):
+        cadclash.Report.from_json(json.dumps(bad))
+    with pytest.raises(ValueError, match=r"/clashes/0/class: unknown contact class 'nearby'"):
         cadclash.Report.from_json(text.replace('"class": "clearance"', '"class": "nearby"', 1))
     with pytest.raises(ValueError, match="/version"):
         cadclash.Report.from_json(text.replace('"version": 2', '"version": 7'))

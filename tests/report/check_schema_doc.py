@@ -3,7 +3,8 @@
 Usage: check_schema_doc.py CADCLASH_EXE docs/report-schema.md DATA_DIR
 
 Runs the CLI on real inputs (as1 by default and with --exact, OBJ boxes with --all-triangles and
---clearance, a --path trajectory, with and without timings), collects every key of every object
+--clearance, a --path trajectory, with and without timings, and as1 reviewed with --baseline and
+--approvals), collects every key of every object
 by where it occurs (top level, settings, pair, side, summary, counters, timings, step), and checks
 both ways against the doc's sections: every written key is documented in its section, and every key
 a section documents is written by some run. Every class, decided_by and kind value written is named
@@ -29,6 +30,14 @@ SECTIONS = {
     "`model`": "model",
     "`model.bytes`": "model_bytes",
     "Step (with `--path`)": "step",
+    "Clash": "clash",
+    "ClashSide": "clash_side",
+    "ClashSurfacePair": "clash_pair",
+    "ClashInterference": "interference",
+    "`review`": "review",
+    "`review.summary`": "review_summary",
+    "ApprovalUse": "approval_use",
+    "Approval": "approval",
 }
 # Documented keys no run here writes, with the reason. Keep empty when possible.
 NOT_WRITTEN = {}
@@ -82,6 +91,22 @@ def collect(report: dict, seen: dict) -> None:
 
     add("top", report)
     add("settings", report["settings"])
+    for c in report.get("clashes", []):
+        add("clash", c)
+        add("clash_side", c["a"])
+        add("clash_side", c["b"])
+        seen.setdefault("values", set()).add(c["status"])
+        for p in c["surface_pairs"]:
+            add("clash_pair", p)
+        if c["interference"] is not None:
+            add("interference", c["interference"])
+    if "review" in report:
+        add("review", report["review"])
+        add("review_summary", report["review"]["summary"])
+        for u in report["review"]["approvals"]:
+            add("approval_use", u)
+            add("approval", u["approval"])
+            seen.setdefault("values", set()).add(u["state"])
     query(report)
     for s in report.get("steps", []):
         add("step", s)
@@ -100,11 +125,29 @@ def main() -> int:
         [as1, "--exact"],
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
+        [boxes[0], boxes[1], "--volume"],
     ]
     seen: dict = {}
     with tempfile.TemporaryDirectory() as tmp:
-        out = pathlib.Path(tmp) / "report.json"
-        for args in runs:
+        outs = [pathlib.Path(tmp) / f"report{k}.json" for k in range(len(runs) + 1)]
+        approvals = pathlib.Path(tmp) / "approvals.json"
+
+        def review_run():
+            # as1 reviewed against the boxes' report (every as1 clash new, the boxes' resolved), with
+            # an id approval, a rule with every glob, classes and an expiry, and an expired one.
+            first = json.loads(outs[0].read_text())["clashes"][0]["id"]
+            common = {"reason": "designed", "by": "doc check", "date": "2026-01-01"}
+            approvals.write_text(json.dumps({"schema": "cadclash-approvals", "version": 1, "approvals": [
+                {"id": first, **common},
+                {"a": "/as1/**", "b": "**/BOLT", "part_a": "*", "part_b": "bolt", "classes": ["touching"],
+                 "expires": "2027-01-01", **common},
+                {"id": "000000000000", "expires": "2020-01-01", **common}]}))
+            return [as1, "--no-timings", "--baseline", outs[2], "--approvals", approvals, "--today", "2026-06-01",
+                    "--group-by", "space"]
+
+        for k, args in enumerate([*runs, None]):
+            args = args if args is not None else review_run()
+            out = outs[k]
             proc = subprocess.run([exe, "check", *map(str, args), "--json", str(out)], capture_output=True, text=True)
             if proc.returncode not in (0, 3):
                 print(f"cadclash check {' '.join(map(str, args))}: exit {proc.returncode}\n{proc.stderr}")
@@ -126,7 +169,7 @@ def main() -> int:
         errors.append("unexamined_pairs: keys other than a, b")
     for e in errors:
         print(f"{doc_path}: {e}")
-    print(f"checked {sum(len(k) for k in doc.values())} documented keys against {len(runs)} runs: "
+    print(f"checked {sum(len(k) for k in doc.values())} documented keys against {len(runs) + 1} runs: "
           f"{len(errors)} problems")
     return 1 if errors else 0
 

@@ -105,7 +105,9 @@ async function checkCase(browser, args, { name, inputs, options, tessellate, exp
   console.log(`pairs by class: ${JSON.stringify(byClass)}; decided by: ${JSON.stringify(report.summary.decided_by)}`);
   if (expectClass) check(byClass[expectClass] > 0, `the report has no ${expectClass} pair`);
 
-  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
+  // 900 px high: with the clash review bar and clash line the table still shows 8 rows, so a filter
+  // listing up to 20 pairs has every row drawn (visible rows plus the table's overscan of 12).
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
   try {
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));

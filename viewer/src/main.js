@@ -13,6 +13,7 @@ import { fillClassToggles, fillLegend, showClassCounts, showSelection } from './
 import { PairFilter } from './filter.js';
 import { PairTable } from './pairtable.js';
 import { CLASSES } from './classes.js';
+import { ReviewState, fillReviewBar, showClash, showReviewCounts } from './review.js';
 
 // Pause in typing before the filter applies: one pass over 60 000 pairs is cheap, but redrawing a
 // big scene (the 3D view colours only the listed pairs) is not.
@@ -147,6 +148,7 @@ function start() {
     table.scrollToPair(index);
     clash.select(pair);
     showSelection(panel, data, index);
+    showClash(clashBox, review, index, reviewChanged);
     document.documentElement.dataset.cadclashSelected = String(index);
     frameSelected();
   }
@@ -158,10 +160,27 @@ function start() {
   const filterCount = document.getElementById('filter-count');
   let shownClasses = Object.fromEntries(CLASSES.map((c) => [c, true]));
   let filterTimer = 0;
+  // The clash review: status and approval toggles, approvals made in the page (viewer/src/review.js).
+  const review = new ReviewState(data);
+  const reviewBar = document.getElementById('review-bar');
+  const clashBox = document.getElementById('clash-info');
+  let shownReview = {};
+  function reviewChanged() {
+    showReviewCounts(reviewBar, review);
+    showClash(clashBox, review, selected, reviewChanged);
+    applyFilter();
+  }
+  fillReviewBar(reviewBar, review, (shown) => {
+    shownReview = shown;
+    applyFilter();
+  });
   function applyFilter() {
     clearTimeout(filterTimer);
     filterTimer = 0;
-    const { indices, counts } = filter.apply(filterBox.value, shownClasses);
+    const matched = filter.apply(filterBox.value, shownClasses);
+    const counts = matched.counts;
+    const indices = Object.values(shownReview).includes(false)
+      ? matched.indices.filter((i) => review.pairShown(i, shownReview)) : matched.indices;
     table.setRows(indices);
     if (selected >= 0) table.scrollToPair(selected);
     showClassCounts(toggles, counts);
@@ -249,6 +268,8 @@ function start() {
       readyMs: tReady,  // since navigation start: includes reading and parsing the HTML file
     },
     selectPair,
+    // The approvals file the export button writes (the report's approvals and the page's changes).
+    approvalsText: () => review.approvalsText(),
     // Per class, how many (instance, surface) the 3D view colours with it (unfiltered).
     highlightCounts: () => clash.highlightCounts(),
     // Scrolls the table to a listed pair's row (false when the filter hides it).

@@ -206,6 +206,85 @@ struct StepReport {
   QueryReport query;
 };
 
+// ---------------------------------------------------------------------------------------------
+// Clashes and their review (cadclash/review.h computes them; docs/report-schema.md, "Clash")
+// ---------------------------------------------------------------------------------------------
+
+// A clash's status against a baseline report: new (not in it), active (unchanged), changed (worst
+// class, a surface pair's class, or the depth changed), resolved (in the baseline, gone now),
+// unexamined (in the baseline, its instance pair not examined by this partial run: unknown now).
+enum class ClashStatus : std::uint8_t { New, Active, Changed, Resolved, Unexamined };
+// Returns "new", "active", "changed", "resolved" or "unexamined".
+const char* clash_status_name(ClashStatus s);
+template <> struct EnumNames<ClashStatus> {
+  static constexpr std::array values{ClashStatus::New, ClashStatus::Active, ClashStatus::Changed, ClashStatus::Resolved,
+                                     ClashStatus::Unexamined};
+  static const char* name(ClashStatus s) { return clash_status_name(s); }
+};
+
+// One surface pair of a clash.
+struct ClashSurfacePair {
+  std::string key;         // stable across runs: face indices (and STEP face names) within the parts
+  std::int64_t pair = -1;  // index into the query's `pairs`; -1 for a resolved clash (its last data below)
+  ContactClass contact = ContactClass::Touching;
+  double penetration = 0.0;
+  double distance = 0.0;  // +infinity: null
+};
+
+// The Boolean common of a clash's two solids (`cadclash check --volume`; cadclash/interference.h).
+struct ClashInterference {
+  bool measured = false;  // false: `note` says why not (a mesh, not a closed solid, an OCCT failure)
+  std::string note;
+  double volume = 0.0;  // mm^3
+  double depth = 0.0;   // mm: smallest extent of the common's oriented box
+  std::array<double, 3> centroid{};  // world; meaningful when volume > 0
+};
+
+// One clash: an instance pair with its surface pairs, the sides in canonical order (review.h).
+struct ReportClash {
+  std::string id;  // 12 hex digits (review.h: clash_id)
+  ClashStatus status = ClashStatus::New;
+  std::string instance_a, part_a, instance_b, part_b;
+  ContactClass worst = ContactClass::Clearance;  // the most severe class of its surface pairs
+  double max_penetration = 0.0;
+  double min_distance = 0.0;  // +infinity: null
+  std::string group;          // the group it belongs to (ClashReview::group_by)
+  // World box of where the two meet (review.h: contact_boxes), for the viewer and spatial groups;
+  // nullopt when not known (a resolved clash, or a review without the model).
+  std::optional<std::array<double, 6>> box;
+  std::optional<ClashInterference> interference;  // with --volume, for penetrating and containment clashes
+  std::int64_t approval = -1;  // index into ClashReview::approvals; -1: not approved
+  std::vector<ClashSurfacePair> surface_pairs;
+};
+
+// One approval: a clash id, or a rule by instance-path and part-name globs (review.h: matching).
+struct Approval {
+  std::string id;                      // a clash id; empty: a rule by the globs below
+  std::string a, b;                    // instance path globs (rule only); empty: "**"
+  std::string part_a, part_b;          // part name globs (rule only); empty: any part
+  std::vector<ContactClass> classes;   // worst classes it approves; empty: every class
+  std::string reason, by, date;        // date: YYYY-MM-DD
+  std::string expires;                 // YYYY-MM-DD, last day it applies; empty: never expires
+};
+
+// What became of one approval in this run.
+struct ApprovalUse {
+  Approval approval;
+  std::string source;       // where it was read: "FILE#/approvals/3"
+  bool expired = false;     // `expires` is before the run's `today`: not applied
+  std::uint64_t matched = 0;  // current clashes it approved (0 and not expired: stale)
+};
+
+struct ClashReview {
+  std::string baseline;   // the baseline report's file; empty: none (every clash is new)
+  std::string approvals_file;  // empty: none
+  std::string today;      // YYYY-MM-DD the expiries were judged by; empty without approvals
+  std::string group_by = "instance";  // instance | part | subassembly | space
+  double cluster_distance = 0.0;      // mm, with group_by "space"
+  std::vector<ReportClash> clashes;   // current clashes in the order of their first pair, then resolved ones
+  std::vector<ApprovalUse> approvals;
+};
+
 struct CheckReport {
   int version = kCheckReportVersion;
   std::vector<std::string> files;  // as given
@@ -219,6 +298,9 @@ struct CheckReport {
   std::string stopped_by;  // first budget that ran out over the steps; empty: none (null)
   std::vector<std::string> diagnostics;  // format_diagnostic() lines
   bool complete = true;
+  // Without a trajectory: the query's pairs grouped into clashes, with their review (written as
+  // `clashes` and `review`); nullopt: not written (reports of the library's callers that do not ask).
+  std::optional<ClashReview> review;
 };
 
 // `r` over `model` with every id resolved to names: what the report says about one query.
@@ -239,6 +321,12 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
 std::string check_report_text(const CheckReport& r, const ReportWriteOptions& o = {});
 // JSON as the report files are written: 2-space indent, invalid UTF-8 replaced, a final newline.
 std::string report_text(const nlohmann::json& j);
+
+// The `clashes` list and the `review` object of a report (written at the top level with `r.review`).
+nlohmann::json clashes_json(const ClashReview& r);
+nlohmann::json review_json(const ClashReview& r);
+// One approval as the approvals file and the report's `review.approvals` hold it.
+nlohmann::json approval_json(const Approval& a);
 
 // The pieces, for the JSON documents built around them (HTML report, `cadclash info`):
 // `summary`: counts per class and per decided_by (containment excluded from decided_by).
@@ -278,6 +366,10 @@ struct ReportReadResult {
 ReportReadResult check_report_from_json(std::string_view text);
 // The same on a document already parsed.
 ReportReadResult check_report_from_parsed(const nlohmann::json& j);
+
+// Reads one approval written by approval_json() (or by hand: unknown fields are ignored); `path`
+// is its JSON pointer for the error. Checks the dates (YYYY-MM-DD) and that it names an id or a rule.
+std::optional<ReportError> approval_from_json(const nlohmann::json& j, const std::string& path, Approval& out);
 
 // Reads back what provenance_json() wrote into `s` (name, provenance, deflection, box; the box is
 // emptied when none was written). Returns the first problem; `s` is then partly assigned.
