@@ -1,5 +1,6 @@
 // cadclash check's review options: the baseline and approvals read, and the review printed.
 #include "check_review.h"
+#include "cmd_check_mpi.h"
 
 #include "cli_common.h"
 
@@ -178,6 +179,11 @@ void print_review(const ClashReview& r, std::ostream& os) {
   }
 }
 
-bool collapse_clashes(const ReviewCliOptions& o) { return !o.expand && isatty(STDOUT_FILENO) == 1; }
+// Under mpirun a rank's stdout is the pseudo-terminal Open MPI forwards output through, whatever
+// mpirun's own stdout is: isatty says nothing there, so an MPI job lists every pair, as a pipe does
+// (and its table stays byte-identical to a single process's).
+bool collapse_clashes(const ReviewCliOptions& o) {
+  return !o.expand && !mpi_launch().by_mpirun && isatty(STDOUT_FILENO) == 1;
+}
 
 }  // namespace cadclash::cli
