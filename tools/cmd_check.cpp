@@ -1,6 +1,7 @@
 // cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
 #include "cli_common.h"
 #include "html_report.h"
+#include "import_stages.h"
 
 #include "cadclash/report.h"
 
@@ -330,6 +331,10 @@ int run_check(const CheckOptions& o) {
   if (!run.stopped_by.empty())
     std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
+  if (!o.no_timings) {
+    report.import = import_report(imported);
+    print_import_stages(imported, report, std::cout);
+  }
   const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
   if (!o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);

@@ -15,6 +15,7 @@
 #include <TopoDS_Compound.hxx>
 
 #include <cassert>
+#include <chrono>
 #include <cstddef>
 
 namespace cadclash {
@@ -159,8 +160,10 @@ void mesh_faces(const BrepPartInput& in, BrepSource::Impl& impl, double deflecti
 
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
-                                   std::vector<Diagnostic>& diagnostics, bool& complete) {
+                                   std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings) {
   assert(options.linear_deflection > 0.0);
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   std::vector<PartId> ids;
   ids.reserve(parts.size());
   const detail::MeshDeadline deadline = detail::MeshDeadline::after(options.time_limit_seconds);
@@ -180,6 +183,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     impl->entity_ids.resize(n, -1);
     for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl->entity_ids[i] = in.tags[i].entity_id;
 
+    const Clock::time_point heal_start = Clock::now();
     const std::vector<char> healed = heal_invalid_faces(in, *impl, diagnostics);
 
     store_plane_pcurves(impl->faces);
@@ -225,7 +229,11 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     impl->exact_faces.resize(n);
     for (std::size_t i = 0; i < n; ++i) impl->exact_faces[i] = surfaces[i].exact_triangles ? 1 : 0;
 
+    if (timings) timings->heal += seconds_since(heal_start);
+
+    const Clock::time_point mesh_start = Clock::now();
     if (!lazy && n > 0) mesh_faces(in, *impl, deflection, options, deadline, surfaces, diagnostics, complete);
+    if (timings) timings->tessellate += seconds_since(mesh_start);
 
     part.source = std::make_shared<BrepSource>(std::move(impl));
     model.parts.push_back(std::move(part));

@@ -2,12 +2,12 @@
 
 Usage: check_schema_doc.py CADCLASH_EXE docs/report-schema.md DATA_DIR
 
-Runs the CLI on real inputs (as1 by default and with --exact, OBJ boxes with --all-triangles and
+Runs the CLI on real inputs (as1 by default and with --exact, twice through a --cache, OBJ boxes with --all-triangles and
 --clearance, a --path trajectory, with and without timings), collects every key of every object
 by where it occurs (top level, settings, pair, side, summary, counters, timings, step), and checks
 both ways against the doc's sections: every written key is documented in its section, and every key
 a section documents is written by some run. Every class, decided_by and kind value written is named
-in the doc too. A key the doc documents but no run writes must be added
+in the doc too (and so is every `cache` value written). A key the doc documents but no run writes must be added
 to a run here (or listed in NOT_WRITTEN with the reason).
 """
 import json
@@ -29,6 +29,8 @@ SECTIONS = {
     "`model`": "model",
     "`model.bytes`": "model_bytes",
     "Step (with `--path`)": "step",
+    "`import_timings`": "import_timings",
+    "`import_timings.files[]`": "import_file",
 }
 # Documented keys no run here writes, with the reason. Keep empty when possible.
 NOT_WRITTEN = {}
@@ -82,6 +84,11 @@ def collect(report: dict, seen: dict) -> None:
 
     add("top", report)
     add("settings", report["settings"])
+    if "import_timings" in report:
+        add("import_timings", report["import_timings"])
+        for f in report["import_timings"]["files"]:
+            add("import_file", f)
+            seen.setdefault("values", set()).add(f["cache"])
     query(report)
     for s in report.get("steps", []):
         add("step", s)
@@ -97,14 +104,17 @@ def main() -> int:
         return 1
     runs = [
         [as1, "--no-timings"],
-        [as1, "--exact"],
+        [as1, "--exact", "--cache", "CACHE"],
+        [as1, "--exact", "--cache", "CACHE"],
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
     ]
     seen: dict = {}
     with tempfile.TemporaryDirectory() as tmp:
         out = pathlib.Path(tmp) / "report.json"
+        cache = pathlib.Path(tmp) / "cache"
         for args in runs:
+            args = [cache if a == "CACHE" else a for a in args]
             proc = subprocess.run([exe, "check", *map(str, args), "--json", str(out)], capture_output=True, text=True)
             if proc.returncode not in (0, 3):
                 print(f"cadclash check {' '.join(map(str, args))}: exit {proc.returncode}\n{proc.stderr}")
