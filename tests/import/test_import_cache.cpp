@@ -219,6 +219,24 @@ TEST(ImportCache, OnlyChangedFilesAreReadAgain) {
   EXPECT_EQ(import_file(as1, parallel).files[0].cache, CacheUse::Hit);
 }
 
+// Parts of one file healed and meshed on several threads (TessellationOptions::parallel, the default),
+// BRepMesh spreading each part's faces over threads too: the same model and check as one thread.
+TEST(ImportParallel, PartsMeshedInParallelAsOneAfterAnother) {
+  for (const char* name : {"as1-tu-203.stp", "linkrods.step"}) {
+    const std::string path = kExternal + name;
+    if (!fs::exists(path)) GTEST_SKIP() << path << " missing: run scripts/setup.sh";
+    SCOPED_TRACE(name);
+    ImportOptions serial;
+    serial.tessellation.parallel = false;
+    const ImportResult one = import_file(path, serial);
+    const ImportResult many = import_file(path, ImportOptions{});
+    EXPECT_GT(one.model.parts.size(), 0u);
+    EXPECT_EQ(messages(many), messages(one));
+    EXPECT_TRUE(same_bytes(everything(many), everything(one)));
+    EXPECT_EQ(check_text(many), check_text(one));
+  }
+}
+
 // A cache directory that cannot be made costs a warning, not the import.
 TEST(ImportCache, UnwritableCacheIsAWarning) {
   const std::string path = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";

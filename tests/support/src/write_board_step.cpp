@@ -1,13 +1,16 @@
 // write_board_step — writes the truth tests' board scene (cadclash/testing/scenes.h) as a STEP
 // assembly, the input of the import benchmark (scripts/import_bench.sh).
-//   write_board_step DATA_EXTERNAL_DIR OUT.step [COPIES [SHIFT_X]]
+//   write_board_step DATA_EXTERNAL_DIR OUT.step [COPIES [SHIFT_X [unshared]]]
 // One product per distinct part (the faces of its B-rep, as a compound), one occurrence per instance,
 // placed by its pose; COPIES (default 1) boards side by side (grid_copies, 5 mm apart), the whole
-// moved SHIFT_X mm along x (default 0; a second file far from the first has no pair with it).
+// moved SHIFT_X mm along x (default 0; a second file far from the first has no pair with it). With
+// "unshared", every instance gets a product of its own (a copy of its part's faces), as exporters
+// that do not find repeated components write them.
 #include "cadclash/geometry.h"
 #include "cadclash/tessellate.h"
 #include "cadclash/testing/scenes.h"
 
+#include <BRepBuilderAPI_Copy.hxx>
 #include <BRep_Builder.hxx>
 #include <Interface_Static.hxx>
 #include <STEPCAFControl_Writer.hxx>
@@ -20,6 +23,7 @@
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Trsf.hxx>
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -41,12 +45,13 @@ std::string leaf_name(const std::string& path) { return path.substr(path.rfind('
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3 || argc > 5) {
-    std::cerr << "usage: write_board_step DATA_EXTERNAL_DIR OUT.step [COPIES [SHIFT_X]]\n";
+  if (argc < 3 || argc > 6) {
+    std::cerr << "usage: write_board_step DATA_EXTERNAL_DIR OUT.step [COPIES [SHIFT_X [unshared]]]\n";
     return 2;
   }
   const int copies = argc >= 4 ? std::atoi(argv[3]) : 1;
   const double shift = argc >= 5 ? std::atof(argv[4]) : 0.0;
+  const bool unshared = argc >= 6 && std::string(argv[5]) == "unshared";
   cadclash::truth::BuiltScene scene = cadclash::truth::board_scene(argv[1], 0.1);
   if (!scene.ok()) {
     for (const auto& d : scene.diagnostics) std::cerr << cadclash::format_diagnostic(d) << '\n';
@@ -60,22 +65,30 @@ int main(int argc, char** argv) {
   Handle(TDocStd_Document) doc;
   XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
   const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-  std::vector<TDF_Label> part_labels(model.parts.size());
-  for (std::size_t p = 0; p < model.parts.size(); ++p) {
+  auto add_part = [&](std::size_t p, bool copy) {
     const auto* source = dynamic_cast<const cadclash::BrepSource*>(model.parts[p].source.get());
-    if (!source) continue;
+    if (!source) return TDF_Label();
     BRep_Builder b;
     TopoDS_Compound c;
     b.MakeCompound(c);
     for (std::uint32_t k = 0; k < source->face_count(); ++k) b.Add(c, source->face(k));
-    part_labels[p] = shapes->AddShape(c, Standard_False);
-    TDataStd_Name::Set(part_labels[p], model.parts[p].name.c_str());
-  }
+    const TDF_Label label = shapes->AddShape(copy ? BRepBuilderAPI_Copy(c).Shape() : TopoDS_Shape(c), Standard_False);
+    TDataStd_Name::Set(label, model.parts[p].name.c_str());
+    return label;
+  };
+  std::vector<TDF_Label> part_labels(model.parts.size());
+  for (std::size_t p = 0; p < model.parts.size(); ++p) part_labels[p] = add_part(p, false);
   const TDF_Label board = shapes->NewShape();
   TDataStd_Name::Set(board, "board");
-  for (const cadclash::Instance& instance : model.instances) {
+  for (std::size_t i = 0; i < model.instances.size(); ++i) {
+    const cadclash::Instance& instance = model.instances[i];
     if (part_labels[instance.part].IsNull()) continue;
-    const TDF_Label component = shapes->AddComponent(board, part_labels[instance.part], TopLoc_Location(trsf_of(instance.pose)));
+    // Every instance after the first of its part: a copy of its own when unshared.
+    const bool own = unshared &&
+                     std::any_of(model.instances.begin(), model.instances.begin() + static_cast<std::ptrdiff_t>(i),
+                                 [&](const cadclash::Instance& e) { return e.part == instance.part; });
+    const TDF_Label part = own ? add_part(instance.part, true) : part_labels[instance.part];
+    const TDF_Label component = shapes->AddComponent(board, part, TopLoc_Location(trsf_of(instance.pose)));
     TDataStd_Name::Set(component, leaf_name(instance.path).c_str());
   }
   shapes->UpdateAssemblies();
