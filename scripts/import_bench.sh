@@ -6,8 +6,8 @@
 #   - two files (the board and a copy moved 1 m away, so the files differ and no pair crosses
 #     them) one after another (--parallel-files 1) and at once (--parallel-files 2);
 #   - one and two files again from a warm --cache.
-# Each run is repeated REPEATS times (default 5); the median wall time is reported, with the stage
-# times (read, transfer, heal, tessellate, query) of the median run.
+# Each case runs REPEATS times (default 5), in rounds; the median wall time is reported, with the
+# stage times (read, transfer, heal, tessellate, query) of the median run.
 #   bash scripts/import_bench.sh [BUILD_DIR] [REPEATS]
 # Needs a build with tests (write_board_step is in tests/support). Writes out/import_bench/results.md.
 set -euo pipefail
@@ -29,33 +29,38 @@ if [ ! -f "$board" ] || [ ! -f "$board2" ]; then
 fi
 size_mb=$(awk -v b="$(stat -c %s "$board")" 'BEGIN { printf "%.1f", b / 1e6 }')
 
-# run NAME ARGS...: REPEATS runs of `cadclash check ARGS --json`, the median's wall time and stages.
-declare -A wall stages
-run() {
-  local name=$1; shift
-  local times=() k
-  for ((k = 0; k < repeats; k++)); do
-    local t0 t1
-    t0=$(date +%s.%N)
-    "$exe" check "$@" --json "$out/$name-$k.json" >"$out/$name-$k.txt" 2>"$out/$name-$k.err" || [ $? -eq 3 ]
-    t1=$(date +%s.%N)
-    times+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }') $k")
-  done
-  local median
-  median=$(printf '%s\n' "${times[@]}" | sort -n | awk -v n="$repeats" 'NR == int((n + 1) / 2)')
-  wall[$name]=${median% *}
-  stages[$name]=$(grep '^stages:' "$out/$name-${median#* }.txt" | sed 's/^stages: //')
-  echo "$name: ${wall[$name]} s ($(printf '%s ' "${times[@]%% *}"))"
+# The cases, each run REPEATS times in rounds (every case once per round), so that a change in the
+# machine's load falls on all of them alike; per case the median run's wall time and stage line.
+names=(one-cold two-serial two-parallel one-warm two-warm)
+args_of() {
+  case $1 in
+    one-cold) echo "$board" ;;
+    two-serial) echo "$board $board2 --parallel-files 1" ;;
+    two-parallel) echo "$board $board2 --parallel-files 2" ;;
+    one-warm) echo "$board --cache $out/cache" ;;
+    two-warm) echo "$board $board2 --cache $out/cache" ;;
+  esac
 }
-
+declare -A times wall stages
 load=$(cut -d" " -f1-3 /proc/loadavg)
 rm -rf "$out/cache"
-run one-cold "$board"
-run two-serial "$board" "$board2" --parallel-files 1
-run two-parallel "$board" "$board2" --parallel-files 2
 "$exe" check "$board" "$board2" --cache "$out/cache" >/dev/null 2>&1 || true  # fill the cache
-run one-warm "$board" --cache "$out/cache"
-run two-warm "$board" "$board2" --cache "$out/cache"
+for ((k = 0; k < repeats; k++)); do
+  for name in "${names[@]}"; do
+    t0=$(date +%s.%N)
+    # shellcheck disable=SC2046  # the paths have no blanks (out/import_bench)
+    "$exe" check $(args_of "$name") --json "$out/$name-$k.json" >"$out/$name-$k.txt" 2>"$out/$name-$k.err" || [ $? -eq 3 ]
+    t1=$(date +%s.%N)
+    times[$name]+="$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }') $k
+"
+  done
+done
+for name in "${names[@]}"; do
+  median=$(printf '%s' "${times[$name]}" | sort -n | awk -v n="$repeats" 'NR == int((n + 1) / 2)')
+  wall[$name]=${median% *}
+  stages[$name]=$(grep '^stages:' "$out/$name-${median#* }.txt" | sed 's/^stages: //')
+  echo "$name: ${wall[$name]} s ($(printf '%s' "${times[$name]}" | cut -d' ' -f1 | tr '\n' ' '))"
+done
 
 # The reports must not depend on how the files were read.
 for name in two-parallel two-warm; do
