@@ -5,6 +5,7 @@
 #include "cli_runner.h"
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -94,6 +95,40 @@ TEST(CliImport, DamagedCacheEntryIsReadAgain) {
   want.erase("diagnostics");
   EXPECT_EQ(got, want);
   EXPECT_EQ(report_of(files, "--no-timings --cache '" + cache + "'"), reference);  // rewritten whole
+}
+
+// Runs sharing one cache directory at once: each writes its entries through a temporary file and a
+// rename, so none ever reads half an entry; all give the reference report, and the directory ends
+// with one whole entry per file and no temporary files.
+TEST(CliImport, ConcurrentRunsShareACache) {
+  const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
+  if (!fs::exists(as1) || !fs::exists(screw)) GTEST_SKIP() << "data/external missing: run scripts/setup.sh";
+  const std::string dir = cadclash::testing::scratch_dir();
+  const std::string cache = dir + "/shared-cache";
+  fs::remove_all(cache);
+  const std::string files = "'" + as1 + "' '" + screw + "'";
+  const std::string reference = report_of(files, "--no-timings");
+  constexpr int kRuns = 3;
+  for (int round = 0; round < 2; ++round) {  // all cold at once, then all warm at once
+    std::string command = "for k in";
+    for (int k = 0; k < kRuns; ++k) command += " " + std::to_string(k);
+    command += std::string("; do timeout 120 '") + CADCLASH_EXE + "' check " + files + " --no-timings --cache '" + cache +
+               "' --json '" + dir + "/shared'$k.json >/dev/null 2>'" + dir + "/shared'$k.err & done; wait";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    for (int k = 0; k < kRuns; ++k) {
+      SCOPED_TRACE("round " + std::to_string(round) + ", run " + std::to_string(k));
+      EXPECT_EQ(cadclash::testing::slurp(dir + "/shared" + std::to_string(k) + ".json"), reference);
+      const std::string err = cadclash::testing::slurp(dir + "/shared" + std::to_string(k) + ".err");
+      EXPECT_EQ(err.find("damaged"), std::string::npos) << err;
+      EXPECT_EQ(err.find("could not store"), std::string::npos) << err;
+    }
+  }
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(cache)) {
+    EXPECT_EQ(e.path().extension(), ".entry") << e.path();
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2);
 }
 
 }  // namespace
