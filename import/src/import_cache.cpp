@@ -16,6 +16,8 @@
 #include <sstream>
 #include <system_error>
 
+#include <dlfcn.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace cadclash::detail {
@@ -54,14 +56,33 @@ std::optional<std::string> file_bytes(const std::string& path) {
   return std::move(buffer).str();
 }
 
+// The build of cadclash reading the files: the file this code was loaded from (the program, or the
+// Python module), its size and modification time. Any rebuild changes it, so an entry written by
+// another build, whose readers or tessellation may differ, is never looked up; stat is all it costs.
+std::string build_identity() {
+  static const std::string id = [] {
+    Dl_info info{};
+    std::string file = "/proc/self/exe";
+    if (dladdr(reinterpret_cast<const void*>(&build_identity), &info) != 0 && info.dli_fname != nullptr &&
+        info.dli_fname[0] == '/')
+      file = info.dli_fname;
+    struct stat st {};
+    if (stat(file.c_str(), &st) != 0) return std::string("build unknown");
+    return "build " + file + " " + std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
+           std::to_string(st.st_mtim.tv_nsec);
+  }();
+  return id;
+}
+
 // Everything the stored result depends on, as text: the file's bytes (by hash) and path, each option
-// that changes what is read or how it is tessellated, and the versions of this cache and of OCCT.
+// that changes what is read or how it is tessellated, the versions of this cache and of OCCT, and the
+// build reading them.
 // Doubles in hexadecimal, so no two settings share a key. `parallel_files` and the threads BRepMesh
 // uses do not change the result, so they are not in it.
 std::string cache_key(const std::string& path, const std::string& bytes, const ImportOptions& o) {
   std::ostringstream k;
   k << std::hexfloat;
-  k << "cadclash import cache " << kCacheFormat << "\nocct " << OCC_VERSION_COMPLETE << "\nfile sha256 "
+  k << "cadclash import cache " << kCacheFormat << "\n" << build_identity() << "\nocct " << OCC_VERSION_COMPLETE << "\nfile sha256 "
     << hex(sha256(bytes)) << "\npath " << path << "\ndeflection " << o.tessellation.linear_deflection << " relative "
     << o.tessellation.relative << " angular " << o.tessellation.angular_deflection << " verify "
     << o.tessellation.verify_deflection << " time limit " << o.tessellation.time_limit_seconds << "\nlazy " << o.lazy

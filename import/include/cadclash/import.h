@@ -76,7 +76,8 @@ struct ImportOptions {
   double model_tolerance = 0.0;
   // A directory for a persistent cache of imported files (made when missing); empty = no cache. One
   // entry per file, keyed by a SHA-256 of the file's bytes, its path as given and every option above
-  // that changes the result (and the cache format and OCCT versions): a file read again with the
+  // that changes the result, the cache format and OCCT versions and the build of cadclash (the program
+  // or module file's size and time: a rebuild starts afresh): a file read again with the
   // same bytes and options comes back from its entry, the same model (B-rep parts with their exact
   // faces and triangles, bit for bit) and diagnostics as when it was read. Every entry is checked
   // (format version, key, size, SHA-256 of its contents) before it is used; a damaged one is read
