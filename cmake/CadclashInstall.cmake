@@ -69,7 +69,7 @@ list(TRANSFORM _occt_libs PREPEND "-l")
 list(JOIN _occt_libs " " _occt_libs)
 # The modules find OCCT in their own directory scope; look again here for its library directory.
 find_package(OpenCASCADE QUIET)
-set(_pc_deps "${_occt_libs} -lmpfr -lgmp -fopenmp -pthread")
+set(_pc_deps "${_occt_libs} -lcrypto -lmpfr -lgmp -fopenmp -pthread")
 if(OpenCASCADE_LIBRARY_DIR AND NOT OpenCASCADE_LIBRARY_DIR IN_LIST CMAKE_CXX_IMPLICIT_LINK_DIRECTORIES)
   set(_pc_deps "-L${OpenCASCADE_LIBRARY_DIR} ${_pc_deps}")
 endif()

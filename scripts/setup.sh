@@ -11,7 +11,7 @@ build_packages=(
   libcgal-dev libgmp-dev libmpfr-dev
   libassimp-dev libeigen3-dev libboost-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev libfcl-dev
-  nlohmann-json3-dev libcli11-dev
+  nlohmann-json3-dev libcli11-dev libssl-dev
   libopenmpi-dev openmpi-bin
   clang-14 libomp-14-dev libclang-rt-14-dev
   pybind11-dev python3-pybind11 python3-numpy python3-pytest

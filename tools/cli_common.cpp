@@ -22,6 +22,11 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_option("--import-time-limit", in.import_time_limit,
                  "Seconds the isolated reader of one STEP/IGES/BREP file may take, and again its tessellation; what is not done by then is reported as not read or not tessellated (0: no limit)")
       ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--cache", in.cache,
+                 "Directory of a persistent cache of imported files: a file read again with the same bytes and "
+                 "settings comes back from it, the same as when it was read (made when missing)");
+  cmd.add_option("--parallel-files", in.parallel_files, "Files read at once (default: one per core)")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option("--model-tolerance", in.model_tolerance,
                  "Uncertainty of mesh coordinates, mm: faces within tolerance + both uncertainties touch "
                  "(default: 2^-24 x the largest coordinate, the single-precision bound)")
@@ -54,6 +59,8 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.reader_time_limit_seconds = in.import_time_limit;
   options.model_tolerance = in.model_tolerance;
   options.tessellation.time_limit_seconds = in.import_time_limit;
+  options.cache_dir = in.cache;
+  options.parallel_files = in.parallel_files;
   ImportResult result = import_files(in.files, options);
   print_diagnostics(result.diagnostics);
   if (in.repair) {

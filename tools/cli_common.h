@@ -26,6 +26,8 @@ struct InputOptions {
   bool no_isolation = false;
   double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
+  std::string cache;               // directory of the import cache (ImportOptions::cache_dir); empty = none
+  int parallel_files = 0;          // files read at once; 0 = one per core
   // Mesh post-processing (mesh parts only; see tessellate.h).
   bool repair = false;
   bool fill_holes = false;  // with --repair

@@ -3,6 +3,7 @@
 #include "cli_common.h"
 #include "cmd_check_mpi.h"
 #include "html_report.h"
+#include "import_stages.h"
 
 #include "cadclash/report.h"
 
@@ -343,6 +344,10 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
   if (!run.stopped_by.empty())
     std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
+  if (!o.no_timings) {
+    report.import = import_report(imported);
+    print_import_stages(imported, report, std::cout);
+  }
   const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
   if (primary && !o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);

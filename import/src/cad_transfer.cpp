@@ -1,6 +1,8 @@
 // Transfer ↔ bytes, and Transfer → model.
 #include "cad_transfer.h"
 
+#include "byte_io.h"
+
 #include <BinTools.hxx>
 #include <BinXCAFDrivers.hxx>
 #include <PCDM_ReaderStatus.hxx>
@@ -14,13 +16,18 @@
 #include <XCAFDoc_ShapeTool.hxx>
 
 #include <algorithm>
-#include <bit>
-#include <cstring>
 #include <mutex>
 #include <sstream>
 
 namespace cadclash::detail {
 namespace {
+
+// The application's document drivers keep state per call: files read in parallel (import_files)
+// open, store and close their documents one at a time.
+std::mutex& application_mutex() {
+  static std::mutex m;
+  return m;
+}
 
 Handle(XCAFApp_Application) application() {
   static std::once_flag once;
@@ -39,51 +46,13 @@ TopTools_IndexedMapOfShape document_faces(const Handle(TDocStd_Document)& doc) {
   return faces;
 }
 
-struct Writer {
-  std::string out;
-  void u64(std::uint64_t v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); }
-  void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
-  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  void str(const std::string& s) {
-    u64(s.size());
-    out += s;
-  }
-};
-
-struct Reader {
-  const std::string& in;
-  std::size_t at = 0;
-  bool ok = true;
-  std::uint64_t u64() {
-    std::uint64_t v = 0;
-    if (in.size() - at < sizeof v) {
-      ok = false;
-      return 0;
-    }
-    std::memcpy(&v, in.data() + at, sizeof v);
-    at += sizeof v;
-    return v;
-  }
-  std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
-  double f64() { return std::bit_cast<double>(u64()); }
-  std::string str() {
-    const std::uint64_t n = u64();
-    if (!ok || in.size() - at < n) {
-      ok = false;
-      return {};
-    }
-    std::string s = in.substr(at, n);
-    at += n;
-    return s;
-  }
-};
-
 }  // namespace
 
 Transfer::~Transfer() { discard_shapes(); }
 
 void Transfer::discard_shapes() {
   try {
+    const std::lock_guard<std::mutex> lock(application_mutex());
     if (!doc.IsNull() && doc->IsOpened()) XCAFApp_Application::GetApplication()->Close(doc);
   } catch (const Standard_Failure&) {
   }
@@ -113,12 +82,13 @@ void record_occt_failure(Transfer& t, const std::string& path, const std::string
 
 Handle(TDocStd_Document) new_xcaf_document() {
   Handle(TDocStd_Document) doc;
+  const std::lock_guard<std::mutex> lock(application_mutex());
   application()->NewDocument("BinXCAF", doc);
   return doc;
 }
 
 std::string pack_transfer(const Transfer& t) {
-  Writer w;
+  ByteWriter w;
   w.u64(t.diagnostics.size());
   for (const Diagnostic& d : t.diagnostics) {
     w.u64(static_cast<std::uint64_t>(d.severity));
@@ -130,6 +100,7 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(t.complete ? 1 : 0);
   w.u64(static_cast<std::uint64_t>(t.kind));
   w.f64(t.declared_uncertainty);
+  w.f64(t.read_seconds);
   if (!t.doc.IsNull()) {
     w.u64(1);
     const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
@@ -143,6 +114,7 @@ std::string pack_transfer(const Transfer& t) {
       w.str(entity->name);
     }
     std::ostringstream stored;
+    const std::lock_guard<std::mutex> lock(application_mutex());
     if (application()->SaveAs(t.doc, stored) != PCDM_SS_OK) return {};
     w.str(stored.str());
   } else if (!t.loose.IsNull()) {
@@ -160,7 +132,7 @@ std::string pack_transfer(const Transfer& t) {
 }
 
 bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
-  Reader r{bytes};
+  ByteReader r{bytes};
   const std::uint64_t n = r.u64();
   for (std::uint64_t i = 0; r.ok && i < n; ++i) {
     Diagnostic d;
@@ -174,6 +146,7 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.complete = r.u64() == 1;
   t.kind = static_cast<SourceKind>(r.u64());
   t.declared_uncertainty = r.f64();
+  t.read_seconds = r.f64();
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
@@ -188,6 +161,7 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
         why = "the reader's output is cut short";
         return false;
       }
+      const std::lock_guard<std::mutex> lock(application_mutex());
       if (application()->Open(stored, t.doc) != PCDM_RS_OK || t.doc.IsNull()) {
         why = "OCCT could not load the document the reader stored";
         return false;
@@ -213,7 +187,11 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
 IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
                                    const std::function<Transfer(const Mark&)>& transfer) {
   IsolatedTransfer out;
+  // OCCT's file translators keep global state (their static parameters, the schema's protocol): in
+  // this process, files read in parallel take turns.
+  static std::mutex unprotected;
   if (!isolate) {
+    const std::lock_guard<std::mutex> lock(unprotected);
     out.transfer = transfer([&out](char c) { out.child.marks += c; });
     out.child.isolated = false;
     return out;
@@ -227,6 +205,7 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double
                                "; read in this process, unprotected from OCCT crashes"};
   out.child = ChildRun{};
   out.child.isolated = false;
+  const std::lock_guard<std::mutex> lock(unprotected);
   out.transfer = transfer([&out](char c) { out.child.marks += c; });
   return out;
 }
@@ -235,9 +214,13 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   ImportResult result;
   result.diagnostics = std::move(t.diagnostics);
   result.complete = t.complete;
+  result.files.push_back(FileImport{path, CacheUse::Off, {}});
+  ImportTimings& timings = result.files.back().timings;
+  timings.read = t.read_seconds;
+  BrepPartTimings part_timings;
   const char* format = t.kind == SourceKind::IgesFace ? "IGES" : "STEP";
   if (!t.doc.IsNull()) {
-    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result);
+    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings);
     if (result.model.instances.empty()) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string(format) + " file produced no shape"});
       result.complete = false;
@@ -251,7 +234,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
     in.tags.resize(t.loose_ids.size());
     for (std::size_t f = 0; f < t.loose_ids.size(); ++f) in.tags[f].entity_id = t.loose_ids[f];
     const auto ids = add_brep_parts(result.model, std::span<const BrepPartInput>(&in, 1), options.tessellation,
-                                    options.lazy, result.diagnostics, result.complete);
+                                    options.lazy, result.diagnostics, result.complete, &part_timings);
     result.model.instances.push_back(Instance{"/" + in.name, ids[0], Pose::Identity()});
     if (!t.loose_note.empty()) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, t.loose_note});
@@ -259,6 +242,8 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
     }
   }
   for (Surface& s : result.model.surfaces) s.uncertainty = std::max(s.uncertainty, t.declared_uncertainty);
+  timings.heal = part_timings.heal;
+  timings.tessellate = part_timings.tessellate;
   return result;
 }
 

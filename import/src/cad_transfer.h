@@ -25,6 +25,8 @@ struct Transfer {
   // The length uncertainty the file declares (mm; STEP's UNCERTAINTY_MEASURE_WITH_UNIT, 0 when none):
   // finish_transfer makes it the floor of every face's model uncertainty (OCCT does not apply it).
   double declared_uncertainty = 0.0;
+  // Seconds the reader spent parsing the file (ImportTimings::read), measured where it ran.
+  double read_seconds = 0.0;
   // Products: an XCAF document (closed by the destructor) and the entities of its faces.
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;

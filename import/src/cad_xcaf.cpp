@@ -211,7 +211,8 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 }
 
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
-                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result) {
+                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
+                       BrepPartTimings* timings) {
   Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, result.diagnostics};
   TDF_LabelSequence roots;
   walker.shapes->GetFreeShapes(roots);
@@ -267,7 +268,7 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
     nonempty_inputs.push_back(std::move(inputs[p]));
   }
   const std::vector<PartId> ids = add_brep_parts(result.model, nonempty_inputs, options.tessellation, options.lazy,
-                                                 result.diagnostics, result.complete);
+                                                 result.diagnostics, result.complete, timings);
   std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
   for (Instance& instance : walker.instances) {

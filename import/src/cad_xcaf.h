@@ -44,8 +44,10 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 // Walks the document's free shapes into `result`: one instance per leaf occurrence with its full path
 // and placement, one part per distinct leaf shape (shared by all its instances), tessellated as the
 // options say. Face tags come from `faces` (by TShape) and the document's colours.
+// `timings`, when given, gets add_brep_parts' seconds added.
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
-                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result);
+                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
+                       BrepPartTimings* timings = nullptr);
 
 // The file's stem ("dir/part.brep" → "part").
 std::string cad_file_stem(const std::string& path);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <shared_mutex>
 #include <sstream>
 
 #include <fcntl.h>
@@ -36,12 +37,46 @@ void default_crash_handlers() {
   for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
 }
 
+std::shared_mutex& fork_mutex() {
+  static std::shared_mutex m;
+  return m;
+}
+
+thread_local int cad_work_depth = 0;  // CadWork objects alive on this thread
+
+// This thread's share of fork_mutex let go of while its child runs, taken back at the end. Not
+// destroyed in the child, which ends with _exit.
+class LetGo {
+ public:
+  LetGo() : held_(cad_work_depth > 0) {
+    if (held_) fork_mutex().unlock_shared();
+  }
+  ~LetGo() {
+    if (held_) fork_mutex().lock_shared();
+  }
+  LetGo(const LetGo&) = delete;
+  LetGo& operator=(const LetGo&) = delete;
+
+ private:
+  bool held_;
+};
+
 }  // namespace
 
+CadWork::CadWork() {
+  if (cad_work_depth++ == 0) fork_mutex().lock_shared();
+}
+
+CadWork::~CadWork() {
+  if (--cad_work_depth == 0) fork_mutex().unlock_shared();
+}
+
 ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds) {
-  static std::mutex one_at_a_time;
-  const std::lock_guard<std::mutex> lock(one_at_a_time);
+  const LetGo let_go;
   ChildRun run;
+  // Held from the pipe to the parent's closing of its write end: a child forked by another thread
+  // meanwhile would inherit that end, and this pipe would not reach its end before that child did.
+  std::unique_lock<std::shared_mutex> no_reader_inside(fork_mutex());
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) {
     run.isolated = false;
@@ -76,6 +111,7 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, 
     _exit(0);  // no atexit handlers or static destructors: they belong to the parent
   }
   close(fds[1]);
+  no_reader_inside.unlock();  // (the child keeps its copy locked: it never returns from here)
   const bool limited = time_limit_seconds > 0.0;
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(

@@ -33,9 +33,23 @@ using Mark = std::function<void(char)>;
 // Preconditions:
 // - `work` uses no OpenMP and starts no threads (a forked child has only the calling thread);
 // - `work` writes nothing to stdout (the child's stdout is /dev/null).
-// Process-wide, one child runs at a time. A child still running after `time_limit_seconds` (> 0;
-// 0 = none) is killed, and the run is `timed_out`.
+// Several threads may each run a child at once (import_files reads files in parallel); the fork
+// itself waits until no other thread holds a CadWork. A child still running after
+// `time_limit_seconds` (> 0; 0 = none) is killed, and the run is `timed_out`.
 ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds = 0.0);
+
+// Held by a thread while it reads a file in this process (import_file holds one throughout).
+// Forking while another thread is inside OCCT (or any library that locks) could give the child a
+// lock that nobody releases, since a child has only the forking thread: run_in_child forks only
+// while no thread holds a CadWork, letting go of its own thread's one for as long as its child runs.
+// Nests within one thread.
+class CadWork {
+ public:
+  CadWork();
+  ~CadWork();
+  CadWork(const CadWork&) = delete;
+  CadWork& operator=(const CadWork&) = delete;
+};
 
 // The time an import's isolated readers have left (ImportOptions::reader_time_limit_seconds), over
 // every child of one file.

@@ -8,6 +8,7 @@
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
 
+#include <chrono>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -39,7 +40,10 @@ Transfer read_brep_shape(const std::string& path) {
     if (!has_topology_header(path)) return fail("not an OCCT .brep: no 'CASCADE Topology' header in its first 64 KB");
     TopoDS_Shape shape;
     BRep_Builder builder;
-    if (!BRepTools::Read(shape, path.c_str(), builder) || shape.IsNull())
+    const auto read_start = std::chrono::steady_clock::now();
+    const bool read = BRepTools::Read(shape, path.c_str(), builder);
+    t.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
+    if (!read || shape.IsNull())
       return fail("cannot read BREP file (not an OCCT .brep, or damaged)");
     // Triangulations stored in the file were made with unknown settings; ours follow the options.
     BRepTools::Clean(shape, Standard_True);

@@ -17,6 +17,7 @@
 #include <TopoDS_Compound.hxx>
 #include <XSControl_WorkSession.hxx>
 
+#include <chrono>
 #include <set>
 
 namespace cadclash::detail {
@@ -78,7 +79,9 @@ Transfer read_iges_transfer(const std::string& path, bool one_by_one, const std:
     reader.SetColorMode(Standard_True);
     reader.SetNameMode(Standard_True);
     reader.SetLayerMode(Standard_False);
+    const auto read_start = std::chrono::steady_clock::now();
     const IFSelect_ReturnStatus status = reader.ReadFile(path.c_str());
+    result.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     const Handle(IGESData_IGESModel) model = Handle(IGESData_IGESModel)::DownCast(reader.Model());
     const EntityLabelFn label = [&model](const Handle(Standard_Transient)& entity) -> std::int64_t {
       const Handle(IGESData_IGESEntity) iges = Handle(IGESData_IGESEntity)::DownCast(entity);

@@ -22,7 +22,9 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
   std::vector<Diagnostic> notes;  // how the attempts went, first in the result
   std::optional<Transfer> faceless;  // the first attempt that finished without a face
+  double read_seconds = 0.0;         // parsing, over every attempt that finished
   auto finish = [&](Transfer transfer) {
+    transfer.read_seconds = read_seconds;
     // What the faceless attempt said (its transfer's checks) stays, without repeating what this one says.
     if (faceless) {
       std::unordered_set<std::string> said;
@@ -45,6 +47,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
                                              [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
+    read_seconds += run.transfer.read_seconds;
     const bool parsed = child.marks.find(kParsed) != std::string::npos;
     if (!child.crashed) {
       if (child.marks.find(kShapes) != std::string::npos) return finish(std::move(run.transfer));

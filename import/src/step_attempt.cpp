@@ -19,6 +19,7 @@
 #include <XCAFDoc_ShapeTool.hxx>
 #include <XSControl_WorkSession.hxx>
 
+#include <chrono>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -151,6 +152,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
     configure(reader);
 
     // One read of the text for every scan below; OCCT reads the file (or a corrected copy) itself.
+    const auto read_start = std::chrono::steady_clock::now();
     const bool readable = static_cast<bool>(std::ifstream(path));
     const std::string text = file_text(path);
     for (Diagnostic& d : unknown_schemas(text, path)) {
@@ -158,6 +160,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
       result.complete = false;
     }
     const IFSelect_ReturnStatus status = parse(reader, path, text, readable, result);
+    result.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     STEPControl_Reader& step = reader.ChangeReader();
     const Handle(StepData_StepModel) model = step.StepModel();
     const EntityLabelFn label = [&model](const Handle(Standard_Transient)& entity) -> std::int64_t {

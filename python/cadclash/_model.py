@@ -241,7 +241,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
          relative: bool = False, preset: Optional[str] = None, lazy: bool = False, repair: bool = False,
          fill_holes: bool = False, segment: bool = False, sharp_angle: float = 60.0, planar: bool = False,
          isolate: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
-         strict: bool = False) -> Model:
+         cache: Optional[PathLike] = None, strict: bool = False) -> Model:
     """Reads one or more files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF) into one ``Model``.
 
     The arguments mirror ``cadclash check``'s input switches: ``deflection`` (mm, or a fraction of
@@ -254,8 +254,11 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     (seconds, 0 = none; the CLI's ``--import-time-limit``) stops an isolated reader that takes longer
     on one file, and then the file's tessellation, with error diagnostics naming what was not done.
     ``model_tolerance`` (mm; the CLI's ``--model-tolerance``) is the uncertainty of mesh coordinates
-    (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch. Several files form one scene;
-    each file's instance paths are then prefixed with "/<file name>".
+    (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch. ``cache``
+    (a directory; the CLI's ``--cache``) keeps every file as imported, keyed by a SHA-256 of its bytes,
+    path and these settings: a file loaded again unchanged comes back from it, the same model; a
+    damaged entry is read again and named in a warning diagnostic. Several files form one scene,
+    read in parallel; each file's instance paths are then prefixed with "/<file name>".
 
     Returns the model with ``diagnostics`` and ``complete`` set: a partly bad file keeps its good
     parts. Raises ``InputError`` (naming each file and line or STEP ``#id``) when no instance could
@@ -268,7 +271,8 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     model = Model()
     raw, complete = model._load(files, float(deflection), bool(relative), float(angular), preset or "",
                                 bool(lazy), bool(repair), bool(fill_holes), bool(segment), float(sharp_angle),
-                                bool(planar), bool(isolate), float(time_limit), float(model_tolerance))
+                                bool(planar), bool(isolate), float(time_limit), float(model_tolerance),
+                                os.fspath(cache) if cache is not None else "")
     model.files = files
     model.diagnostics = _diagnostics(raw)
     model.complete = complete

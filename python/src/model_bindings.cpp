@@ -35,6 +35,7 @@ struct LoadArgs {
   bool isolate = true;
   double time_limit = 0.0;
   double model_tolerance = 0.0;
+  std::string cache;  // ImportOptions::cache_dir; empty: none
 };
 
 // Same steps and defaults as the CLI's import_inputs(), without printing: (diagnostics, complete).
@@ -59,6 +60,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   options.tessellation.time_limit_seconds = a.time_limit;
   if (!(a.model_tolerance >= 0.0)) throw pyb::value_error("model_tolerance must be >= 0 mm (0: from the coordinates)");
   options.model_tolerance = a.model_tolerance;
+  options.cache_dir = a.cache;
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;
@@ -145,13 +147,15 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate, double time_limit, double model_tolerance) {
+             bool planar, bool isolate, double time_limit, double model_tolerance, std::string cache) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
-                               fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance});
+                               fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance,
+                               std::move(cache)});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
-          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"))
+          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"),
+          pyb::arg("cache"))
       .def("_counts",
            [](const ModelCore& c) {
              const Model& md = c.state->model;  // sizes never change after load

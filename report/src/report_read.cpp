@@ -329,6 +329,26 @@ ClashReview read_review(const Json& j, const QueryReport& query) {
   return r;
 }
 
+ReportImport read_import(const Json& j, const std::string& p) {
+  ReportImport out;
+  out.seconds = number(field(j, p, "seconds"), p + "/seconds");
+  const Json& files = array(field(j, p, "files"), p + "/files");
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    const std::string pk = p + "/files/" + std::to_string(k);
+    ReportFileImport f;
+    f.file = text(field(object(files[k], pk), pk, "file"), pk + "/file");
+    f.cache = text(field(files[k], pk, "cache"), pk + "/cache");
+    if (f.cache != "off" && f.cache != "hit" && f.cache != "miss" && f.cache != "rebuilt")
+      fail(pk + "/cache", "expected \"off\", \"hit\", \"miss\" or \"rebuilt\"");
+    for (auto [name, member] : {std::pair{"read", &ReportFileImport::read}, {"transfer", &ReportFileImport::transfer},
+                                {"heal", &ReportFileImport::heal}, {"tessellate", &ReportFileImport::tessellate},
+                                {"total", &ReportFileImport::total}})
+      f.*member = number(field(files[k], pk, name), pk + "/" + name);
+    out.files.push_back(std::move(f));
+  }
+  return out;
+}
+
 CheckReport read_report(const Json& j) {
   CheckReport r;
   object(j, "");
@@ -358,6 +378,7 @@ CheckReport read_report(const Json& j) {
   }
   r.diagnostics = strings(field(j, "", "diagnostics"), "/diagnostics");
   r.complete = boolean(field(j, "", "complete"), "/complete");
+  if (j.contains("import_timings")) r.import = read_import(object(j["import_timings"], "/import_timings"), "/import_timings");
   return r;
 }
 

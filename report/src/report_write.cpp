@@ -334,6 +334,13 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
   }
   j["diagnostics"] = r.diagnostics;
   j["complete"] = r.complete;
+  if (o.timings && r.import) {
+    nlohmann::json files = nlohmann::json::array();
+    for (const ReportFileImport& f : r.import->files)
+      files.push_back({{"file", f.file}, {"cache", f.cache}, {"read", f.read}, {"transfer", f.transfer},
+                       {"heal", f.heal}, {"tessellate", f.tessellate}, {"total", f.total}});
+    j["import_timings"] = {{"seconds", r.import->seconds}, {"files", std::move(files)}};
+  }
   return j;
 }
 

@@ -15,7 +15,9 @@
 #include <TopoDS_Compound.hxx>
 
 #include <cassert>
+#include <chrono>
 #include <cstddef>
+#include <exception>
 
 namespace cadclash {
 namespace {
@@ -157,80 +159,151 @@ void mesh_faces(const BrepPartInput& in, BrepSource::Impl& impl, double deflecti
 
 }  // namespace
 
+namespace {
+
+// One part on its way into the model: made by prepare_part, meshed by mesh_faces, appended in input
+// order, so the model and the diagnostics are the same whether parts are done in parallel or not.
+struct PartWork {
+  std::unique_ptr<BrepSource::Impl> impl;
+  std::vector<Surface> surfaces;
+  std::vector<Diagnostic> diagnostics;
+  bool complete = true;
+  double deflection = 0.0;
+};
+
+// Faces, healing, exact boxes and face facts of one part, whose id will be `part_id`.
+void prepare_part(const BrepPartInput& in, const TessellationOptions& options, PartId part_id, PartWork& w) {
+  assert(in.shape != nullptr);
+  w.impl = std::make_unique<BrepSource::Impl>();
+  BrepSource::Impl& impl = *w.impl;
+  impl.part_name = in.name;
+  impl.source_file = in.source_file;
+  impl.angular_deflection = options.angular_deflection;
+  impl.verify_deflection = options.verify_deflection;
+
+  TopTools_IndexedMapOfShape map;
+  TopExp::MapShapes(*in.shape, TopAbs_FACE, map);
+  const auto n = static_cast<std::size_t>(map.Extent());
+  impl.faces.reserve(n);
+  for (Standard_Integer i = 1; i <= map.Extent(); ++i) impl.faces.push_back(TopoDS::Face(map(i)));
+  impl.entity_ids.resize(n, -1);
+  for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl.entity_ids[i] = in.tags[i].entity_id;
+
+  const std::vector<char> healed = heal_invalid_faces(in, impl, w.diagnostics);
+  store_plane_pcurves(impl.faces);
+
+  impl.boxes.resize(n);
+  Aabb part_box;
+#pragma omp parallel for schedule(dynamic, 8) if (options.parallel && n > 16)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i)
+    impl.boxes[static_cast<std::size_t>(i)] = detail::face_aabb(impl.faces[static_cast<std::size_t>(i)]);
+  for (const Aabb& b : impl.boxes)
+    if (!b.isEmpty()) part_box.extend(b);
+  w.deflection = options.linear_deflection;
+  if (options.relative) {
+    const double diagonal = part_box.isEmpty() ? 0.0 : part_box.diagonal().norm();
+    w.deflection = diagonal > 0.0 ? options.linear_deflection * diagonal : options.linear_deflection;
+  }
+  impl.default_deflection = w.deflection;
+
+  w.surfaces.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Surface& s = w.surfaces[i];
+    s.name = "face" + std::to_string(i);
+    s.part = part_id;
+    s.provenance.kind = in.kind;
+    s.provenance.source_file = in.source_file;
+    s.provenance.face_index = static_cast<std::int32_t>(i);
+    s.provenance.healed = healed[i] != 0;
+    if (i < in.tags.size()) {
+      s.provenance.step_id = in.tags[i].entity_id;
+      s.provenance.source_name = in.tags[i].name;
+      s.provenance.colour = in.tags[i].colour;
+    }
+    s.aabb = impl.boxes[i];
+    detail::describe_face(impl.faces[i], s);
+  }
+  impl.exact_faces.resize(n);
+  for (std::size_t i = 0; i < n; ++i) impl.exact_faces[i] = w.surfaces[i].exact_triangles ? 1 : 0;
+}
+
+// Whether two of the parts share an edge: healing and the plane pcurves write into edges, so such
+// parts are done one after another. Parts of a file are distinct shapes, but a file may let two
+// products reach one edge entity.
+bool parts_share_edges(std::span<const BrepPartInput> parts) {
+  TopTools_IndexedMapOfShape all;
+  int sum = 0;
+  for (const BrepPartInput& in : parts) {
+    TopTools_IndexedMapOfShape edges;
+    TopExp::MapShapes(*in.shape, TopAbs_EDGE, edges);
+    sum += edges.Extent();
+    for (Standard_Integer e = 1; e <= edges.Extent(); ++e) all.Add(edges(e));
+  }
+  return all.Extent() != sum;
+}
+
+// f(0) ... f(n - 1), on OpenMP threads when `parallel` (a part per thread at a time: the OpenMP loops
+// inside a part then run on that thread, BRepMesh's own threads still in parallel). What f throws
+// is thrown again here, the first part's first.
+template <class F>
+void for_each_part(std::size_t n, bool parallel, const F& f) {
+  std::vector<std::exception_ptr> failed(n);
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1)
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+    try {
+      f(static_cast<std::size_t>(k));
+    } catch (...) {
+      failed[static_cast<std::size_t>(k)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace
+
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
-                                   std::vector<Diagnostic>& diagnostics, bool& complete) {
+                                   std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings) {
   assert(options.linear_deflection > 0.0);
+  for (const BrepPartInput& in : parts) assert(in.shape != nullptr), (void)in;
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  const detail::MeshDeadline deadline = detail::MeshDeadline::after(options.time_limit_seconds);
+  const bool in_parallel = options.parallel && parts.size() > 1 && !parts_share_edges(parts);
+  const auto first_id = static_cast<PartId>(model.parts.size());
+  std::vector<PartWork> work(parts.size());
+
+  const Clock::time_point heal_start = Clock::now();
+  for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
+    prepare_part(parts[k], options, static_cast<PartId>(first_id + k), work[k]);
+  });
+  if (timings) timings->heal += seconds_since(heal_start);
+
+  const Clock::time_point mesh_start = Clock::now();
+  if (!lazy)
+    for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
+      PartWork& w = work[k];
+      if (!w.surfaces.empty())
+        mesh_faces(parts[k], *w.impl, w.deflection, options, deadline, w.surfaces, w.diagnostics, w.complete);
+    });
+  if (timings) timings->tessellate += seconds_since(mesh_start);
+
   std::vector<PartId> ids;
   ids.reserve(parts.size());
-  const detail::MeshDeadline deadline = detail::MeshDeadline::after(options.time_limit_seconds);
-  for (const BrepPartInput& in : parts) {
-    assert(in.shape != nullptr);
-    auto impl = std::make_unique<BrepSource::Impl>();
-    impl->part_name = in.name;
-    impl->source_file = in.source_file;
-    impl->angular_deflection = options.angular_deflection;
-    impl->verify_deflection = options.verify_deflection;
-
-    TopTools_IndexedMapOfShape map;
-    TopExp::MapShapes(*in.shape, TopAbs_FACE, map);
-    const auto n = static_cast<std::size_t>(map.Extent());
-    impl->faces.reserve(n);
-    for (Standard_Integer i = 1; i <= map.Extent(); ++i) impl->faces.push_back(TopoDS::Face(map(i)));
-    impl->entity_ids.resize(n, -1);
-    for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl->entity_ids[i] = in.tags[i].entity_id;
-
-    const std::vector<char> healed = heal_invalid_faces(in, *impl, diagnostics);
-
-    store_plane_pcurves(impl->faces);
-
-    impl->boxes.resize(n);
-    Aabb part_box;
-#pragma omp parallel for schedule(dynamic, 8) if (options.parallel && n > 16)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i)
-      impl->boxes[static_cast<std::size_t>(i)] = detail::face_aabb(impl->faces[static_cast<std::size_t>(i)]);
-    for (const Aabb& b : impl->boxes)
-      if (!b.isEmpty()) part_box.extend(b);
-    double deflection = options.linear_deflection;
-    if (options.relative) {
-      const double diagonal = part_box.isEmpty() ? 0.0 : part_box.diagonal().norm();
-      deflection = diagonal > 0.0 ? options.linear_deflection * diagonal : options.linear_deflection;
-    }
-    impl->default_deflection = deflection;
-
-    const auto part_id = static_cast<PartId>(model.parts.size());
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    PartWork& w = work[k];
+    diagnostics.insert(diagnostics.end(), w.diagnostics.begin(), w.diagnostics.end());
+    complete = complete && w.complete;
     Part part;
-    part.name = in.name;
-    part.source_file = in.source_file;
+    part.name = parts[k].name;
+    part.source_file = parts[k].source_file;
     part.first_surface = static_cast<SurfaceId>(model.surfaces.size());
-    part.surface_count = static_cast<std::uint32_t>(n);
-
-    std::vector<Surface> surfaces(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      Surface& s = surfaces[i];
-      s.name = "face" + std::to_string(i);
-      s.part = part_id;
-      s.provenance.kind = in.kind;
-      s.provenance.source_file = in.source_file;
-      s.provenance.face_index = static_cast<std::int32_t>(i);
-      s.provenance.healed = healed[i] != 0;
-      if (i < in.tags.size()) {
-        s.provenance.step_id = in.tags[i].entity_id;
-        s.provenance.source_name = in.tags[i].name;
-        s.provenance.colour = in.tags[i].colour;
-      }
-      s.aabb = impl->boxes[i];
-      detail::describe_face(impl->faces[i], s);
-    }
-    impl->exact_faces.resize(n);
-    for (std::size_t i = 0; i < n; ++i) impl->exact_faces[i] = surfaces[i].exact_triangles ? 1 : 0;
-
-    if (!lazy && n > 0) mesh_faces(in, *impl, deflection, options, deadline, surfaces, diagnostics, complete);
-
-    part.source = std::make_shared<BrepSource>(std::move(impl));
+    part.surface_count = static_cast<std::uint32_t>(w.surfaces.size());
+    part.source = std::make_shared<BrepSource>(std::move(w.impl));
+    ids.push_back(static_cast<PartId>(model.parts.size()));
     model.parts.push_back(std::move(part));
-    for (Surface& s : surfaces) model.surfaces.push_back(std::move(s));
-    ids.push_back(part_id);
+    for (Surface& s : w.surfaces) model.surfaces.push_back(std::move(s));
   }
   return ids;
 }

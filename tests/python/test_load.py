@@ -112,6 +112,24 @@ def test_time_limit_stops_the_isolated_reader(data_dir):
     assert len(cadclash.load(step, time_limit=60).surfaces) == len(cadclash.load(step).surfaces)
 
 
+def test_cache_gives_back_the_same_model(data_dir, tmp_path):
+    # The first load reads the file and stores it; the second comes from the cache: the same
+    # surfaces, triangles and diagnostics. A damaged entry is read again, with a warning.
+    step = data_dir / "cad" / "valid_two_solids.step"
+    cold = cadclash.load(step, cache=tmp_path / "cache")
+    warm = cadclash.load(step, cache=tmp_path / "cache")
+    entries = list((tmp_path / "cache").iterdir())
+    assert len(entries) == 1
+    assert [s.name for s in warm.surfaces] == [s.name for s in cold.surfaces]
+    assert all((a.vertices == b.vertices).all() and (a.triangles == b.triangles).all()
+               for a, b in zip(cold.surfaces, warm.surfaces))
+    assert [d.message for d in warm.diagnostics] == [d.message for d in cold.diagnostics]
+    entries[0].write_bytes(entries[0].read_bytes()[:100])
+    again = cadclash.load(step, cache=tmp_path / "cache")
+    assert any("is damaged" in d.message for d in again.diagnostics)
+    assert len(again.surfaces) == len(cold.surfaces)
+
+
 def test_bad_arguments(boxes):
     with pytest.raises(ValueError, match="preset"):
         cadclash.load(boxes, preset="ultra")

@@ -2,13 +2,13 @@
 
 Usage: check_schema_doc.py CADCLASH_EXE docs/report-schema.md DATA_DIR
 
-Runs the CLI on real inputs (as1 by default and with --exact, OBJ boxes with --all-triangles and
---clearance, a --path trajectory, with and without timings, and as1 reviewed with --baseline and
---approvals), collects every key of every object
+Runs the CLI on real inputs (as1 by default and with --exact, twice through a --cache, OBJ boxes with
+--all-triangles and --clearance, a --path trajectory, with and without timings, and as1 reviewed with
+--baseline and --approvals), collects every key of every object
 by where it occurs (top level, settings, pair, side, summary, counters, timings, step), and checks
 both ways against the doc's sections: every written key is documented in its section, and every key
 a section documents is written by some run. Every class, decided_by and kind value written is named
-in the doc too. A key the doc documents but no run writes must be added
+in the doc too (and so is every `cache` value written). A key the doc documents but no run writes must be added
 to a run here (or listed in NOT_WRITTEN with the reason).
 """
 import json
@@ -38,6 +38,8 @@ SECTIONS = {
     "`review.summary`": "review_summary",
     "ApprovalUse": "approval_use",
     "Approval": "approval",
+    "`import_timings`": "import_timings",
+    "`import_timings.files[]`": "import_file",
 }
 # Documented keys no run here writes, with the reason. Keep empty when possible.
 NOT_WRITTEN = {}
@@ -107,6 +109,11 @@ def collect(report: dict, seen: dict) -> None:
             add("approval_use", u)
             add("approval", u["approval"])
             seen.setdefault("values", set()).add(u["state"])
+    if "import_timings" in report:
+        add("import_timings", report["import_timings"])
+        for f in report["import_timings"]["files"]:
+            add("import_file", f)
+            seen.setdefault("values", set()).add(f["cache"])
     query(report)
     for s in report.get("steps", []):
         add("step", s)
@@ -122,7 +129,8 @@ def main() -> int:
         return 1
     runs = [
         [as1, "--no-timings"],
-        [as1, "--exact"],
+        [as1, "--exact", "--cache", "CACHE"],
+        [as1, "--exact", "--cache", "CACHE"],
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
         [boxes[0], boxes[1], "--volume"],
@@ -131,6 +139,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         outs = [pathlib.Path(tmp) / f"report{k}.json" for k in range(len(runs) + 1)]
         approvals = pathlib.Path(tmp) / "approvals.json"
+        cache = pathlib.Path(tmp) / "cache"
 
         def review_run():
             # as1 reviewed against the boxes' report (every as1 clash new, the boxes' resolved), with
@@ -142,11 +151,12 @@ def main() -> int:
                 {"a": "/as1/**", "b": "**/BOLT", "part_a": "*", "part_b": "bolt", "classes": ["touching"],
                  "expires": "2027-01-01", **common},
                 {"id": "000000000000", "expires": "2020-01-01", **common}]}))
-            return [as1, "--no-timings", "--baseline", outs[2], "--approvals", approvals, "--today", "2026-06-01",
+            return [as1, "--no-timings", "--baseline", outs[3], "--approvals", approvals, "--today", "2026-06-01",
                     "--group-by", "space"]
 
         for k, args in enumerate([*runs, None]):
             args = args if args is not None else review_run()
+            args = [cache if a == "CACHE" else a for a in args]
             out = outs[k]
             proc = subprocess.run([exe, "check", *map(str, args), "--json", str(out)], capture_output=True, text=True)
             if proc.returncode not in (0, 3):

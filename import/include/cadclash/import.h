@@ -47,6 +47,7 @@
 #include "cadclash/collide.h"
 #include "cadclash/tessellate.h"
 
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -73,20 +74,58 @@ struct ImportOptions {
   // every mesh surface's Surface::uncertainty. 0 = derived by collide from the coordinates (2^-24 x the
   // part's largest coordinate: the single-precision bound, as STL, glTF and PLY store float32).
   double model_tolerance = 0.0;
+  // A directory for a persistent cache of imported files (made when missing); empty = no cache. One
+  // entry per file, keyed by a SHA-256 of the file's bytes, its path as given and every option above
+  // that changes the result, the cache format and OCCT versions and the build of cadclash (the program
+  // or module file's size and time: a rebuild starts afresh): a file read again with the
+  // same bytes and options comes back from its entry, the same model (B-rep parts with their exact
+  // faces and triangles, bit for bit) and diagnostics as when it was read. Every entry is checked
+  // (format version, key, size, SHA-256 of its contents) before it is used; a damaged one is read
+  // again from the file, rewritten, and named in a warning. Entries are written whole (temporary file,
+  // then rename), so runs sharing the directory never see half an entry. A file whose reading ran into
+  // a time limit is not stored. Entries are never removed: delete the directory to empty it.
+  std::string cache_dir;
+  // import_files: how many files are read at once (each in its own thread, a CAD file's isolated reader
+  // in its own process); 0 = one per OpenMP thread (omp_get_max_threads). The result does not depend on it.
+  int parallel_files = 0;
+};
+
+// Where one file's import spent its time, seconds of wall clock on the thread that read it.
+struct ImportTimings {
+  double read = 0.0;        // parsing the file (CAD: OCCT's reader, in the isolated child); from the cache: loading the entry
+  double transfer = 0.0;    // the rest: OCCT's transfer into shapes and bringing them back, the assembly walk, hashing
+  double heal = 0.0;        // B-rep: checking and fixing faces, exact face boxes and facts
+  double tessellate = 0.0;  // B-rep: BRepMesh and measuring the triangles (0 when lazy)
+  double total = 0.0;       // the whole file, storing its cache entry included
+};
+
+// What the cache did for one file: not asked, gave it, did not hold it (now stored), or held a
+// damaged entry (read again and rewritten).
+enum class CacheUse : std::uint8_t { Off, Hit, Miss, Rebuilt };
+// Returns "off", "hit", "miss" or "rebuilt".
+const char* cache_use_name(CacheUse c);
+
+struct FileImport {
+  std::string path;  // as given
+  CacheUse cache = CacheUse::Off;
+  ImportTimings timings;
 };
 
 struct ImportResult {
   Model model;                           // everything that could be read, even when diagnostics hold errors
   std::vector<Diagnostic> diagnostics;   // every problem; each dropped element is named here
   bool complete = true;                  // false when any part of the input was dropped or failed to mesh
+  std::vector<FileImport> files;         // one per file, in the order given
+  double seconds = 0.0;                  // wall clock of the whole import (files read in parallel)
 };
 
 // Reads one file. Never throws for bad input: problems come back as diagnostics, and the good parts
 // of a partly bad file are kept. A file that cannot be read at all gives an empty model and an error.
 ImportResult import_file(const std::string& path, const ImportOptions& options = {});
 
-// Reads several files into one scene. When more than one file is given, each file's instance paths
-// are prefixed with "/<file name>" so they stay unique.
+// Reads several files into one scene, options.parallel_files at a time. When more than one file is
+// given, each file's instance paths are prefixed with "/<file name>" so they stay unique. The files
+// are merged in the order given, so the result is the same however many are read at once.
 ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options = {});
 
 }  // namespace cadclash

@@ -285,6 +285,18 @@ struct ClashReview {
   std::vector<ApprovalUse> approvals;
 };
 
+// `import_timings`: where reading each input file went, in seconds (cadclash/import.h, ImportTimings),
+// and what the import cache did for it. Written only with timings.
+struct ReportFileImport {
+  std::string file;           // as given
+  std::string cache = "off";  // "off", "hit", "miss" or "rebuilt"
+  double read = 0.0, transfer = 0.0, heal = 0.0, tessellate = 0.0, total = 0.0;
+};
+struct ReportImport {
+  double seconds = 0.0;  // wall clock of the whole import (files are read in parallel)
+  std::vector<ReportFileImport> files;
+};
+
 struct CheckReport {
   int version = kCheckReportVersion;
   std::vector<std::string> files;  // as given
@@ -301,6 +313,7 @@ struct CheckReport {
   // Without a trajectory: the query's pairs grouped into clashes, with their review (written as
   // `clashes` and `review`); nullopt: not written (reports of the library's callers that do not ask).
   std::optional<ClashReview> review;
+  std::optional<ReportImport> import;    // absent: not written (and not in reports written without timings)
 };
 
 // `r` over `model` with every id resolved to names: what the report says about one query.

@@ -93,11 +93,16 @@ struct BrepPartInput {
 // BrepSource::triangulate(). Faces that BRepCheck finds invalid are fixed with ShapeFix_Face first
 // (Provenance::healed). A face that fails to mesh keeps its surface with has_triangles == false and
 // gets an Error diagnostic naming the part and the face's entity #id; `complete` is then set false.
-// Returns the new parts' ids, in input order.
+// Returns the new parts' ids, in input order. `timings`, when given, gets the seconds spent added.
 // Preconditions: every input's shape is non-null; options.linear_deflection > 0.
+struct BrepPartTimings {
+  double heal = 0.0;        // BRepCheck and ShapeFix of invalid faces, plane pcurves, exact boxes and face facts
+  double tessellate = 0.0;  // BRepMesh, reading and measuring the triangles (eager only)
+};
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
-                                   std::vector<Diagnostic>& diagnostics, bool& complete);
+                                   std::vector<Diagnostic>& diagnostics, bool& complete,
+                                   BrepPartTimings* timings = nullptr);
 
 // The SurfaceSource of a B-rep part. Thread-safe: each part has a shared mutex; triangulate() calls
 // on one part serialise, exact_distance() calls only read the faces and run concurrently.
@@ -162,9 +167,21 @@ class BrepSource final : public SurfaceSource {
                                        std::uint32_t local_b, const Pose& pose_b, double max_distance,
                                        double enough = 0.0) const override;
 
+  // A part's source as bytes, for a cache of imported parts: its faces in OCCT's binary shape format
+  // (BinTools, with their triangulations, so nothing is meshed again) and what add_brep_parts
+  // computed about them. A source loaded from them answers every query bit for bit as this one does.
+  // Do not call it while another thread meshes this part.
+  friend std::string save_brep_source(const BrepSource& source);
+  // Back from save_brep_source's bytes; nullptr and `why` when they are not whole. The bytes must be
+  // ones save_brep_source wrote (check a cache entry's checksum first): OCCT's shape reader trusts them.
+  friend std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
+
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+std::string save_brep_source(const BrepSource& source);
+std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
 
 // =============================================================================================
 // Raw meshes: repair and segmentation (CGAL Polygon_mesh_processing)

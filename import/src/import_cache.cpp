@@ -1,0 +1,232 @@
+// The import cache: entry names from a SHA-256 of the file and the options, entries checked whole
+// before use, written through a temporary file and a rename.
+#include "import_cache.h"
+
+#include "byte_io.h"
+
+#include <Standard_Version.hxx>
+#include <openssl/evp.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include <dlfcn.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace cadclash::detail {
+namespace {
+
+// Bumped whenever the entry layout or what it stores (save_import, save_brep_source) changes; part
+// of every key, so entries of another version are never looked up.
+constexpr std::uint64_t kCacheFormat = 1;
+constexpr std::string_view kMagic = "CCIMPORT";
+constexpr std::size_t kDigestBytes = 32;
+using Digest = std::array<unsigned char, kDigestBytes>;
+
+Digest sha256(std::string_view bytes) {
+  Digest d{};
+  unsigned int n = 0;
+  EVP_Digest(bytes.data(), bytes.size(), d.data(), &n, EVP_sha256(), nullptr);
+  return d;
+}
+
+std::string hex(const Digest& d) {
+  static constexpr char digits[] = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : d) {
+    out += digits[c >> 4];
+    out += digits[c & 15];
+  }
+  return out;
+}
+
+std::optional<std::string> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) return std::nullopt;
+  return std::move(buffer).str();
+}
+
+// The build of cadclash reading the files: the file this code was loaded from (the program, or the
+// Python module), its size and modification time. Any rebuild changes it, so an entry written by
+// another build, whose readers or tessellation may differ, is never looked up; stat is all it costs.
+std::string build_identity() {
+  static const std::string id = [] {
+    Dl_info info{};
+    std::string file = "/proc/self/exe";
+    if (dladdr(reinterpret_cast<const void*>(&build_identity), &info) != 0 && info.dli_fname != nullptr &&
+        info.dli_fname[0] == '/')
+      file = info.dli_fname;
+    struct stat st {};
+    if (stat(file.c_str(), &st) != 0) return std::string("build unknown");
+    return "build " + file + " " + std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
+           std::to_string(st.st_mtim.tv_nsec);
+  }();
+  return id;
+}
+
+// Everything the stored result depends on, as text: the file's bytes (by hash) and path, each option
+// that changes what is read or how it is tessellated, the versions of this cache and of OCCT, and the
+// build reading them.
+// Doubles in hexadecimal, so no two settings share a key. `parallel_files` and the threads BRepMesh
+// uses do not change the result, so they are not in it.
+std::string cache_key(const std::string& path, const std::string& bytes, const ImportOptions& o) {
+  std::ostringstream k;
+  k << std::hexfloat;
+  k << "cadclash import cache " << kCacheFormat << "\n" << build_identity() << "\nocct " << OCC_VERSION_COMPLETE << "\nfile sha256 "
+    << hex(sha256(bytes)) << "\npath " << path << "\ndeflection " << o.tessellation.linear_deflection << " relative "
+    << o.tessellation.relative << " angular " << o.tessellation.angular_deflection << " verify "
+    << o.tessellation.verify_deflection << " time limit " << o.tessellation.time_limit_seconds << "\nlazy " << o.lazy
+    << " isolated " << o.isolate_cad_readers << " reader time limit " << o.reader_time_limit_seconds
+    << " model tolerance " << o.model_tolerance << '\n';
+  return k.str();
+}
+
+std::string entry_name(const std::string& key) { return hex(sha256(key)) + ".entry"; }
+
+// magic, format, key, payload size, SHA-256 of the payload, payload.
+std::string entry_bytes(const std::string& key, const std::string& payload) {
+  ByteWriter w;
+  w.out += kMagic;
+  w.u64(kCacheFormat);
+  w.str(key);
+  w.u64(payload.size());
+  const Digest d = sha256(payload);
+  w.out.append(reinterpret_cast<const char*>(d.data()), d.size());
+  w.out += payload;
+  return std::move(w.out);
+}
+
+// The payload of a whole entry for `key`; nullopt and `why` otherwise.
+std::optional<std::string_view> entry_payload(std::string_view entry, const std::string& key, std::string& why) {
+  if (entry.substr(0, kMagic.size()) != kMagic) {
+    why = "not a cadclash cache entry";
+    return std::nullopt;
+  }
+  ByteReader r{entry, kMagic.size()};
+  if (r.u64() != kCacheFormat || !r.ok) {
+    why = "written by another version of the cache";
+    return std::nullopt;
+  }
+  if (r.str() != key || !r.ok) {
+    why = "written for other input (its key differs)";
+    return std::nullopt;
+  }
+  const std::uint64_t size = r.u64();
+  if (!r.ok || entry.size() - r.at < kDigestBytes || entry.size() - r.at - kDigestBytes != size) {
+    why = "its size is wrong (cut short or appended to)";
+    return std::nullopt;
+  }
+  const std::string_view payload = entry.substr(r.at + kDigestBytes);
+  const Digest stored = [&] {
+    Digest d{};
+    std::copy_n(entry.begin() + static_cast<std::ptrdiff_t>(r.at), kDigestBytes, d.begin());
+    return d;
+  }();
+  if (sha256(payload) != stored) {
+    why = "its checksum does not match its contents";
+    return std::nullopt;
+  }
+  return payload;
+}
+
+// Writes the entry whole or not at all: a temporary file in the same directory, then a rename over
+// the name (atomic on POSIX), so a concurrent run reads the old entry, the new one, or none.
+bool write_entry(const std::filesystem::path& target, const std::string& bytes, std::string& why) {
+  static std::atomic<unsigned> serial{0};
+  const std::filesystem::path temporary =
+      target.string() + ".tmp." + std::to_string(getpid()) + "." + std::to_string(serial++);
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out) {
+      why = "cannot write " + temporary.string();
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      return false;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, target, ec);
+  if (ec) {
+    why = "cannot rename " + temporary.string() + ": " + ec.message();
+    std::filesystem::remove(temporary, ec);
+    return false;
+  }
+  return true;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+Diagnostic cache_warning(const std::string& path, std::string message) {
+  return Diagnostic{Severity::Warning, path, 0, -1, std::move(message)};
+}
+
+// Whether a time limit cut the reading short: such a result depends on the machine's speed.
+bool stopped_by_time_limit(const ImportResult& r, const ImportOptions& o) {
+  if (!(o.reader_time_limit_seconds > 0.0) && !(o.tessellation.time_limit_seconds > 0.0)) return false;
+  for (const Diagnostic& d : r.diagnostics)
+    if (d.message.find("time limit") != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options) {
+  const std::optional<std::string> bytes = file_bytes(path);
+  if (!bytes) return std::nullopt;
+  return entry_name(cache_key(path, *bytes, options));
+}
+
+ImportResult cached_import(const std::string& path, const ImportOptions& options,
+                           const std::function<ImportResult()>& read) {
+  const std::optional<std::string> bytes = file_bytes(path);
+  if (!bytes) return read();  // the reader names the problem (no such file, a directory, ...)
+  const std::string key = cache_key(path, *bytes, options);
+  const std::filesystem::path dir(options.cache_dir);
+  const std::filesystem::path entry = dir / entry_name(key);
+
+  std::optional<Diagnostic> damaged;
+  if (const std::optional<std::string> stored = file_bytes(entry.string())) {
+    const auto load_start = std::chrono::steady_clock::now();
+    std::string why;
+    ImportResult hit;
+    if (const auto payload = entry_payload(*stored, key, why); payload && load_import(*payload, hit, why)) {
+      hit.files.assign(1, FileImport{path, CacheUse::Hit, {}});
+      hit.files.back().timings.read = seconds_since(load_start);
+      return hit;
+    }
+    damaged = cache_warning(path, "the cache entry " + entry.string() + " is damaged (" + why +
+                                      "); the file was read again and the entry rewritten");
+  }
+
+  ImportResult result = read();
+  result.files.front().cache = damaged ? CacheUse::Rebuilt : CacheUse::Miss;
+  if (stopped_by_time_limit(result, options)) return result;
+  // Stored without this run's warning about the damaged entry: a later run read from it says what
+  // reading the file said.
+  const std::optional<std::string> payload = save_import(result);
+  if (damaged) result.diagnostics.insert(result.diagnostics.begin(), *damaged);
+  if (!payload) return result;  // a part this cache cannot store: read every time
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::string why;
+  if (ec) why = "cannot make the directory: " + ec.message();
+  if (ec || !write_entry(entry, entry_bytes(key, *payload), why))
+    result.diagnostics.push_back(cache_warning(path, "could not store the file in the cache " + dir.string() + " (" + why + ")"));
+  return result;
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,30 @@
+// The persistent cache of imported files (ImportOptions::cache_dir). Internal to cadclash::import.
+#pragma once
+
+#include "cadclash/import.h"
+
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace cadclash::detail {
+
+// Reads `path` through the cache in options.cache_dir: a whole entry for the file's bytes and the
+// options gives back what was stored (files[0].cache = Hit); otherwise `read()` runs and its result
+// is stored (Miss, or Rebuilt with a warning first in the diagnostics when the entry was damaged).
+// `read` returns one file's result with files[0] set. A cache that cannot be read or written never
+// stops the import: a warning says so and the file is read.
+ImportResult cached_import(const std::string& path, const ImportOptions& options,
+                           const std::function<ImportResult()>& read);
+
+// The file name of the entry for `path` read with `options` ("<64 hex digits>.entry"); nullopt when
+// the file cannot be read. For the tests, which damage entries on purpose.
+std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options);
+
+// One file's result as an entry's contents, and back. std::nullopt when the model holds a part whose
+// source cannot be stored (neither none nor a BrepSource). load_import returns false and `why` when
+// the contents are not whole.
+std::optional<std::string> save_import(const ImportResult& r);
+bool load_import(std::string_view bytes, ImportResult& r, std::string& why);
+
+}  // namespace cadclash::detail

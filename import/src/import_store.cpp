@@ -1,0 +1,181 @@
+// One file's ImportResult as bytes and back: the contents of an import cache entry.
+#include "byte_io.h"
+#include "import_cache.h"
+
+namespace cadclash::detail {
+namespace {
+
+void put_vec(ByteWriter& w, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) w.f64(v[k]);
+}
+
+Vec3 get_vec(ByteReader& r) {
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = r.f64();
+  return v;
+}
+
+void put_surface(ByteWriter& w, const Surface& s) {
+  w.str(s.name);
+  w.u64(s.part);
+  const Provenance& p = s.provenance;
+  w.u64(static_cast<std::uint64_t>(p.kind));
+  w.str(p.source_file);
+  w.i64(p.step_id);
+  w.i64(p.face_index);
+  w.str(p.source_name);
+  w.u64(p.parent);
+  w.u64(p.colour ? 1 : 0);
+  if (p.colour)
+    for (const float c : *p.colour) w.f64(c);
+  w.u64((p.healed ? 1 : 0) | (p.repaired ? 2 : 0) | (s.exact_triangles ? 4 : 0) | (s.has_triangles ? 8 : 0));
+  put_vec(w, s.aabb.min());
+  put_vec(w, s.aabb.max());
+  w.f64(s.deflection);
+  w.f64(s.uncertainty);
+  w.u64(static_cast<std::uint64_t>(s.analytic.shape));
+  put_vec(w, s.analytic.origin);
+  put_vec(w, s.analytic.axis);
+  w.f64(s.analytic.radius);
+  w.f64(s.analytic.radius2);
+  w.u64(s.mesh.vertices.size());
+  for (const Vec3& v : s.mesh.vertices) put_vec(w, v);
+  w.u64(s.mesh.triangles.size());
+  for (const auto& t : s.mesh.triangles) w.u64(std::uint64_t{t[0]} | std::uint64_t{t[1]} << 32), w.u64(t[2]);
+}
+
+bool get_surface(ByteReader& r, Surface& s) {
+  s.name = r.str();
+  s.part = static_cast<PartId>(r.u64());
+  Provenance& p = s.provenance;
+  const std::uint64_t kind = r.u64();
+  if (kind > static_cast<std::uint64_t>(SourceKind::Segment)) return false;
+  p.kind = static_cast<SourceKind>(kind);
+  p.source_file = r.str();
+  p.step_id = r.i64();
+  p.face_index = static_cast<std::int32_t>(r.i64());
+  p.source_name = r.str();
+  p.parent = static_cast<SurfaceId>(r.u64());
+  if (r.u64() != 0) {
+    std::array<float, 3> c{};
+    for (float& x : c) x = static_cast<float>(r.f64());
+    p.colour = c;
+  }
+  const std::uint64_t flags = r.u64();
+  p.healed = (flags & 1) != 0;
+  p.repaired = (flags & 2) != 0;
+  s.exact_triangles = (flags & 4) != 0;
+  s.has_triangles = (flags & 8) != 0;
+  const Vec3 lo = get_vec(r), hi = get_vec(r);
+  s.aabb = Aabb(lo, hi);
+  s.deflection = r.f64();
+  s.uncertainty = r.f64();
+  const std::uint64_t shape = r.u64();
+  if (shape > static_cast<std::uint64_t>(SurfaceShape::Torus)) return false;
+  s.analytic.shape = static_cast<SurfaceShape>(shape);
+  s.analytic.origin = get_vec(r);
+  s.analytic.axis = get_vec(r);
+  s.analytic.radius = r.f64();
+  s.analytic.radius2 = r.f64();
+  s.mesh.vertices.resize(r.count(24));
+  for (Vec3& v : s.mesh.vertices) v = get_vec(r);
+  s.mesh.triangles.resize(r.count(16));
+  for (auto& t : s.mesh.triangles) {
+    const std::uint64_t ab = r.u64(), c = r.u64();
+    t = {static_cast<std::uint32_t>(ab), static_cast<std::uint32_t>(ab >> 32), static_cast<std::uint32_t>(c)};
+    for (const std::uint32_t corner : t)
+      if (corner >= s.mesh.vertices.size()) return false;
+  }
+  return r.ok;
+}
+
+}  // namespace
+
+std::optional<std::string> save_import(const ImportResult& result) {
+  ByteWriter w;
+  w.u64(result.diagnostics.size());
+  for (const Diagnostic& d : result.diagnostics) {
+    w.u64(static_cast<std::uint64_t>(d.severity));
+    w.str(d.file);
+    w.i64(d.line);
+    w.i64(d.step_id);
+    w.str(d.message);
+  }
+  w.u64(result.complete ? 1 : 0);
+  const Model& m = result.model;
+  w.u64(m.parts.size());
+  for (const Part& part : m.parts) {
+    w.str(part.name);
+    w.str(part.source_file);
+    w.u64(part.first_surface);
+    w.u64(part.surface_count);
+    if (!part.source) {
+      w.u64(0);
+      continue;
+    }
+    const auto* brep = dynamic_cast<const BrepSource*>(part.source.get());
+    if (!brep) return std::nullopt;
+    w.u64(1);
+    w.str(save_brep_source(*brep));
+  }
+  w.u64(m.surfaces.size());
+  for (const Surface& s : m.surfaces) put_surface(w, s);
+  w.u64(m.instances.size());
+  for (const Instance& instance : m.instances) {
+    w.str(instance.path);
+    w.u64(instance.part);
+    const Eigen::Matrix4d& matrix = instance.pose.matrix();
+    for (int k = 0; k < 16; ++k) w.f64(matrix.data()[k]);
+  }
+  return std::move(w.out);
+}
+
+bool load_import(std::string_view bytes, ImportResult& result, std::string& why) {
+  ByteReader r{bytes};
+  why = "its contents are cut short or inconsistent";
+  result.diagnostics.resize(r.count(40));
+  for (Diagnostic& d : result.diagnostics) {
+    d.severity = r.u64() == 0 ? Severity::Warning : Severity::Error;
+    d.file = r.str();
+    d.line = r.i64();
+    d.step_id = r.i64();
+    d.message = r.str();
+  }
+  result.complete = r.u64() == 1;
+  Model& m = result.model;
+  m.parts.resize(r.count(40));
+  for (Part& part : m.parts) {
+    part.name = r.str();
+    part.source_file = r.str();
+    part.first_surface = static_cast<SurfaceId>(r.u64());
+    part.surface_count = static_cast<std::uint32_t>(r.u64());
+    if (r.u64() == 0 || !r.ok) continue;
+    std::string source_why;
+    const std::string stored = r.str();
+    if (!r.ok) return false;
+    std::shared_ptr<BrepSource> source = load_brep_source(stored, source_why);
+    if (!source) {
+      why = "part '" + part.name + "': " + source_why;
+      return false;
+    }
+    if (source->face_count() != part.surface_count) return false;
+    part.source = std::move(source);
+  }
+  m.surfaces.resize(r.count(100));
+  for (Surface& s : m.surfaces)
+    if (!get_surface(r, s) || s.part >= m.parts.size()) return false;
+  for (const Part& part : m.parts)
+    if (std::uint64_t{part.first_surface} + part.surface_count > m.surfaces.size()) return false;
+  m.instances.resize(r.count(8 * 18));
+  for (Instance& instance : m.instances) {
+    instance.path = r.str();
+    instance.part = static_cast<PartId>(r.u64());
+    Eigen::Matrix4d matrix;
+    for (int k = 0; k < 16; ++k) matrix.data()[k] = r.f64();
+    instance.pose.matrix() = matrix;
+    if (instance.part >= m.parts.size()) return false;
+  }
+  return r.at_end();
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,130 @@
+// Files read in parallel (ImportOptions::parallel_files): the same scene, diagnostics and order as
+// one after another, whatever the files do (crash the reader, fail to parse, hold meshes).
+#include "cadclash/import.h"
+#include "../test_temp.h"
+#include "import_cache.h"
+#include "isolated_run.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace cadclash {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kData = std::string(CADCLASH_DATA_DIR) + "/";
+
+std::vector<std::string> messages(const ImportResult& r) {
+  std::vector<std::string> out;
+  for (const Diagnostic& d : r.diagnostics) out.push_back(format_diagnostic(d));
+  return out;
+}
+
+// Every field of the result but the B-rep parts' exact faces, which stand in as their number: what the
+// faces answer is compared through the reports of checks that query them (OCCT's binary format of a
+// face read back can differ from the face it wrote in bookkeeping flags such as TShape::Orientable).
+std::string everything(const ImportResult& r) {
+  ImportResult plain;
+  plain.diagnostics = r.diagnostics;
+  plain.complete = r.complete;
+  plain.model = r.model;
+  for (Part& part : plain.model.parts) {
+    if (const auto* brep = dynamic_cast<const BrepSource*>(part.source.get())) part.name += "/faces " + std::to_string(brep->face_count());
+    part.source.reset();
+  }
+  const std::optional<std::string> bytes = detail::save_import(plain);
+  EXPECT_TRUE(bytes.has_value());
+  return bytes.value_or("");
+}
+
+// Equal bytes; on a difference, its offset and the sizes (not the bytes: they are binary).
+::testing::AssertionResult same_bytes(const std::string& a, const std::string& b) {
+  if (a == b) return ::testing::AssertionSuccess();
+  std::size_t at = 0;
+  while (at < a.size() && at < b.size() && a[at] == b[at]) ++at;
+  return ::testing::AssertionFailure() << "sizes " << a.size() << " and " << b.size() << ", first difference at byte " << at;
+}
+
+TEST(ImportParallel, SameSceneForAnyNumberOfFilesAtOnce) {
+  const std::vector<std::string> files{
+      kData + "external/as1-tu-203.stp", kData + "cad/truncated.step",  kData + "external/screw.step",
+      kData + "collide/box_a.obj",       kData + "cad/not_step.step",   kData + "cad/heal_unshared_vertices.brep",
+      kData + "external/linkrods.step",  kData + "no-such-file.step",
+  };
+  for (const std::string& f : files)
+    if (f.find("external/") != std::string::npos && !fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  ImportOptions options;
+  options.parallel_files = 1;
+  const ImportResult serial = import_files(files, options);
+  ASSERT_EQ(serial.files.size(), files.size());
+  for (std::size_t i = 0; i < files.size(); ++i) EXPECT_EQ(serial.files[i].path, files[i]);
+  EXPECT_FALSE(serial.complete);
+  for (const int at_once : {2, 3, 8}) {
+    SCOPED_TRACE(at_once);
+    options.parallel_files = at_once;
+    const ImportResult parallel = import_files(files, options);
+    EXPECT_EQ(messages(parallel), messages(serial));
+    EXPECT_EQ(parallel.complete, serial.complete);
+    EXPECT_TRUE(same_bytes(everything(parallel), everything(serial)));
+    ASSERT_EQ(parallel.files.size(), files.size());
+    for (std::size_t i = 0; i < files.size(); ++i) EXPECT_EQ(parallel.files[i].path, files[i]);
+  }
+}
+
+// Without the isolated reader, OCCT's translators run in this process: they take turns.
+TEST(ImportParallel, UnisolatedReadersTakeTurns) {
+  const std::vector<std::string> files{kData + "cad/valid_two_solids.step", kData + "cad/dangling_ref.step",
+                                       kData + "cad/valid_two_solids.step", kData + "cad/wrong_schema.step"};
+  ImportOptions options;
+  options.isolate_cad_readers = false;
+  options.parallel_files = 1;
+  const ImportResult serial = import_files(files, options);
+  options.parallel_files = 4;
+  const ImportResult parallel = import_files(files, options);
+  EXPECT_EQ(messages(parallel), messages(serial));
+  EXPECT_TRUE(same_bytes(everything(parallel), everything(serial)));
+}
+
+// Children of several threads run at once: each child announces itself with a file and waits for the
+// others' files, which children run one after another would never see.
+TEST(IsolatedRun, ChildrenOfSeveralThreadsRunAtOnce) {
+  constexpr int kThreads = 3;
+  const fs::path dir = fs::path(testing::scratch_dir()) / "rendezvous";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::vector<detail::ChildRun> runs(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&runs, &dir, t] {
+      const detail::CadWork work;  // as import_file holds it: let go of while the child runs
+      runs[static_cast<std::size_t>(t)] = detail::run_in_child([&dir, t](const detail::Mark& mark) {
+        mark(static_cast<char>('a' + t));
+        std::ofstream(dir / std::to_string(t)) << t;
+        for (int wait = 0; wait < 1000; ++wait) {  // 10 s at most
+          int here = 0;
+          for (int other = 0; other < kThreads; ++other) here += fs::exists(dir / std::to_string(other)) ? 1 : 0;
+          if (here == kThreads) return "met the others";
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        return "alone";
+      });
+    });
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < kThreads; ++t) {
+    const detail::ChildRun& run = runs[static_cast<std::size_t>(t)];
+    EXPECT_TRUE(run.isolated);
+    EXPECT_FALSE(run.crashed) << run.how;
+    EXPECT_EQ(run.marks, std::string(1, static_cast<char>('a' + t)));
+    EXPECT_EQ(run.payload, "met the others");
+  }
+}
+
+}  // namespace
+}  // namespace cadclash

@@ -1,0 +1,134 @@
+// `cadclash check` end to end on the import's speed-ups: files read in parallel (--parallel-files) and
+// the import cache (--cache) give byte-identical reports (--no-timings) to reading one file after
+// another without a cache; with timings, every file's stages are in the table and the JSON.
+#include <gtest/gtest.h>
+#include "cli_runner.h"
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using cadclash::testing::CliRun;
+CliRun cadclash(const std::string& args) { return cadclash::testing::run_cadclash(args); }
+
+const std::string kExternal = std::string(CADCLASH_DATA_DIR) + "/external/";
+
+// The --json report of `cadclash check FILES ARGS --json <scratch>`; fails the test on a bad exit.
+std::string report_of(const std::string& files, const std::string& args) {
+  const std::string json = cadclash::testing::scratch_dir() + "/import-report.json";
+  fs::remove(json);
+  const CliRun r = cadclash("check " + files + " " + args + " --json '" + json + "'");
+  EXPECT_TRUE(r.code == 0 || r.code == 3) << r.err;
+  return cadclash::testing::slurp(json);
+}
+
+TEST(CliImport, ParallelAndCachedReportsAreTheReference) {
+  const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step",
+                    linkrods = kExternal + "linkrods.step";
+  for (const std::string& f : {as1, screw, linkrods})
+    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  const std::string files = "'" + as1 + "' '" + screw + "' '" + linkrods + "'";
+  const std::string cache = cadclash::testing::scratch_dir() + "/cli-cache";
+  fs::remove_all(cache);
+  const std::string reference = report_of(files, "--no-timings --parallel-files 1 --threads 1");
+  ASSERT_NE(reference.find("\"pairs\""), std::string::npos);
+  EXPECT_EQ(reference.find("import_timings"), std::string::npos);
+  EXPECT_EQ(report_of(files, "--no-timings --parallel-files 3"), reference);
+  EXPECT_EQ(report_of(files, "--no-timings --cache '" + cache + "'"), reference);  // cold
+  EXPECT_EQ(report_of(files, "--no-timings --cache '" + cache + "'"), reference);  // warm
+  EXPECT_EQ(report_of(files, "--no-timings --lazy --cache '" + cache + "'"),
+            report_of(files, "--no-timings --lazy"));
+}
+
+TEST(CliImport, StagesAreInTheTableAndTheJson) {
+  const std::string as1 = kExternal + "as1-tu-203.stp";
+  if (!fs::exists(as1)) GTEST_SKIP() << as1 << " missing: run scripts/setup.sh";
+  const std::string box = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
+  const std::string cache = cadclash::testing::scratch_dir() + "/stage-cache";
+  fs::remove_all(cache);
+  const std::string files = "'" + as1 + "' '" + box + "'";
+  (void)report_of(files, "--cache '" + cache + "'");
+  const std::string json = cadclash::testing::scratch_dir() + "/stages.json";
+  const CliRun r = cadclash("check " + files + " --cache '" + cache + "' --json '" + json + "'");
+  ASSERT_TRUE(r.code == 0 || r.code == 3) << r.err;
+  EXPECT_NE(r.out.find("stages: read "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" ms, query "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("as1-tu-203.stp"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(cadclash::testing::slurp(json));
+  ASSERT_TRUE(j.contains("import_timings"));
+  const auto& files_json = j["import_timings"]["files"];
+  ASSERT_EQ(files_json.size(), 2u);
+  EXPECT_EQ(files_json[0]["file"], as1);
+  EXPECT_EQ(files_json[0]["cache"], "hit");
+  EXPECT_EQ(files_json[1]["cache"], "hit");
+  for (const auto& f : files_json)
+    for (const char* stage : {"read", "transfer", "heal", "tessellate", "total"}) {
+      ASSERT_TRUE(f[stage].is_number()) << stage;
+      EXPECT_GE(f[stage].get<double>(), 0.0) << stage;
+    }
+  ASSERT_TRUE(j["import_timings"]["seconds"].is_number());
+  EXPECT_GE(j["import_timings"]["seconds"].get<double>(), 0.0);
+  const CliRun quiet = cadclash("check " + files + " --no-timings");
+  EXPECT_EQ(quiet.out.find("stages:"), std::string::npos);
+}
+
+// A damaged entry: the check says so on stderr and in the report's diagnostics, and finds the same pairs.
+TEST(CliImport, DamagedCacheEntryIsReadAgain) {
+  const std::string box_a = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
+  const std::string box_b = std::string(CADCLASH_DATA_DIR) + "/collide/box_overlap.obj";
+  const std::string cache = cadclash::testing::scratch_dir() + "/damaged-cache";
+  fs::remove_all(cache);
+  const std::string files = "'" + box_a + "' '" + box_b + "'";
+  const std::string reference = report_of(files, "--no-timings --cache '" + cache + "'");
+  for (const auto& e : fs::directory_iterator(cache)) fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+  const std::string json = cadclash::testing::scratch_dir() + "/damaged.json";
+  const CliRun r = cadclash("check " + files + " --no-timings --cache '" + cache + "' --json '" + json + "'");
+  EXPECT_NE(r.err.find("is damaged"), std::string::npos) << r.err;
+  nlohmann::json got = nlohmann::json::parse(cadclash::testing::slurp(json));
+  nlohmann::json want = nlohmann::json::parse(reference);
+  EXPECT_EQ(got["diagnostics"].size(), 2u);
+  got.erase("diagnostics");
+  want.erase("diagnostics");
+  EXPECT_EQ(got, want);
+  EXPECT_EQ(report_of(files, "--no-timings --cache '" + cache + "'"), reference);  // rewritten whole
+}
+
+// Runs sharing one cache directory at once: each writes its entries through a temporary file and a
+// rename, so none ever reads half an entry; all give the reference report, and the directory ends
+// with one whole entry per file and no temporary files.
+TEST(CliImport, ConcurrentRunsShareACache) {
+  const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
+  if (!fs::exists(as1) || !fs::exists(screw)) GTEST_SKIP() << "data/external missing: run scripts/setup.sh";
+  const std::string dir = cadclash::testing::scratch_dir();
+  const std::string cache = dir + "/shared-cache";
+  fs::remove_all(cache);
+  const std::string files = "'" + as1 + "' '" + screw + "'";
+  const std::string reference = report_of(files, "--no-timings");
+  constexpr int kRuns = 3;
+  for (int round = 0; round < 2; ++round) {  // all cold at once, then all warm at once
+    std::string command = "for k in";
+    for (int k = 0; k < kRuns; ++k) command += " " + std::to_string(k);
+    command += std::string("; do timeout 120 '") + CADCLASH_EXE + "' check " + files + " --no-timings --cache '" + cache +
+               "' --json '" + dir + "/shared'$k.json >/dev/null 2>'" + dir + "/shared'$k.err & done; wait";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    for (int k = 0; k < kRuns; ++k) {
+      SCOPED_TRACE("round " + std::to_string(round) + ", run " + std::to_string(k));
+      EXPECT_EQ(cadclash::testing::slurp(dir + "/shared" + std::to_string(k) + ".json"), reference);
+      const std::string err = cadclash::testing::slurp(dir + "/shared" + std::to_string(k) + ".err");
+      EXPECT_EQ(err.find("damaged"), std::string::npos) << err;
+      EXPECT_EQ(err.find("could not store"), std::string::npos) << err;
+    }
+  }
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(cache)) {
+    EXPECT_EQ(e.path().extension(), ".entry") << e.path();
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2);
+}
+
+}  // namespace
