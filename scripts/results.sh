@@ -78,7 +78,8 @@ echo "results: numerical extremes (triangle test against the exact oracle)"
 elapsed=$(( $(date +%s) - start ))
 
 # Plots next to the page; links in the embedded tables point there.
-rm -f "$docs"/*.svg "$docs"/*.png
+# (mpi_model.svg stays: the MPI section is measured by scripts/mpi_scaling.sh, not by this script)
+find "$docs" -maxdepth 1 \( -name '*.svg' -o -name '*.png' \) ! -name 'mpi_model.svg' -delete
 for f in "$out"/*.svg "$out"/*.png; do [ -e "$f" ] && cp "$f" "$docs/"; done
 relink() { sed -E 's#\]\(([^/():]+\.(svg|png))\)#](results/\1)#g' "$1"; }
 # compare.md starts at level 1; under this page's "## Side by side" its headings go two levels down.
