@@ -13,6 +13,17 @@
 #include <filesystem>
 #include <system_error>
 
+#if defined(__SANITIZE_ADDRESS__)
+#define CADCLASH_ASAN_RUNTIME 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CADCLASH_ASAN_RUNTIME 1
+#endif
+#endif
+#ifndef CADCLASH_ASAN_RUNTIME
+#define CADCLASH_ASAN_RUNTIME 0
+#endif
+
 namespace cadclash {
 namespace detail {
 
@@ -100,7 +111,15 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
   const auto start = std::chrono::steady_clock::now();
   std::vector<ImportResult> each(paths.size());
   std::vector<std::exception_ptr> failed(paths.size());
-  const int threads = options.parallel_files > 0 ? options.parallel_files : omp_get_max_threads();
+  int threads = options.parallel_files > 0 ? options.parallel_files : omp_get_max_threads();
+#if CADCLASH_ASAN_RUNTIME
+  // clang-14's AddressSanitizer runtime does not make its own locks safe across fork: a child forked
+  // while another thread of this process is inside the runtime (starting a thread, allocating) can
+  // inherit a held lock and hang (seen once in the sanitizer pass: an isolated STEP reader that never
+  // finished while a mesh file was read beside it). Sanitizer builds read files one after another;
+  // Release builds (glibc's fork-safe allocator) read them in parallel.
+  threads = 1;
+#endif
   // One file per thread at a time; OpenMP regions inside a file's import then run on that thread.
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(paths.size()); ++k) {
