@@ -252,7 +252,8 @@ struct SurfacePairResult {
 
 // What a Scene's collision model holds, in bytes per component: the triangles and vertices of the
 // surfaces that have a hierarchy (the Model's arrays, counted once per surface), the hierarchies
-// built so far, and the per-instance data (poses, world boxes, flags).
+// built so far plus every surface's slot (exact root box, sizes; built or not), and the per-instance
+// data (poses, world boxes, flags, and the instance tree when a broad phase built one).
 struct SceneMemory {
   std::uint64_t triangles = 0;
   std::uint64_t vertices = 0;
