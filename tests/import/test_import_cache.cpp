@@ -4,6 +4,7 @@
 #include "cadclash/report.h"
 #include "../test_temp.h"
 #include "import_cache.h"
+#include "import_compare.h"
 
 #include <gtest/gtest.h>
 
@@ -18,6 +19,8 @@ namespace cadclash {
 namespace {
 
 namespace fs = std::filesystem;
+using testing_import::everything;
+using testing_import::same_bytes;
 
 const std::string kExternal = std::string(CADCLASH_DATA_DIR) + "/external/";
 
@@ -35,37 +38,6 @@ std::string fresh_cache(const std::string& name) {
   const fs::path dir = fs::path(testing::scratch_dir()) / ("cache-" + name);
   fs::remove_all(dir);
   return dir.string();
-}
-
-// Every field of the result but the B-rep parts' exact faces, which stand in as their number: what the
-// faces answer is compared through the reports of checks that query them (OCCT's binary format of a
-// face read back can differ from the face it wrote in bookkeeping flags such as TShape::Orientable).
-std::string everything(const ImportResult& r) {
-  ImportResult plain;
-  plain.diagnostics = r.diagnostics;
-  plain.complete = r.complete;
-  plain.model = r.model;
-  for (Part& part : plain.model.parts) {
-    if (const auto* brep = dynamic_cast<const BrepSource*>(part.source.get())) part.name += "/faces " + std::to_string(brep->face_count());
-    part.source.reset();
-  }
-  const std::optional<std::string> bytes = detail::save_import(plain);
-  EXPECT_TRUE(bytes.has_value());
-  return bytes.value_or("");
-}
-
-// Equal bytes; on a difference, its offset and the sizes (not the bytes: they are binary).
-::testing::AssertionResult same_bytes(const std::string& a, const std::string& b) {
-  if (a == b) return ::testing::AssertionSuccess();
-  std::size_t at = 0;
-  while (at < a.size() && at < b.size() && a[at] == b[at]) ++at;
-  auto around = [at](const std::string& s) {
-    std::ostringstream o;
-    for (std::size_t k = at >= 24 ? at - 24 : 0; k < s.size() && k < at + 24; ++k) o << (k == at ? "[" : "") << int(static_cast<unsigned char>(s[k])) << (k == at ? "]" : "") << ' ';
-    return o.str();
-  };
-  return ::testing::AssertionFailure() << "sizes " << a.size() << " and " << b.size() << ", first difference at byte " << at
-                                       << ":\n  " << around(a) << "\n  " << around(b);
 }
 
 // The report of a certified check of the whole model, without timings: what `cadclash check` writes.
