@@ -1,6 +1,7 @@
 // Trajectories: CSV of per-step instance poses, replayed on a Scene.
 #include "cadclash/collide.h"
 
+#include <cassert>
 #include <chrono>
 #include <charconv>
 #include <cmath>
@@ -86,6 +87,31 @@ std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::
   return rows;
 }
 
+std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> rows, std::size_t k,
+                                  std::vector<Diagnostic>& diagnostics, const std::string& file) {
+  assert(k < rows.size());
+  const std::int64_t step = rows[k].step;
+  for (; k < rows.size() && rows[k].step == step; ++k) {
+    const InstanceId id = scene.find_instance(rows[k].path);
+    if (id == kInvalidId) {
+      diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
+                             "no instance with path '" + rows[k].path + "'; row skipped"});
+      continue;
+    }
+    scene.set_pose(id, rows[k].pose);
+  }
+  return k;
+}
+
+Diagnostic steps_not_checked(std::span<const TrajectoryRow> rows, std::size_t k, const std::string& file) {
+  assert(k < rows.size());
+  std::size_t steps_left = 0;
+  for (std::size_t r = k; r < rows.size(); ++r) steps_left += (r == k || rows[r].step != rows[r - 1].step);
+  return {Severity::Warning, file, rows[k].line, -1,
+          "time budget ran out: " + std::to_string(steps_left) + " steps from step " + std::to_string(rows[k].step) +
+              " on were not checked"};
+}
+
 std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const TrajectoryRow> rows,
                                           const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                           const std::string& file) {
@@ -102,24 +128,12 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
       const bool out_of_time = left <= 0.0 || (!results.empty() && !results.back().report.complete &&
                                                results.back().report.stopped_by.find("time") != std::string::npos);
       if (out_of_time) {
-        std::size_t steps_left = 0;
-        for (std::size_t r = k; r < rows.size(); ++r) steps_left += (r == k || rows[r].step != rows[r - 1].step);
-        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
-                               "time budget ran out: " + std::to_string(steps_left) +
-                                   " steps from step " + std::to_string(step) + " on were not checked"});
+        diagnostics.push_back(steps_not_checked(rows, k, file));
         break;
       }
       step_options.time_budget_seconds = left;
     }
-    for (; k < rows.size() && rows[k].step == step; ++k) {
-      const InstanceId id = scene.find_instance(rows[k].path);
-      if (id == kInvalidId) {
-        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
-                               "no instance with path '" + rows[k].path + "'; row skipped"});
-        continue;
-      }
-      scene.set_pose(id, rows[k].pose);
-    }
+    k = apply_trajectory_step(scene, rows, k, diagnostics, file);
     results.push_back({step, scene.check(step_options)});
   }
   return results;

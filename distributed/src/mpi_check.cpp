@@ -247,24 +247,12 @@ DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const
       check_mpi(MPI_Bcast(&stop, 1, MPI_INT, 0, comm), "MPI_Bcast", comm);
       check_mpi(MPI_Bcast(&left, 1, MPI_DOUBLE, 0, comm), "MPI_Bcast", comm);
       if (stop) {
-        std::size_t steps_left = 0;
-        for (std::size_t r = k; r < rows.size(); ++r) steps_left += (r == k || rows[r].step != rows[r - 1].step);
-        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
-                               "time budget ran out: " + std::to_string(steps_left) + " steps from step " +
-                                   std::to_string(step) + " on were not checked"});
+        diagnostics.push_back(steps_not_checked(rows, k, file));
         break;
       }
       step_options.time_budget_seconds = left;
     }
-    for (; k < rows.size() && rows[k].step == step; ++k) {
-      const InstanceId id = scene.find_instance(rows[k].path);
-      if (id == kInvalidId) {
-        diagnostics.push_back({Severity::Warning, file, rows[k].line, -1,
-                               "no instance with path '" + rows[k].path + "'; row skipped"});
-        continue;
-      }
-      scene.set_pose(id, rows[k].pose);
-    }
+    k = apply_trajectory_step(scene, rows, k, diagnostics, file);
     DistributedCheck c = check_distributed(scene, model, step_options, history, comm);
     if (rank == 0) {
       last_cut_by_time = !c.report.complete && c.report.stopped_by.find("time") != std::string::npos;

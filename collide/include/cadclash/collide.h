@@ -406,6 +406,17 @@ struct TrajectoryRow {
 std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::string& file,
                                             std::vector<Diagnostic>& diagnostics);
 
+// Applies the rows of the step that starts at rows[k] (the rows that follow with the same step
+// number) to `scene`; a row naming an unknown instance becomes a warning naming `file` and its line
+// and is skipped. Returns the index of the first row after the step. Precondition: k < rows.size().
+std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> rows, std::size_t k,
+                                  std::vector<Diagnostic>& diagnostics, const std::string& file);
+
+// The warning a replay gives when its time budget ran out before the step that starts at rows[k]:
+// how many steps from there on were not checked, at that row's line of `file`.
+// Precondition: k < rows.size().
+Diagnostic steps_not_checked(std::span<const TrajectoryRow> rows, std::size_t k, const std::string& file);
+
 struct StepResult {
   std::int64_t step = 0;
   Report report;
