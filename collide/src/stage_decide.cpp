@@ -110,7 +110,7 @@ void witness_steps(Run& run) {
   // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
   // cross by round-off only, and the vertex witnesses prove those.
   run.step(run.open([&](std::size_t k) {
-             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->penetration > run.pending[k].threshold;
+             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->crosses_threshold;
            }),
            [&](std::size_t k) {
              crossing_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],

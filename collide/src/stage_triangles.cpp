@@ -33,6 +33,9 @@ void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
                      task_tau(s, q, t), q.prepared[k], q.task_counters[k]);
+  // Certified: the decision's crossing step asks whether the triangles cross deeper than T.
+  if (q.o.decision != DecisionMode::Fast)
+    q.prepared[k].threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
   bytes[k] = prepared_bytes(q.prepared[k]);
 }
 

@@ -31,7 +31,8 @@ namespace cadclash {
 //    more into B's frame (the paper's single update). Surfaces meeting it survive (msA, msB).
 // 3. Surface level: surviving pairs whose boxes (in A's frame) overlap → surface-pair OAABB.
 // 4. Triangle level: each surface's BVH (built once) is queried under the surface-pair OAABB on both
-//    sides (mpSk, mpSl); candidate triangle pairs come from a sweep over the survivors, or from the
+//    sides (mpSk, mpSl); candidate triangle pairs come from a tree over Sl's survivors queried by
+//    each survivor of Sk in turn (so a surface pair whose outcome is settled stops making them), or from the
 //    paper's flat double loop for small lists.
 // 5. Exact test (triangles_intersect; float filter + exact fallback) and, while no intersection is
 //    found, triangle–triangle distance.
@@ -157,9 +158,9 @@ const char* schedule_name(Schedule s);
 
 // How candidate triangle pairs are formed under the surface-pair OAABB.
 enum class TriangleLevel : std::uint8_t {
-  Auto,  // flat loops when |survivors of Sk| * |survivors of Sl| <= flat_limit, else the BVH + sweep
+  Auto,  // flat loops when |survivors of Sk| * |survivors of Sl| <= flat_limit, else the BVH + tree
   Flat,  // the paper's loops: every triangle of Sk against every triangle of Sl, box test first
-  Bvh,   // per-surface BVH queried under the OAABB, candidate pairs by a sweep over the survivors
+  Bvh,   // per-surface BVH queried under the OAABB, candidate pairs from a tree over Sl's survivors
 };
 // Returns "auto", "flat" or "bvh".
 const char* triangle_level_name(TriangleLevel t);
@@ -205,7 +206,7 @@ struct CollideCounters {
   std::uint64_t triangles_b = 0;          // mpSl
   std::uint64_t triangle_tests = 0;       // exact triangle intersection tests (EarlyExit: after a surface
                                           // pair's first intersecting triangle pair, only pairs whose
-                                          // crossing depth could raise its penetration are tested)
+                                          // crossing depth could exceed T or τ are tested)
   std::uint64_t exact_fallbacks = 0;      // tests the float filter could not decide
   std::uint64_t distance_tests = 0;       // triangle distance computations
   std::uint64_t intersecting_pairs = 0;   // surface pairs with at least one intersecting triangle pair
@@ -236,7 +237,12 @@ struct SurfacePairResult {
   bool intersecting = false;  // some triangle pair intersects exactly
   double distance = 0.0;      // min triangle distance; 0 when intersecting; for Containment, the min
                               // distance when within the search margin, else +infinity
-  double penetration = 0.0;   // crossing-depth estimate (see above); in EarlyExit mode a lower bound
+  // Crossing depth (see above) of a triangle pair crossing deeper than τ (certified: T + δa + δb + r),
+  // the depth that makes the pair penetrating: in EarlyExit mode the first such pair in visiting
+  // order (a lower bound of the deepest), in AllTrianglePairs mode the deepest. 0 when no triangle
+  // pair crosses deeper: shallower crossings are within the tessellation bands and say nothing about
+  // the exact faces, so they are neither reported nor, past the first one, measured.
+  double penetration = 0.0;
   DecidedBy decided_by = DecidedBy::Mesh;
   // Bounds on the exact face distance d* from the evidence that decided the pair (see "Certified
   // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].
