@@ -12,7 +12,9 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -165,6 +167,49 @@ enum class TriangleLevel : std::uint8_t {
 // Returns "auto", "flat" or "bvh".
 const char* triangle_level_name(TriangleLevel t);
 
+// ---------------------------------------------------------------------------------------------
+// Progress of long work
+// ---------------------------------------------------------------------------------------------
+// An import (import.h), the eager tessellation of B-rep parts (tessellate.h), a check and a
+// trajectory replay tell an optional callback how far they are, for a progress display such as the
+// command line's status line. Library code never prints. An empty callback (the default) costs one
+// test per work item and nothing else; a callback never changes a result (reports are byte-identical
+// with and without one).
+//
+// Each run of a stage makes calls with done rising from 0 to total: a first call with done = 0 as
+// it starts, calls as items finish (at most one per whole percent of total, so a callback is cheap
+// whatever the number of items), and a last call with done == total when it ends (also when a
+// budget cut it short: skipped items count as finished); the first call with done == total is the
+// run's last (so a run of total 0 is one call). Calls never overlap. The callback must not
+// throw and must not use the object that is reporting (the Scene, the Model being imported).
+enum class ProgressStage : std::uint8_t {
+  ReadFile,        // import: files finished of the files given; label: the file (as given) that
+                   // started or finished last. One run per import_file / import_files call.
+  TessellatePart,  // eager B-rep tessellation: parts meshed of one file's (one add_brep_parts call's)
+                   // parts; label: the name of a part meshed last. None when lazy or read from the cache.
+  CheckPairs,      // Scene::check: instance pairs (of the broad phase's) through one step of the query;
+                   // label: the step, "surface level", then "triangle level", then "decisions" (a run
+                   // each, done starting at 0 again; the decisions count the pairs with nothing to
+                   // decide at once and the rest when every decision step is done).
+  TrajectoryStep,  // replay_trajectory: steps checked of the trajectory's steps; label: the number of
+                   // the step checked last (the first step's as it starts). The checks of the steps
+                   // do not report CheckPairs.
+};
+// Returns "read file", "tessellate part", "check instance pairs" or "trajectory step".
+const char* progress_stage_name(ProgressStage s);
+
+struct Progress {
+  ProgressStage stage = ProgressStage::ReadFile;
+  std::size_t done = 0;   // items finished, 0 <= done <= total, never falling within a run
+  std::size_t total = 0;  // items of this run of the stage
+  std::string label;      // what it is working on (see ProgressStage)
+};
+
+// Called by a long operation as it goes (see above). Threads: collide (check, replay) calls it only
+// on the thread that called the query; tessellation on the thread that called add_brep_parts; an
+// import on the threads reading files (import_files with parallel_files > 1: several, one at a time).
+using ProgressCallback = std::function<void(const Progress&)>;
+
 struct CollideOptions {
   double tolerance = 0.0;         // contact tolerance t, mm (>= 0)
   double clearance = 0.0;         // report non-touching pairs closer than this, mm (0 = never)
@@ -191,6 +236,9 @@ struct CollideOptions {
   //   Structures a previous check() of the same Scene built are not counted again.
   double time_budget_seconds = 0.0;
   std::size_t memory_budget_bytes = 0;
+  // Told how far check() (CheckPairs) and replay_trajectory() (TrajectoryStep) are; empty = nothing.
+  // The split forms (Scene::plan, check_part, cadclash/distributed.h) do not call it.
+  ProgressCallback progress;
 };
 
 // Counters of one query, summed over instance pairs (the paper's Table 2). They depend on the options
