@@ -6,7 +6,7 @@
 namespace cadclash::detail {
 namespace {
 
-constexpr std::uint32_t kLeafItems = 4;
+constexpr std::uint32_t kLeafItems = 8;
 
 FlatBox union_of(const FlatBox& a, const FlatBox& b) {
   FlatBox u;

@@ -18,8 +18,8 @@ namespace cadclash::detail {
 
 struct PreparedPair {
   double tau = 0.0;     // touching bound: tolerance + both deflections; a crossing deeper ends the run
-  // Crossings deeper than this set PairOutcome::crosses_threshold (<= tau; certified: T, where the
-  // crossing step of the decision begins; else tau).
+  // Crossings deeper than this set PairOutcome::crosses_threshold (<= tau; certified, where one face
+  // is a plane: T, where the decision's crossing step begins; else tau).
   double threshold = 0.0;
   double margin = 0.0;  // search margin: max(tau, clearance) plus the rounding slack
   double slack = 0.0;   // that rounding slack: bounds any rounding of a height or box coordinate here

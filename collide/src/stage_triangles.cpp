@@ -63,8 +63,12 @@ void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
                      task_tau(s, q, t), q.prepared[k], q.task_counters[k]);
-  // Certified: the decision's crossing step asks whether the triangles cross deeper than T.
-  if (q.o.decision != DecisionMode::Fast)
+  // Certified: the decision's crossing step asks whether the triangles cross deeper than T, and
+  // only where one face is a plane (decide_crossing.cpp); elsewhere the run need not find out.
+  const Surface& a = s.model.surfaces[t.sa];
+  const Surface& b = s.model.surfaces[t.sb];
+  if (q.o.decision != DecisionMode::Fast &&
+      (a.analytic.shape == SurfaceShape::Plane || b.analytic.shape == SurfaceShape::Plane))
     q.prepared[k].threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
   bytes[k] = prepared_bytes(q.prepared[k]);
 }
