@@ -149,7 +149,7 @@ struct RankStats {
   std::uint64_t instance_pairs = 0;  // assigned to it
   std::uint64_t cost = 0;            // their estimated cost (PlannedPair::cost)
   std::uint64_t triangles = 0;       // triangles its scene holds afterwards (model_memory.triangle_count)
-  double seconds = 0.0;              // wall time of its check_part() calls
+  double seconds = 0.0;              // wall time of its check_part() calls (and share_parts() before them)
   double cpu_seconds = 0.0;          // CPU time of the process (all its threads) during them
   double plan_seconds = 0.0;         // wall time of its plan() calls (every rank plans every pair)
   std::uint64_t result_bytes = 0;    // bytes of its results sent to rank 0
