@@ -152,12 +152,13 @@ TEST(MpiCli, As1PartMeshingTrajectorySameReport) {
   expect_identical("check '" + as1_path() + "' --deflection 2 --path '" + as1_trajectory_csv() + "'", false);
 }
 
-// `write_board_step OUT COPIES 0 [unshared]`: the truth tests' board (17 instances) COPIES times side
-// by side as a STEP assembly; unshared: a product per instance.
-std::string board_step(int copies, bool unshared) {
-  const std::string out = scratch("board" + std::to_string(copies) + (unshared ? "u" : "s") + ".step");
+// `write_board_step OUT COPIES SHIFT [unshared]`: the truth tests' board (17 instances) COPIES times
+// side by side as a STEP assembly, moved SHIFT mm along x; unshared: a product per instance.
+std::string board_step(int copies, bool unshared, int shift = 0) {
+  const std::string out = scratch("board" + std::to_string(copies) + (unshared ? "u" : "s") + "_" +
+                                  std::to_string(shift) + ".step");
   const std::string command = std::string("'") + CADCLASH_WRITE_BOARD_STEP + "' '" + CADCLASH_DATA_DIR +
-                              "/external' '" + out + "' " + std::to_string(copies) + " 0" +
+                              "/external' '" + out + "' " + std::to_string(copies) + " " + std::to_string(shift) +
                               (unshared ? " unshared" : "") + " >/dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   return out;
@@ -223,6 +224,39 @@ TEST(MpiCli, RanksMeshOnlyThePartsTheirShareReaches) {
     }
     EXPECT_GE(sum, model) << r.err;
   }
+}
+
+// Two files, two boards and one board 1000 mm away, on two ranks, the pairs selected within the
+// boards (each file also holds an unused part at its origin, which write_board_step leaves as a free
+// shape: it would pair across the files). Rank 0's run lies within the first file (it holds about
+// 2/3 of the pairs), so rank 0 keeps nothing of the second file, though it reads it: it holds no more
+// triangles than the first file has. Rank 1 holds the second file's board and what its pairs reach
+// of the first.
+TEST(MpiCli, RankMeshesNothingOfAFileItsPairsDoNotReach) {
+  REQUIRE_AS1();
+  const std::string first = board_step(2, false), second = board_step(1, false, 1000);
+  const Outcome alone = run(1, "check '" + first + "' --tolerance 0.01 --no-timings --threads 1");
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  const auto first_only = meshed_per_rank(alone.err, 1);
+  ASSERT_EQ(first_only.size(), 1u);
+  const std::uint64_t in_first = first_only[0][2];
+  const std::string boards = "/" + std::filesystem::path(first).filename().string() + "/board /" +
+                             std::filesystem::path(second).filename().string() + "/board";
+  const std::string args = "check '" + first + "' '" + second + "' --select-a " + boards + " --select-b " + boards +
+                           " --tolerance 0.01 --no-timings --threads 1 --json ";
+  const Outcome single = run(0, args + "'" + scratch("files_one.json") + "'");
+  ASSERT_EQ(single.code, 0) << single.err;
+  const Outcome two = run(2, args + "'" + scratch("files_np2.json") + "'");
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_TRUE(slurp(scratch("files_np2.json")) == slurp(scratch("files_one.json")));
+  EXPECT_TRUE(two.out == single.out);
+  const auto ranks = meshed_per_rank(two.err, 2);
+  ASSERT_EQ(ranks.size(), 2u);
+  const std::uint64_t model = ranks[0][2];
+  ASSERT_GT(model, in_first);
+  EXPECT_LE(ranks[0][0], in_first) << "rank 0 holds parts of the second file:\n" << two.err;
+  EXPECT_GT(ranks[1][0], 0u) << two.err;
+  EXPECT_LT(ranks[1][0], model) << two.err;
 }
 
 // With --lazy every rank reads and keeps the B-rep and tessellates face by face: no part meshing.
