@@ -1,4 +1,5 @@
 #include "cli_common.h"
+#include "progress_line.h"
 
 #include <cassert>
 #include <chrono>
@@ -27,6 +28,9 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
                  "settings comes back from it, the same as when it was read (made when missing)");
   cmd.add_option("--parallel-files", in.parallel_files, "Files read at once (default: one per core)")
       ->check(CLI::NonNegativeNumber);
+  cmd.add_flag("-q,--quiet", in.quiet,
+               "No progress line (shown on a terminal) and no summary lines on stderr; errors and warnings "
+               "about the input still print");
   cmd.add_option("--model-tolerance", in.model_tolerance,
                  "Uncertainty of mesh coordinates, mm: faces within tolerance + both uncertainties touch "
                  "(default: 2^-24 x the largest coordinate, the single-precision bound)")
@@ -51,7 +55,25 @@ TessellationOptions effective_tessellation(const InputOptions& in) {
   return apply_preset(t, *preset);
 }
 
+namespace {
+
+void print_repair_summary(const MeshRepairReport& r, bool fill_holes, double seconds) {
+  std::size_t changed = 0;
+  for (const SurfaceRepairStats& s : r.per_surface) changed += s.changed ? 1 : 0;
+  const SurfaceRepairStats& t = r.total;
+  std::cerr << "repair: " << changed << " of " << r.per_surface.size() << " mesh surfaces changed: "
+            << t.merged_points << " merged points, " << t.unused_points << " unused points, " << t.degenerate_faces
+            << " degenerate and " << t.duplicate_faces << " repeated triangles removed, " << t.flipped_faces
+            << " flipped, " << t.stitched_edges << " edges stitched, " << t.duplicated_vertices
+            << " vertices duplicated";
+  if (fill_holes) std::cerr << ", " << t.filled_holes << " holes filled with " << t.hole_faces << " triangles";
+  std::cerr << " (" << seconds << " s)\n";
+}
+
+}  // namespace
+
 ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report, SegmentReport* segment_report) {
+  ProgressLine line(show_progress(in.quiet), std::cerr);
   ImportOptions options;
   options.tessellation = effective_tessellation(in);
   options.lazy = in.lazy;
@@ -61,7 +83,9 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.tessellation.time_limit_seconds = in.import_time_limit;
   options.cache_dir = in.cache;
   options.parallel_files = in.parallel_files;
+  options.progress = line.callback();
   ImportResult result = import_files(in.files, options);
+  line.clear();
   print_diagnostics(result.diagnostics);
   if (in.repair) {
     MeshRepairOptions repair_options;
@@ -70,16 +94,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
     MeshRepairReport r = repair_meshes(result.model, repair_options);
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     print_diagnostics(r.diagnostics);
-    std::size_t changed = 0;
-    for (const SurfaceRepairStats& s : r.per_surface) changed += s.changed ? 1 : 0;
-    const SurfaceRepairStats& t = r.total;
-    std::cerr << "repair: " << changed << " of " << r.per_surface.size() << " mesh surfaces changed: "
-              << t.merged_points << " merged points, " << t.unused_points << " unused points, " << t.degenerate_faces
-              << " degenerate and " << t.duplicate_faces << " repeated triangles removed, " << t.flipped_faces
-              << " flipped, " << t.stitched_edges << " edges stitched, " << t.duplicated_vertices
-              << " vertices duplicated";
-    if (in.fill_holes) std::cerr << ", " << t.filled_holes << " holes filled with " << t.hole_faces << " triangles";
-    std::cerr << " (" << took.count() << " s)\n";
+    if (!in.quiet) print_repair_summary(r, in.fill_holes, took.count());
     if (repair_report) *repair_report = std::move(r);
   }
   if (in.segment) {
@@ -90,7 +105,8 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
     SegmentReport r = segment_surfaces(result.model, segment_options);
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     print_diagnostics(r.diagnostics);
-    std::cerr << "segment: " << r.surfaces_split << " of " << r.surfaces.size() << " surfaces split into " << r.patches
+    if (!in.quiet)
+      std::cerr << "segment: " << r.surfaces_split << " of " << r.surfaces.size() << " surfaces split into " << r.patches
               << " patches (" << took.count() << " s)\n";
     if (segment_report) *segment_report = std::move(r);
   }

@@ -28,6 +28,7 @@ struct InputOptions {
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   std::string cache;               // directory of the import cache (ImportOptions::cache_dir); empty = none
   int parallel_files = 0;          // files read at once; 0 = one per core
+  bool quiet = false;              // no progress line and no summary lines on stderr (progress_line.h)
   // Mesh post-processing (mesh parts only; see tessellate.h).
   bool repair = false;
   bool fill_holes = false;  // with --repair
@@ -44,8 +45,9 @@ void add_input_options(CLI::App& cmd, InputOptions& in);
 // and the report's settings both read this.
 TessellationOptions effective_tessellation(const InputOptions& in);
 
-// Imports the files, printing every diagnostic to stderr, then repairs and segments the mesh parts
-// when asked (printing what changed to stderr). Returns the result; `repair_report` / `segment_report`,
+// Imports the files (with a progress line on a terminal, show_progress), printing every diagnostic
+// to stderr, then repairs and segments the mesh parts when asked (printing what changed to stderr
+// unless --quiet). Returns the result; `repair_report` / `segment_report`,
 // when given, receive what repair and segmentation did (left empty without --repair / --segment).
 ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report = nullptr,
                            SegmentReport* segment_report = nullptr);
@@ -53,7 +55,7 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
 // Prints diagnostics to stderr, one line each.
 void print_diagnostics(const std::vector<Diagnostic>& ds);
 
-// True when stderr is a terminal (progress is shown only then).
+// True when stderr is a terminal (progress is shown only then: show_progress, progress_line.h).
 bool stderr_is_terminal();
 
 void register_info(CLI::App& app);

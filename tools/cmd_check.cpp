@@ -4,6 +4,7 @@
 #include "cmd_check_mpi.h"
 #include "html_report.h"
 #include "import_stages.h"
+#include "progress_line.h"
 
 #include "cadclash/report.h"
 
@@ -381,9 +382,21 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
 #if CADCLASH_HAS_MPI
   if (mpi != nullptr) mpi->note_parts(scene);
 #endif
-  Runner runner{[&](const CollideOptions& c) { return scene.check(c); },
+  // A progress line for each query or replay, gone before its results are printed (never under mpirun).
+  const bool progress = show_progress(o.in.quiet);
+  auto with_progress = [](CollideOptions c, ProgressLine& line) {
+    c.progress = line.callback();
+    return c;
+  };
+  Runner runner{[&](const CollideOptions& c) {
+                  ProgressLine line(progress, std::cerr);
+                  return scene.check(with_progress(c, line));
+                },
                 [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
-                    const std::string& file) { return replay_trajectory(scene, r, c, ds, file); },
+                    const std::string& file) {
+                  ProgressLine line(progress, std::cerr);
+                  return replay_trajectory(scene, r, with_progress(c, line), ds, file);
+                },
                 {}};
   bool primary = true;
 #if CADCLASH_HAS_MPI
@@ -459,7 +472,7 @@ int run_check(const CheckOptions& o, const Launch& launch) {
     }
     if (by_parts) mesh_parts_or_import(o, imported, import_messages.str(), mpi);
     const int code = rows ? check_imported(o, imported, *rows, *review, &mpi) : kExitInputError;
-    if (mpi.rank() == 0) mpi.print_ranks(std::cerr);
+    if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
     return mpi.agree(code);
   }
 #endif

@@ -1,5 +1,6 @@
 // cadclash tessellate: write the surface-tagged model to OBJ or glTF binary.
 #include "cli_common.h"
+#include "progress_line.h"
 
 #include "cadclash/export.h"
 
@@ -16,22 +17,25 @@ struct TessellateOptions {
 };
 
 int run_tessellate(TessellateOptions& o) {
-  // Progress: one line per phase, on a terminal only; pipes and logs get just the result line.
-  const bool progress = stderr_is_terminal();
-  if (progress) std::cerr << "reading " << o.in.files.size() << (o.in.files.size() == 1 ? " file\n" : " files\n");
+  // Progress: the import's line (files, parts), then this command's own steps on the same line; on a
+  // terminal only and without --quiet: pipes and logs get just the result line.
   ImportResult r = import_inputs(o.in);
-  if (progress) std::cerr << "meshing " << r.model.surfaces.size() << " surfaces\n";
+  ProgressLine line(show_progress(o.in.quiet), std::cerr);
   // Writing needs every triangle, so a lazy import is completed here.
   std::vector<SurfaceId> all(r.model.surfaces.size());
   std::iota(all.begin(), all.end(), SurfaceId{0});
+  if (o.in.lazy) line.status("meshing " + std::to_string(r.model.surfaces.size()) + " surfaces");
   std::vector<Diagnostic> mesh_errors = require_triangles(r.model, all);
+  line.clear();
   print_diagnostics(mesh_errors);
-  if (progress) std::cerr << "writing " << o.output << '\n';
+  line.status("writing " + o.output);
   std::vector<Diagnostic> written = export_model(r.model, o.output);
+  line.clear();
   print_diagnostics(written);
   if (has_error(written)) return kExitInputError;
-  std::cerr << "wrote " << o.output << ": " << r.model.surfaces.size() << " surfaces, " << triangle_count(r.model)
-            << " triangles\n";
+  if (!o.in.quiet)
+    std::cerr << "wrote " << o.output << ": " << r.model.surfaces.size() << " surfaces, " << triangle_count(r.model)
+              << " triangles\n";
   return has_error(r.diagnostics) || has_error(mesh_errors) ? kExitInputError : kExitOk;
 }
 

@@ -35,6 +35,16 @@ const char* decision_mode_name(DecisionMode m) {
   return "unknown";
 }
 
+const char* progress_stage_name(ProgressStage s) {
+  switch (s) {
+    case ProgressStage::ReadFile: return "read file";
+    case ProgressStage::TessellatePart: return "tessellate part";
+    case ProgressStage::CheckPairs: return "check instance pairs";
+    case ProgressStage::TrajectoryStep: return "trajectory step";
+  }
+  return "unknown";
+}
+
 const char* collide_mode_name(CollideMode m) {
   return m == CollideMode::AllTrianglePairs ? "all-triangle-pairs" : "early-exit";
 }

@@ -1,5 +1,7 @@
 #include "narrow_phase.h"
 
+#include "crossing_bound.h"
+
 #include "cadclash/geometry.h"
 
 #include <array>
@@ -14,17 +16,29 @@ namespace {
 // The normal of P's plane, unnormalised, as straddle measures heights with it.
 inline Vec3 facet_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) { return (p1 - p0).cross(p2 - p0); }
 
-// False when straddle(T, P) is 0 without clipping: P has no normal, or T's vertices, as their heights
-// are computed, do not lie strictly on both sides of P's plane. Clipping only shrinks the straddle,
-// so a triangle wholly on one side needs none. `n` = facet_normal(P), p0 its first vertex.
-inline bool may_straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& n) {
+// The largest heights of T's vertices above and below P's plane (0 when none), as computed, in units
+// of |n| (n = facet_normal(P), p0 its first vertex). Clipping only shrinks the part of T that counts,
+// so min(up, down) / |n| bounds straddle(T, P) from above.
+struct Heights {
   double up = 0.0, down = 0.0;
+};
+inline Heights heights(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& n) {
+  Heights h;
   for (const Vec3* v : {&v0, &v1, &v2}) {
-    const double h = n.dot(*v - p0);
-    up = std::max(up, h);
-    down = std::max(down, -h);
+    const double x = n.dot(*v - p0);
+    h.up = std::max(h.up, x);
+    h.down = std::max(h.down, -x);
   }
-  return up > 0.0 && down > 0.0 && n.squaredNorm() > 0.0;  // the length, its root, is 0 exactly when this is
+  return h;
+}
+
+// False when straddle(T, P) is 0 without clipping: P has no normal, or T's vertices, as their heights
+// are computed, do not lie strictly on both sides of P's plane.
+inline bool straddles(const Heights& h, const Vec3& n) {
+  return h.up > 0.0 && h.down > 0.0 && n.squaredNorm() > 0.0;  // the length, its root, is 0 exactly when this is
+}
+inline bool may_straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, const Vec3& n) {
+  return straddles(heights(v0, v1, v2, p0, n), n);
 }
 
 // straddle(T, P) for a pair may_straddle lets through (n = facet_normal(P)). Plain doubles in place
@@ -104,29 +118,6 @@ double straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, 
   return may_straddle(v0, v1, v2, p0, n) ? clipped_straddle(v0, v1, v2, p0, p1, p2, n) : 0.0;
 }
 
-// A box of the triangle-level sweep, copied out of the Aabb in sweep order.
-struct SweepBox {
-  double lo[3], hi[3];
-};
-
-std::vector<SweepBox> sweep_boxes(const std::vector<Aabb>& boxes, const std::vector<std::uint32_t>& order) {
-  std::vector<SweepBox> out(order.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const Aabb& b = boxes[order[i]];
-    out[i] = {{b.min().x(), b.min().y(), b.min().z()}, {b.max().x(), b.max().y(), b.max().z()}};
-  }
-  return out;
-}
-
-// boxes_within for two triangles' boxes (never empty: each holds its three finite vertices).
-inline bool sweep_within(const SweepBox& a, const SweepBox& b, double margin) {
-  for (int k = 0; k < 3; ++k) {
-    if (b.lo[k] - a.hi[k] > margin) return false;
-    if (a.lo[k] - b.hi[k] > margin) return false;
-  }
-  return true;
-}
-
 double max_magnitude(const std::vector<Aabb>& boxes) {
   double m = 0.0;
   for (const Aabb& b : boxes) m = std::max(m, box_magnitude(b));
@@ -166,6 +157,7 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
                         PreparedPair& out, CollideCounters& counters) {
   out = PreparedPair{};
   out.tau = tau;
+  out.threshold = tau;
   const double search = std::max(out.tau, options.clearance);
   if (options.use_oaabb) {
     // Surface-pair OAABB in A's frame: where a triangle of one side can come within `search` of the
@@ -207,24 +199,54 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
     }
     out.box_b[j] = b;
   }
-  // Slack so that rounding in box arithmetic never turns "within the margin" into "beyond it".
-  out.margin = search + kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
+  // Slack so that rounding in box arithmetic never turns "within the margin" into "beyond it", nor a
+  // height over a plane (at most a few ulps of these magnitudes) a crossing bound below its depth.
+  out.slack = kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
+  out.margin = search + out.slack;
+  if (options.use_oaabb && options.triangle_level != TriangleLevel::Flat &&
+      (options.triangle_level == TriangleLevel::Bvh || out.la.size() * out.lb.size() > options.flat_limit))
+    out.tree_b.build(out.box_b);
 }
 
 std::size_t prepared_bytes(const PreparedPair& p) {
   return (p.la.size() + p.lb.size()) * sizeof(std::uint32_t) + (p.box_a.size() + p.box_b.size()) * sizeof(Aabb) +
-         p.tri_b.size() * sizeof(p.tri_b[0]);
+         p.tri_b.size() * sizeof(p.tri_b[0]) + p.tree_b.bytes();
 }
 
 namespace {
 
+// A triangle's plane for the crossing bounds: n = facet_normal, its length, and n·p0.
+struct Plane {
+  Vec3 n;
+  double length = 0.0, offset = 0.0;
+};
+inline Plane plane_of(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  Plane q;
+  q.n = facet_normal(p0, p1, p2);
+  q.length = q.n.norm();
+  q.offset = q.n.dot(p0);
+  return q;
+}
+
+// True when the heights of T's vertices over plane q prove straddle(T, P) <= limit (in lengths):
+// min(largest height above, largest below) <= limit, with `slack` covering the rounding of heights
+// taken as n·v - n·p0 here and as n·(v - p0) by the clipping. Clipping only shrinks what counts.
+inline bool cannot_straddle_beyond(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Plane& q, double limit,
+                                   double slack) {
+  const double h0 = q.n.dot(v0) - q.offset, h1 = q.n.dot(v1) - q.offset, h2 = q.n.dot(v2) - q.offset;
+  const double up = std::max(std::max(h0, h1), std::max(h2, 0.0));
+  const double down = -std::min(std::min(h0, h1), std::min(h2, 0.0));
+  return std::min(up, down) <= (limit - slack) * q.length;
+}
+
 // One run of the triangle level over a range of A's survivors: the state the candidate visits share.
 struct TriangleRun {
-  TriangleRun(const Surface& surface_a, const PreparedPair& prepared, const CollideOptions& o, PairOutcome& outcome,
-              CollideCounters& c, const Deadline* d)
-      : sa(surface_a), p(prepared), options(o), out(outcome), counters(c), deadline(d) {}
+  TriangleRun(const Surface& surface_a, const PreparedPair& prepared, std::size_t first, std::size_t last,
+              const CollideOptions& o, PairOutcome& outcome, CollideCounters& c, const Deadline* d)
+      : sa(surface_a), p(prepared), begin(first), end(last), options(o), out(outcome), counters(c), deadline(d) {}
   const Surface& sa;
   const PreparedPair& p;
+  const std::size_t begin, end;  // A's survivors la[begin, end)
   const CollideOptions& options;
   PairOutcome& out;
   CollideCounters& counters;
@@ -234,66 +256,97 @@ struct TriangleRun {
   const bool want_distance = p.margin > 0.0;
   bool done = false;
   std::uint32_t polls = 0;
-  // Normals for the penetration-only tests: A's is reused over the run of candidates with the same
-  // triangle of A, B's are kept once computed.
-  std::size_t normal_of = ~std::size_t{0};
-  Vec3 normal_a;
-  std::vector<Vec3> normals_b;
-  std::vector<char> have_normal_b;
+  // The current triangle of A (its vertices and plane), and B's planes once the run needs them (the
+  // penetration-only tests), all made at once: by then most of B's survivors take part.
+  std::size_t current = ~std::size_t{0};
+  Vec3 a0, a1, a2;
+  bool have_plane_a = false;
+  Plane plane_a;
+  std::vector<Plane> planes_b;
+  // Once the run has an intersecting pair (early exit): which candidates can still cross deeper than
+  // the current level (crossing_bound), made at the first need and again when the level rises.
+  bool bounded = false;
+  double bound_level = 0.0;
+  CrossingBound bound;
 
-  // Once the run has an intersecting pair, another can change the outcome only by raising the
-  // penetration (the maximum crossing depth; deeper than tau ends the run). A pair whose crossing
-  // depth, computed exactly as crossing_depth does, does not exceed it is skipped without the
-  // intersection test: whether it intersects changes nothing. Most candidates of a contact are
-  // decided by the plane sides alone.
-  void raise_penetration(std::size_t i, std::size_t j, const Vec3& a0, const Vec3& a1, const Vec3& a2,
-                         const std::array<Vec3, 3>& tb) {
-    if (normal_of != i) {
-      normal_a = facet_normal(a0, a1, a2);
-      normal_of = i;
-    }
-    if (normals_b.empty()) {
-      normals_b.resize(p.lb.size());
-      have_normal_b.assign(p.lb.size(), 0);
-    }
-    if (!have_normal_b[j]) {
-      normals_b[j] = facet_normal(tb[0], tb[1], tb[2]);
-      have_normal_b[j] = 1;
-    }
-    const Vec3& normal_b = normals_b[j];
-    if (!may_straddle(a0, a1, a2, tb[0], normal_b) || !may_straddle(tb[0], tb[1], tb[2], a0, normal_a)) return;
-    const double over_b = clipped_straddle(a0, a1, a2, tb[0], tb[1], tb[2], normal_b);
-    if (!(over_b > out.penetration)) return;
-    const double depth = std::min(over_b, clipped_straddle(tb[0], tb[1], tb[2], a0, a1, a2, normal_a));
-    if (!(depth > out.penetration)) return;
-    if (!triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) return;
-    out.penetration = depth;
-    if (depth > p.tau) done = true;
+  bool penetration_only() const { return out.intersecting && !all; }
+  double level() const { return out.crosses_threshold ? p.tau : p.threshold; }
+
+  // Brings the bound to the current level; when no candidate left can cross deeper than it, the
+  // outcome is settled and the run ends.
+  void update_bound() {
+    const double l = level();
+    if (bounded && bound_level == l) return;
+    bound = crossing_bound(sa.mesh, sa.analytic, p.la, begin, end, p.tri_b, l, p.slack);
+    bounded = true;
+    bound_level = l;
+    if (!bound.any) done = true;
   }
 
-  // Candidate (A's survivor i, B's survivor j).
-  void test(std::size_t i, std::size_t j) {
-    if (deadline != nullptr && (++polls & 255u) == 0 && deadline->expired()) {
-      out.cut = true;
-      done = true;
-      return;
-    }
+  // False when no candidate of A's survivor i can change the outcome any more (penetration-only).
+  bool may_cross(std::size_t i) {
+    update_bound();
+    return !done && bound.steep_a[i - begin];
+  }
+
+  void load_a(std::size_t i) {
+    if (current == i) return;
     const auto& ta = sa.mesh.triangles[p.la[i]];
-    const Vec3& a0 = sa.mesh.vertices[ta[0]];
-    const Vec3& a1 = sa.mesh.vertices[ta[1]];
-    const Vec3& a2 = sa.mesh.vertices[ta[2]];
-    const auto& tb = p.tri_b[j];
-    if (out.intersecting && !all) {
-      raise_penetration(i, j, a0, a1, a2, tb);
-      return;
+    a0 = sa.mesh.vertices[ta[0]];
+    a1 = sa.mesh.vertices[ta[1]];
+    a2 = sa.mesh.vertices[ta[2]];
+    have_plane_a = false;
+    current = i;
+  }
+
+  // An intersecting pair's crossing depth: what the flag and the penetration keep of it.
+  void note_crossing(double depth) {
+    if (depth > p.threshold) out.crosses_threshold = true;
+    if (depth > p.tau) {
+      out.penetration = std::max(out.penetration, depth);
+      if (!all) done = true;
     }
+  }
+
+  // Once the run has an intersecting pair, another can change the outcome only by crossing deeper
+  // than threshold (until one has) or tau. A pair whose crossing depth, computed exactly as
+  // crossing_depth does, cannot is skipped without the intersection test: whether it intersects
+  // changes nothing. The vertices' heights bound the depth from above (with the rounding slack), so
+  // most candidates of a contact are settled by six dot products, without clipping.
+  void raise_penetration(std::size_t j) {
+    if (planes_b.empty()) {
+      planes_b.resize(p.lb.size());
+      for (std::size_t k = 0; k < p.lb.size(); ++k) planes_b[k] = plane_of(p.tri_b[k][0], p.tri_b[k][1], p.tri_b[k][2]);
+    }
+    const double level = this->level();
+    const auto& tb = p.tri_b[j];
+    if (cannot_straddle_beyond(a0, a1, a2, planes_b[j], level, p.slack)) return;
+    if (!have_plane_a) {
+      plane_a = plane_of(a0, a1, a2);
+      have_plane_a = true;
+    }
+    if (cannot_straddle_beyond(tb[0], tb[1], tb[2], plane_a, level, p.slack)) return;
+    // The crossing depth as crossing_depth computes it (the same operations, so the same bits).
+    const Vec3& normal_b = planes_b[j].n;
+    const Vec3& normal_a = plane_a.n;
+    if (!may_straddle(a0, a1, a2, tb[0], normal_b) || !may_straddle(tb[0], tb[1], tb[2], a0, normal_a)) return;
+    const double over_b = clipped_straddle(a0, a1, a2, tb[0], tb[1], tb[2], normal_b);
+    if (!(over_b > level)) return;
+    const double depth = std::min(over_b, clipped_straddle(tb[0], tb[1], tb[2], a0, a1, a2, normal_a));
+    if (!(depth > level)) return;
+    if (!triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) return;
+    note_crossing(depth);
+  }
+
+  // Until the run has an intersecting pair (and for every pair when all are listed): the exact
+  // intersection test, and the distance while none intersects.
+  [[gnu::noinline]] void first_phase(std::size_t i, std::size_t j) {
+    const auto& tb = p.tri_b[j];
     if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
       if (!out.intersecting) out.witness = {p.la[i], p.lb[j]};
       out.intersecting = true;
-      const double depth = crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]);
-      out.penetration = std::max(out.penetration, depth);
       if (all) out.triangle_pairs.push_back({p.la[i], p.lb[j]});
-      else if (depth > p.tau) done = true;
+      note_crossing(crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]));
     } else if (!out.intersecting && want_distance) {
       // A box lower bound beyond what is already known cannot lower the minimum (slack: rounding).
       const double lower = box_distance(p.box_a[i], p.box_b[j]);
@@ -307,59 +360,43 @@ struct TriangleRun {
       }
     }
   }
-};
 
-// Sweep over x of A's survivors [begin, end) (grown by the margin) and B's; candidates are then
-// visited in the same (a, b) order as the flat loops, so both variants give the same answer. The
-// boxes are copied in sweep order so that the inner loops read memory in sequence.
-void sweep_candidates(TriangleRun& run, std::size_t begin, std::size_t end) {
-  const PreparedPair& p = run.p;
-  const std::size_t na = end - begin, nb = p.lb.size();
-  std::vector<std::uint32_t> oa(na), ob(nb);
-  for (std::size_t i = 0; i < na; ++i) oa[i] = static_cast<std::uint32_t>(begin + i);
-  for (std::size_t j = 0; j < nb; ++j) ob[j] = static_cast<std::uint32_t>(j);
-  auto by_min_a = [&](std::uint32_t x, std::uint32_t y) {
-    return p.box_a[x].min().x() < p.box_a[y].min().x() || (p.box_a[x].min().x() == p.box_a[y].min().x() && x < y);
-  };
-  auto by_min_b = [&](std::uint32_t x, std::uint32_t y) {
-    return p.box_b[x].min().x() < p.box_b[y].min().x() || (p.box_b[x].min().x() == p.box_b[y].min().x() && x < y);
-  };
-  std::sort(oa.begin(), oa.end(), by_min_a);
-  std::sort(ob.begin(), ob.end(), by_min_b);
-  const std::vector<SweepBox> sa_boxes = sweep_boxes(p.box_a, oa), sb_boxes = sweep_boxes(p.box_b, ob);
-  std::vector<std::array<std::uint32_t, 2>> cand;
-  std::size_t ia = 0, ib = 0;
-  const double m = p.margin;
-  while (ia < na && ib < nb) {
-    const SweepBox& ba = sa_boxes[ia];
-    const SweepBox& bb = sb_boxes[ib];
-    if (ba.lo[0] - m <= bb.lo[0]) {
-      for (std::size_t k = ib; k < nb && sb_boxes[k].lo[0] <= ba.hi[0] + m; ++k) {
-        ++run.counters.aabb_tests;
-        if (sweep_within(ba, sb_boxes[k], m)) cand.push_back({oa[ia], ob[k]});
-      }
-      ++ia;
+  // Candidate (A's survivor i, B's survivor j).
+  void test(std::size_t i, std::size_t j) {
+    if (deadline != nullptr && (++polls & 255u) == 0 && deadline->expired()) {
+      out.cut = true;
+      done = true;
+      return;
+    }
+    if (penetration_only()) {
+      if (!may_cross(i) || !bound.steep_b[j]) return;
+      load_a(i);
+      raise_penetration(j);
     } else {
-      for (std::size_t k = ia; k < na && sa_boxes[k].lo[0] - m <= bb.hi[0]; ++k) {
-        ++run.counters.aabb_tests;
-        if (sweep_within(sa_boxes[k], bb, m)) cand.push_back({oa[k], ob[ib]});
-      }
-      ++ib;
+      load_a(i);
+      first_phase(i, j);
     }
   }
-  // Visit in (a, b) order: a counting sort by A's triangle, then each triangle's few b's sorted.
-  std::vector<std::uint32_t> first(na + 1, 0), by_a(cand.size());
-  for (const auto& c : cand) ++first[c[0] - begin + 1];
-  for (std::size_t i = 0; i < na; ++i) first[i + 1] += first[i];
-  {
-    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-    for (const auto& c : cand) by_a[fill[c[0] - begin]++] = c[1];
+};
+
+// A's survivors [begin, end) in order, each with its candidates from B's tree, visited in (a, b)
+// order as the flat loops visit them, so both give the same answer. Once only deeper crossings can
+// change the outcome, a triangle of A that cannot take part in one is passed over unqueried.
+void tree_candidates(TriangleRun& run) {
+  const PreparedPair& p = run.p;
+  CandidateTree own;  // a pair prepared for the flat loops has none
+  if (p.tree_b.empty()) own.build(p.box_b);
+  const CandidateTree& tree = p.tree_b.empty() ? own : p.tree_b;
+  std::vector<std::uint32_t> js;
+  std::uint64_t box_tests = 0;
+  for (std::size_t i = run.begin; i < run.end && !run.done; ++i) {
+    if (run.penetration_only() && !run.may_cross(i)) continue;
+    js.clear();
+    tree.query(flat_box(p.box_a[i]), p.margin, js, box_tests);
+    if (js.size() > 1) std::sort(js.begin(), js.end());
+    for (std::size_t k = 0; k < js.size() && !run.done; ++k) run.test(i, js[k]);
   }
-  for (std::size_t i = 0; i < na && !run.done; ++i) {
-    const auto from = by_a.begin() + first[i], to = by_a.begin() + first[i + 1];
-    std::sort(from, to);
-    for (auto it = from; it != to && !run.done; ++it) run.test(begin + i, *it);
-  }
+  run.counters.aabb_tests += box_tests;
 }
 
 }  // namespace
@@ -367,7 +404,7 @@ void sweep_candidates(TriangleRun& run, std::size_t begin, std::size_t end) {
 void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
               const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
               const Deadline* deadline) {
-  TriangleRun run(sa, p, options, out, counters, deadline);
+  TriangleRun run(sa, p, begin, end, options, out, counters, deadline);
   const std::size_t na = end - begin, nb = p.lb.size();
   if (!options.use_oaabb) {
     for (std::size_t i = begin; i < end && !run.done; ++i)
@@ -380,7 +417,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
         if (boxes_within(p.box_a[i], p.box_b[j], p.margin)) run.test(i, j);
       }
   } else {
-    sweep_candidates(run, begin, end);
+    tree_candidates(run);
   }
   counters.triangle_tests += run.stats.tests;
   counters.exact_fallbacks += run.stats.exact_fallbacks;
@@ -393,6 +430,7 @@ void merge_outcome(PairOutcome& into, PairOutcome&& later) {
     into.witness = later.witness;
   into.intersecting = into.intersecting || later.intersecting;
   into.cut = into.cut || later.cut;
+  into.crosses_threshold = into.crosses_threshold || later.crosses_threshold;
   into.penetration = std::max(into.penetration, later.penetration);
   into.distance = std::min(into.distance, later.distance);
   into.triangle_pairs.insert(into.triangle_pairs.end(), later.triangle_pairs.begin(), later.triangle_pairs.end());

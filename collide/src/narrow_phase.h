@@ -4,6 +4,7 @@
 #pragma once
 
 #include "budget.h"
+#include "candidate_tree.h"
 #include "cadclash/collide.h"
 #include "surface_bvh.h"
 
@@ -16,11 +17,16 @@
 namespace cadclash::detail {
 
 struct PreparedPair {
-  double tau = 0.0;     // touching bound: tolerance + both deflections
+  double tau = 0.0;     // touching bound: tolerance + both deflections; a crossing deeper ends the run
+  // Crossings deeper than this set PairOutcome::crosses_threshold (<= tau; certified: T, where the
+  // crossing step of the decision begins; else tau).
+  double threshold = 0.0;
   double margin = 0.0;  // search margin: max(tau, clearance) plus the rounding slack
+  double slack = 0.0;   // that rounding slack: bounds any rounding of a height or box coordinate here
   std::vector<std::uint32_t> la, lb;           // surviving triangle indices of Sk and Sl, ascending
   std::vector<Aabb> box_a, box_b;              // their boxes in A's frame, parallel to la / lb
   std::vector<std::array<Vec3, 3>> tri_b;      // Sl's survivors mapped into A's frame
+  CandidateTree tree_b;  // over box_b, when the triangle level will not use the flat loops
 };
 
 // The touching bound of fast mode (and of the paper's narrow phase): tolerance + both surfaces'
@@ -37,7 +43,12 @@ inline double search_reach(const CollideOptions& o, double share_a, double share
 
 struct PairOutcome {
   bool intersecting = false;
+  // Crossing depth of an intersecting triangle pair deeper than PreparedPair::tau: the first in
+  // visiting order (EarlyExit, which stops there) or the deepest (AllTrianglePairs); 0 when no pair
+  // crosses deeper than tau. Shallower crossings are within the bands and say nothing about the
+  // exact faces: they are not measured beyond what the two flags need.
   double penetration = 0.0;
+  bool crosses_threshold = false;  // some intersecting pair crosses deeper than PreparedPair::threshold
   double distance = std::numeric_limits<double>::infinity();
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
   // The triangle pair (indices in Sk's and Sl's meshes) that decided the outcome: the first
@@ -64,8 +75,10 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
 // Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
 // Polls `deadline` (when given) every 256 triangle tests and stops with out.cut set once it expired.
 // EarlyExit mode: once the run has found an intersecting pair, a later candidate is tested for
-// intersection (and counted in triangle_tests) only if its crossing depth would raise the
-// penetration; the outcome is the same as testing every candidate (test_crossing_depth).
+// intersection (and counted in triangle_tests) only if its crossing depth could exceed threshold
+// (until one has) or tau; the vertices' heights over the other triangle's plane bound the crossing
+// depth from above, so most candidates of a touching contact need no clipping. The outcome is the
+// same as testing every candidate (test_crossing_depth).
 void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::size_t end,
               const CollideOptions& options, PairOutcome& out, CollideCounters& counters,
               const Deadline* deadline = nullptr);

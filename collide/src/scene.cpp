@@ -87,6 +87,7 @@ Report Scene::check(const CollideOptions& o) {
   detail::SceneData& s = *impl_;
   detail::QueryState q(o, std::chrono::steady_clock::now());
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  q.progress = &o.progress;
   detail::set_schedule(o.schedule);
   detail::broad_phase_stage(s, q);  // which instance pairs can meet
   q.report.timings.broad = detail::seconds_since(q.t0);

@@ -77,6 +77,8 @@ struct QueryState {
   std::chrono::steady_clock::time_point t0;
   Deadline deadline;
   int threads = 1;
+  // The check's progress callback (CheckPairs); null for check_part, which reports nothing.
+  const ProgressCallback* progress = nullptr;
   Report report;
 
   std::vector<InstancePair> pairs;

@@ -110,7 +110,7 @@ void witness_steps(Run& run) {
   // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
   // cross by round-off only, and the vertex witnesses prove those.
   run.step(run.open([&](std::size_t k) {
-             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->penetration > run.pending[k].threshold;
+             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->crosses_threshold;
            }),
            [&](std::size_t k) {
              crossing_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
@@ -261,6 +261,8 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 // ---------------------------------------------------------------------------------------------
 #include "scene_stages.h"
 
+#include "cadclash/internal/progress_meter.h"
+
 namespace cadclash::detail {
 
 void decision_stage(SceneData& s, QueryState& q) {
@@ -285,9 +287,17 @@ void decision_stage(SceneData& s, QueryState& q) {
     decide.push_back({ip.a, ip.b, t.sa, t.sb, usable ? &q.outcomes[k] : nullptr, ip.t_ab, ip.t_ba, ip.roundoff});
     task_of.push_back(k);
   }
+  // Progress: the pairs with nothing to decide are through at once, the rest when every step is.
+  ProgressMeter meter(q.progress, ProgressStage::CheckPairs, npairs, "decisions");
+  if (meter.active()) {
+    std::vector<char> open(npairs, 0);
+    for (std::size_t k : task_of) open[q.tasks[k].pair] = 1;
+    meter.add(static_cast<std::size_t>(std::count(open.begin(), open.end(), 0)));
+  }
   std::vector<DecideResult> results =
       decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
                    q.report.counters);
+  meter.finish();
   for (std::size_t i = 0; i < results.size(); ++i) {
     const std::size_t k = task_of[i];
     const std::size_t pair = q.tasks[k].pair;

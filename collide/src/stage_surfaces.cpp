@@ -4,6 +4,8 @@
 #include "decide.h"
 #include "scene_stages.h"
 
+#include "cadclash/internal/progress_meter.h"
+
 #include <omp.h>
 
 namespace cadclash::detail {
@@ -77,12 +79,15 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
 void surface_level_stage(const SceneData& s, QueryState& q) {
   const Model& model = s.model;
   const auto npairs = static_cast<std::ptrdiff_t>(q.pairs.size());
+  ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "surface level");
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (npairs >= kMinParallelPairs)
   for (std::ptrdiff_t k = 0; k < npairs; ++k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
     if (q.deadline.expired()) ip.cut = true;
     else surface_level(s, ip, q.o);
+    meter.add();
   }
+  meter.finish();
   q.charge.assign(q.pairs.size(), 0);
   q.first_task.assign(q.pairs.size() + 1, 0);
   q.first_need.assign(model.surfaces.size(), kInvalidId);

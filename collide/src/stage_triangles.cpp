@@ -4,9 +4,12 @@
 #include "decide.h"
 #include "scene_stages.h"
 
+#include "cadclash/internal/progress_meter.h"
+
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 
 namespace cadclash::detail {
 namespace {
@@ -27,29 +30,62 @@ double task_tau(const SceneData& s, const QueryState& q, const Task& t) {
   return certified_reach(a, s.eps[t.sa], b, s.eps[t.sb], q.o.tolerance, q.pairs[t.pair].roundoff);
 }
 
+// The triangle level's progress in instance pairs (CheckPairs, "triangle level"): a pair is through
+// when the last of its work items is; pairs without items are through at once. Without a progress
+// callback it does nothing.
+class PairsThrough {
+ public:
+  // pair_of(i): the instance pair of work item i < n.
+  template <class PairOf>
+  PairsThrough(const QueryState& q, std::size_t n, PairOf pair_of)
+      : meter_(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "triangle level") {
+    if (!meter_.active()) return;
+    left_ = std::vector<std::atomic<std::uint32_t>>(q.pairs.size());
+    for (std::size_t i = 0; i < n; ++i) left_[pair_of(i)].fetch_add(1, std::memory_order_relaxed);
+    std::size_t idle = 0;
+    for (const auto& l : left_) idle += l.load(std::memory_order_relaxed) == 0;
+    meter_.add(idle);
+  }
+  // One work item of instance pair `pair` finished (or was skipped); any thread.
+  void item_done(std::uint32_t pair) {
+    if (meter_.active() && left_[pair].fetch_sub(1, std::memory_order_relaxed) == 1) meter_.add();
+  }
+  void finish() { meter_.finish(); }
+
+ private:
+  ProgressMeter meter_;
+  std::vector<std::atomic<std::uint32_t>> left_;
+};
+
 void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes) {
   const Task& t = q.tasks[k];
   if (!usable(s.model, t)) return;
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
                      task_tau(s, q, t), q.prepared[k], q.task_counters[k]);
+  // Certified: the decision's crossing step asks whether the triangles cross deeper than T.
+  if (q.o.decision != DecisionMode::Fast)
+    q.prepared[k].threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
   bytes[k] = prepared_bytes(q.prepared[k]);
 }
 
 void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
+  PairsThrough through(q, ntasks, [&](std::size_t k) { return q.tasks[k].pair; });
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     if (q.deadline.expired()) {
       q.task_cut[ku] = 1;
-      continue;
+    } else {
+      prepare(s, q, ku, bytes);
+      run_pair(s.model.surfaces[q.tasks[ku].sa], q.prepared[ku], 0, q.prepared[ku].la.size(), q.o, q.outcomes[ku],
+               q.task_counters[ku], &q.deadline);
+      q.prepared[ku] = PreparedPair{};  // free the survivors as we go
     }
-    prepare(s, q, ku, bytes);
-    run_pair(s.model.surfaces[q.tasks[ku].sa], q.prepared[ku], 0, q.prepared[ku].la.size(), q.o, q.outcomes[ku],
-             q.task_counters[ku], &q.deadline);
-    q.prepared[ku] = PreparedPair{};  // free the survivors as we go
+    through.item_done(q.tasks[ku].pair);
   }
+  through.finish();
 }
 
 // Version 2 holds every survivor list at once: they are charged, and the budget applied, before the
@@ -75,6 +111,7 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
   std::vector<PairOutcome> item_out(items.size());
   std::vector<CollideCounters> item_counters(items.size());
   const auto nitems = static_cast<std::ptrdiff_t>(items.size());
+  PairsThrough through(q, items.size(), [&](std::size_t i) { return q.tasks[items[i].task].pair; });
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (nitems >= kMinParallel)
   for (std::ptrdiff_t i = 0; i < nitems; ++i) {
     const auto iu = static_cast<std::size_t>(i);
@@ -82,7 +119,9 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
     if (q.deadline.expired()) item_out[iu].cut = true;
     else run_pair(s.model.surfaces[q.tasks[it.task].sa], q.prepared[it.task], it.begin, it.end, q.o, item_out[iu],
                   item_counters[iu], &q.deadline);
+    through.item_done(q.tasks[it.task].pair);
   }
+  through.finish();
   for (std::size_t i = 0; i < items.size(); ++i) {  // fixed order: independent of the thread count
     merge_outcome(q.outcomes[items[i].task], std::move(item_out[i]));
     add(q.task_counters[items[i].task], item_counters[i]);

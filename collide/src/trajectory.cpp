@@ -1,6 +1,8 @@
 // Trajectories: CSV of per-step instance poses, replayed on a Scene.
 #include "cadclash/collide.h"
 
+#include "cadclash/internal/progress_meter.h"
+
 #include <cassert>
 #include <chrono>
 #include <charconv>
@@ -118,10 +120,15 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
   std::vector<StepResult> results;
   // The time budget covers the whole replay: each step gets what the earlier ones left.
   const auto start = std::chrono::steady_clock::now();
+  std::size_t steps = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) steps += k == 0 || rows[k].step != rows[k - 1].step;
+  detail::ProgressMeter meter(&options.progress, ProgressStage::TrajectoryStep, steps,
+                              rows.empty() ? std::string() : std::to_string(rows.front().step));
   std::size_t k = 0;
   while (k < rows.size()) {
     const std::int64_t step = rows[k].step;
     CollideOptions step_options = options;
+    step_options.progress = nullptr;  // the replay reports its steps, not the checks inside them
     if (options.time_budget_seconds > 0.0) {
       const double left = options.time_budget_seconds -
                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -135,7 +142,9 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
     }
     k = apply_trajectory_step(scene, rows, k, diagnostics, file);
     results.push_back({step, scene.check(step_options)});
+    if (meter.active()) meter.add(1, std::to_string(step));
   }
+  meter.finish();
   return results;
 }
 

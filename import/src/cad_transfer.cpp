@@ -1,7 +1,7 @@
 // Transfer ↔ bytes, and Transfer → model.
 #include "cad_transfer.h"
 
-#include "byte_io.h"
+#include "cadclash/internal/byte_io.h"
 
 #include <BinTools.hxx>
 #include <BinXCAFDrivers.hxx>

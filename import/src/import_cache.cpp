@@ -2,7 +2,7 @@
 // before use, written through a temporary file and a rename.
 #include "import_cache.h"
 
-#include "byte_io.h"
+#include "cadclash/internal/byte_io.h"
 
 #include <Standard_Version.hxx>
 #include <openssl/evp.h>

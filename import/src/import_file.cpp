@@ -11,6 +11,7 @@
 #include <chrono>
 #include <exception>
 #include <filesystem>
+#include <mutex>
 #include <system_error>
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -62,7 +63,10 @@ const char* cache_use_name(CacheUse c) {
   return "off";
 }
 
-ImportResult import_file(const std::string& path, const ImportOptions& options) {
+namespace {
+
+// One file, without its ReadFile progress; `options.tessellation.progress` gets its parts' meshing.
+ImportResult import_one(const std::string& path, const ImportOptions& options) {
   assert(options.model_tolerance >= 0.0);
   const auto start = std::chrono::steady_clock::now();
   const detail::CadWork occt_in_this_process;
@@ -83,6 +87,24 @@ ImportResult import_file(const std::string& path, const ImportOptions& options) 
   t.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   t.transfer = std::max(0.0, t.total - t.read - t.heal - t.tessellate);
   r.seconds = t.total;
+  return r;
+}
+
+// The options a file is read with: the tessellation reports to `parts` (import ignores the caller's
+// tessellation.progress: ImportOptions::progress gets every stage).
+ImportOptions with_part_progress(const ImportOptions& options, ProgressCallback parts) {
+  ImportOptions o = options;
+  o.tessellation.progress = std::move(parts);
+  return o;
+}
+
+}  // namespace
+
+ImportResult import_file(const std::string& path, const ImportOptions& options) {
+  if (!options.progress) return import_one(path, with_part_progress(options, nullptr));
+  options.progress(Progress{ProgressStage::ReadFile, 0, 1, path});
+  ImportResult r = import_one(path, with_part_progress(options, options.progress));
+  options.progress(Progress{ProgressStage::ReadFile, 1, 1, path});
   return r;
 }
 
@@ -120,12 +142,31 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
   // Release builds (glibc's fork-safe allocator) read them in parallel.
   threads = 1;
 #endif
+  // Progress from the threads reading files, one call at a time: each file as it starts and ends
+  // (ReadFile, done = files finished), its parts as they are meshed (TessellatePart).
+  std::mutex progress_lock;
+  std::size_t finished = 0;
+  auto file_progress = [&](const std::string& path, bool ended) {
+    if (!options.progress) return;
+    const std::lock_guard<std::mutex> hold(progress_lock);
+    finished += ended ? 1 : 0;
+    options.progress(Progress{ProgressStage::ReadFile, finished, paths.size(), path});
+  };
+  ProgressCallback part_progress;
+  if (options.progress)
+    part_progress = [&](const Progress& p) {
+      const std::lock_guard<std::mutex> hold(progress_lock);
+      options.progress(p);
+    };
+  const ImportOptions file_options = with_part_progress(options, part_progress);
   // One file per thread at a time; OpenMP regions inside a file's import then run on that thread.
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(paths.size()); ++k) {
     const auto i = static_cast<std::size_t>(k);
     try {
-      each[i] = import_file(paths[i], options);
+      file_progress(paths[i], false);
+      each[i] = import_one(paths[i], file_options);
+      file_progress(paths[i], true);
     } catch (...) {
       failed[i] = std::current_exception();  // bad_alloc and the like: thrown again below
     }

@@ -1,5 +1,5 @@
 // One file's ImportResult as bytes and back: the contents of an import cache entry.
-#include "byte_io.h"
+#include "cadclash/internal/byte_io.h"
 #include "import_cache.h"
 
 namespace cadclash::detail {

@@ -1,6 +1,8 @@
 // add_brep_parts: B-rep shapes into parts and surfaces (healing, exact boxes, eager tessellation).
 #include "brep_internal.h"
 
+#include "cadclash/internal/progress_meter.h"
+
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepLib.hxx>
@@ -301,12 +303,17 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   if (timings) timings->heal += seconds_since(heal_start);
 
   const Clock::time_point mesh_start = Clock::now();
-  if (!lazy)
+  if (!lazy) {
+    detail::ProgressMeter meter(&options.progress, ProgressStage::TessellatePart, parts.size(),
+                                parts.empty() ? std::string() : parts.front().name);
     for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
       PartWork& w = work[k];
       if (!w.surfaces.empty())
         mesh_faces(*w.impl, w.deflection, options, deadline, w.surfaces, w.diagnostics, w.complete);
+      meter.add(1, parts[k].name);
     });
+    meter.finish();
+  }
   if (timings) timings->tessellate += seconds_since(mesh_start);
 
   std::vector<PartId> ids;

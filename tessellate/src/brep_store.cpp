@@ -1,6 +1,8 @@
 // save_brep_source / load_brep_source: a B-rep part's source as bytes, for the import cache.
 #include "brep_internal.h"
 
+#include "cadclash/internal/byte_io.h"
+
 #include <BRep_Builder.hxx>
 #include <BinTools.hxx>
 #include <Standard_Failure.hxx>
@@ -10,8 +12,6 @@
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Iterator.hxx>
 
-#include <bit>
-#include <cstring>
 #include <sstream>
 
 namespace cadclash {
@@ -20,55 +20,12 @@ namespace {
 // "CCBREP" and the layout's version: bumped whenever the fields below change.
 constexpr std::uint64_t kMagic = 0x0001'5045'5242'4343ULL;
 
-struct Out {
-  std::string bytes;
-  void u64(std::uint64_t v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
-  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  void str(const std::string& s) {
-    u64(s.size());
-    bytes += s;
-  }
-};
-
-struct In {
-  std::string_view bytes;
-  std::size_t at = 0;
-  bool ok = true;
-  std::uint64_t u64() {
-    std::uint64_t v = 0;
-    if (bytes.size() - at < sizeof v) {
-      ok = false;
-      return 0;
-    }
-    std::memcpy(&v, bytes.data() + at, sizeof v);
-    at += sizeof v;
-    return v;
-  }
-  double f64() { return std::bit_cast<double>(u64()); }
-  std::string str() {
-    const std::uint64_t n = u64();
-    if (!ok || bytes.size() - at < n) {
-      ok = false;
-      return {};
-    }
-    std::string s(bytes.substr(at, n));
-    at += n;
-    return s;
-  }
-  // A count of items of at least `item_bytes` each that the rest of the bytes can hold.
-  std::uint64_t count(std::size_t item_bytes) {
-    const std::uint64_t n = u64();
-    if (n > (bytes.size() - at) / item_bytes) ok = false;
-    return ok ? n : 0;
-  }
-};
-
 }  // namespace
 
 std::string save_brep_source(const BrepSource& source) {
   const BrepSource::Impl& impl = *source.impl_;
   const std::shared_lock<std::shared_mutex> lock(impl.mutex);
-  Out o;
+  detail::ByteWriter o;
   o.u64(kMagic);
   o.str(impl.part_name);
   o.str(impl.source_file);
@@ -94,11 +51,11 @@ std::string save_brep_source(const BrepSource& source) {
   std::ostringstream shape;
   BinTools::Write(compound, shape, Standard_True, Standard_True, BinTools_FormatVersion_CURRENT);
   o.str(shape.str());
-  return std::move(o.bytes);
+  return std::move(o.out);
 }
 
 std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why) {
-  In in{bytes};
+  detail::ByteReader in{bytes};
   if (in.u64() != kMagic || !in.ok) {
     why = "not a stored B-rep part of this version";
     return nullptr;

@@ -74,7 +74,9 @@ TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
     const Pose pa = random_pose(rng, offset);
     Pose pb = pa;
     pb.translation() += Vec3(3, 4, 5);
-    if (offset <= 1e6) EXPECT_LT(pair_roundoff(pa, pb, mag_a, mag_b), 1e-8) << "offset " << offset;
+    if (offset <= 1e6) {
+      EXPECT_LT(pair_roundoff(pa, pb, mag_a, mag_b), 1e-8) << "offset " << offset;
+    }
   }
   std::printf("worst error / bound: %.3g\n", worst_ratio);
 }

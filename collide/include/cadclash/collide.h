@@ -12,7 +12,9 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -31,7 +33,8 @@ namespace cadclash {
 //    more into B's frame (the paper's single update). Surfaces meeting it survive (msA, msB).
 // 3. Surface level: surviving pairs whose boxes (in A's frame) overlap → surface-pair OAABB.
 // 4. Triangle level: each surface's BVH (built once) is queried under the surface-pair OAABB on both
-//    sides (mpSk, mpSl); candidate triangle pairs come from a sweep over the survivors, or from the
+//    sides (mpSk, mpSl); candidate triangle pairs come from a tree over Sl's survivors queried by
+//    each survivor of Sk in turn (so a surface pair whose outcome is settled stops making them), or from the
 //    paper's flat double loop for small lists.
 // 5. Exact test (triangles_intersect; float filter + exact fallback) and, while no intersection is
 //    found, triangle–triangle distance.
@@ -157,12 +160,55 @@ const char* schedule_name(Schedule s);
 
 // How candidate triangle pairs are formed under the surface-pair OAABB.
 enum class TriangleLevel : std::uint8_t {
-  Auto,  // flat loops when |survivors of Sk| * |survivors of Sl| <= flat_limit, else the BVH + sweep
+  Auto,  // flat loops when |survivors of Sk| * |survivors of Sl| <= flat_limit, else the BVH + tree
   Flat,  // the paper's loops: every triangle of Sk against every triangle of Sl, box test first
-  Bvh,   // per-surface BVH queried under the OAABB, candidate pairs by a sweep over the survivors
+  Bvh,   // per-surface BVH queried under the OAABB, candidate pairs from a tree over Sl's survivors
 };
 // Returns "auto", "flat" or "bvh".
 const char* triangle_level_name(TriangleLevel t);
+
+// ---------------------------------------------------------------------------------------------
+// Progress of long work
+// ---------------------------------------------------------------------------------------------
+// An import (import.h), the eager tessellation of B-rep parts (tessellate.h), a check and a
+// trajectory replay tell an optional callback how far they are, for a progress display such as the
+// command line's status line. Library code never prints. An empty callback (the default) costs one
+// test per work item and nothing else; a callback never changes a result (reports are byte-identical
+// with and without one).
+//
+// Each run of a stage makes calls with done rising from 0 to total: a first call with done = 0 as
+// it starts, calls as items finish (at most one per whole percent of total, so a callback is cheap
+// whatever the number of items), and a last call with done == total when it ends (also when a
+// budget cut it short: skipped items count as finished); the first call with done == total is the
+// run's last (so a run of total 0 is one call). Calls never overlap. The callback must not
+// throw and must not use the object that is reporting (the Scene, the Model being imported).
+enum class ProgressStage : std::uint8_t {
+  ReadFile,        // import: files finished of the files given; label: the file (as given) that
+                   // started or finished last. One run per import_file / import_files call.
+  TessellatePart,  // eager B-rep tessellation: parts meshed of one file's (one add_brep_parts call's)
+                   // parts; label: the name of a part meshed last. None when lazy or read from the cache.
+  CheckPairs,      // Scene::check: instance pairs (of the broad phase's) through one step of the query;
+                   // label: the step, "surface level", then "triangle level", then "decisions" (a run
+                   // each, done starting at 0 again; the decisions count the pairs with nothing to
+                   // decide at once and the rest when every decision step is done).
+  TrajectoryStep,  // replay_trajectory: steps checked of the trajectory's steps; label: the number of
+                   // the step checked last (the first step's as it starts). The checks of the steps
+                   // do not report CheckPairs.
+};
+// Returns "read file", "tessellate part", "check instance pairs" or "trajectory step".
+const char* progress_stage_name(ProgressStage s);
+
+struct Progress {
+  ProgressStage stage = ProgressStage::ReadFile;
+  std::size_t done = 0;   // items finished, 0 <= done <= total, never falling within a run
+  std::size_t total = 0;  // items of this run of the stage
+  std::string label;      // what it is working on (see ProgressStage)
+};
+
+// Called by a long operation as it goes (see above). Threads: collide (check, replay) calls it only
+// on the thread that called the query; tessellation on the thread that called add_brep_parts; an
+// import on the threads reading files (import_files with parallel_files > 1: several, one at a time).
+using ProgressCallback = std::function<void(const Progress&)>;
 
 struct CollideOptions {
   double tolerance = 0.0;         // contact tolerance t, mm (>= 0)
@@ -190,6 +236,9 @@ struct CollideOptions {
   //   Structures a previous check() of the same Scene built are not counted again.
   double time_budget_seconds = 0.0;
   std::size_t memory_budget_bytes = 0;
+  // Told how far check() (CheckPairs) and replay_trajectory() (TrajectoryStep) are; empty = nothing.
+  // The split forms (Scene::plan, check_part, cadclash/distributed.h) do not call it.
+  ProgressCallback progress;
 };
 
 // Counters of one query, summed over instance pairs (the paper's Table 2). They depend on the options
@@ -205,7 +254,7 @@ struct CollideCounters {
   std::uint64_t triangles_b = 0;          // mpSl
   std::uint64_t triangle_tests = 0;       // exact triangle intersection tests (EarlyExit: after a surface
                                           // pair's first intersecting triangle pair, only pairs whose
-                                          // crossing depth could raise its penetration are tested)
+                                          // crossing depth could exceed T or τ are tested)
   std::uint64_t exact_fallbacks = 0;      // tests the float filter could not decide
   std::uint64_t distance_tests = 0;       // triangle distance computations
   std::uint64_t intersecting_pairs = 0;   // surface pairs with at least one intersecting triangle pair
@@ -236,7 +285,12 @@ struct SurfacePairResult {
   bool intersecting = false;  // some triangle pair intersects exactly
   double distance = 0.0;      // min triangle distance; 0 when intersecting; for Containment, the min
                               // distance when within the search margin, else +infinity
-  double penetration = 0.0;   // crossing-depth estimate (see above); in EarlyExit mode a lower bound
+  // Crossing depth (see above) of a triangle pair crossing deeper than τ (certified: T + δa + δb + r),
+  // the depth that makes the pair penetrating: in EarlyExit mode the first such pair in visiting
+  // order (a lower bound of the deepest), in AllTrianglePairs mode the deepest. 0 when no triangle
+  // pair crosses deeper: shallower crossings are within the tessellation bands and say nothing about
+  // the exact faces, so they are neither reported nor, past the first one, measured.
+  double penetration = 0.0;
   DecidedBy decided_by = DecidedBy::Mesh;
   // Bounds on the exact face distance d* from the evidence that decided the pair (see "Certified
   // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].

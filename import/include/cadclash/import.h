@@ -88,6 +88,13 @@ struct ImportOptions {
   // import_files: how many files are read at once (each in its own thread, a CAD file's isolated reader
   // in its own process); 0 = one per OpenMP thread (omp_get_max_threads). The result does not depend on it.
   int parallel_files = 0;
+  // Told how far the import is (collide.h, "Progress of long work"): ReadFile as each file starts
+  // and ends (done = files finished), and TessellatePart as each B-rep part of a file is meshed
+  // (eager import of a file not in the cache; one run per file). Calls never overlap; with
+  // parallel_files > 1 they come from the threads reading files, and one file's TessellatePart run
+  // may be interleaved with another's. Isolated readers' child processes never call it. Empty =
+  // nothing; tessellation.progress is ignored (this one gets every stage). Never part of the cache key.
+  ProgressCallback progress;
 };
 
 // Where one file's import spent its time, seconds of wall clock on the thread that read it.

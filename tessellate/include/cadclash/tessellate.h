@@ -44,6 +44,10 @@ struct TessellationOptions {
   // each face left without triangles keeps its surface and gets an error naming it and the limit.
   // Lazy tessellation (triangulate, require_triangles) is not limited.
   double time_limit_seconds = 0.0;
+  // Told how far add_brep_parts' eager meshing is (TessellatePart: parts of that call meshed, label
+  // the part's name; collide.h, "Progress of long work"), on the thread that called it; empty =
+  // nothing. Import ignores it and reports through ImportOptions::progress.
+  ProgressCallback progress;
 };
 
 // Named settings a user understands, like Mayo's and FreeCAD's mesh quality choices.

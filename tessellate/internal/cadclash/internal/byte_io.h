@@ -1,5 +1,10 @@
-// Plain little binary records: what the isolated reader's child sends back (cad_transfer.h) and
-// what an import cache entry holds (import_cache.h). Internal to cadclash::import.
+// cadclash/internal/byte_io.h — plain little binary records (native-endian 64-bit integers, doubles
+// by their bits, strings as a length and the bytes): a stored B-rep part (save_brep_source), what the
+// isolated reader's child sends back (import's cad_transfer.h) and what an import cache entry holds
+// (import_cache.h). Internal to cadclash, shared by tessellate and import (their CMakeLists add
+// tessellate/internal to their private include path); not installed, not API. Changing a layout here
+// changes the bytes of cache entries: bump the cache format version (import_cache.cpp) and the
+// stored B-rep part's magic (brep_store.cpp).
 #pragma once
 
 #include <bit>

@@ -1,0 +1,199 @@
+#include "crossing_bound.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace cadclash::detail {
+namespace {
+
+Vec3 normal_of(const Vec3& p0, const Vec3& p1, const Vec3& p2) { return (p1 - p0).cross(p2 - p0); }
+
+// The core and its r (crossing_bound.h): a plane (u unit, offset c), a line (point, unit direction)
+// or a point.
+struct Core {
+  enum Kind { Plane, Line, Point } kind = Plane;
+  Vec3 origin = Vec3::Zero(), dir = Vec3::UnitZ();
+  double offset = 0.0;
+
+  // The vector from the core to v (line: perpendicular to it; plane: unused).
+  Vec3 rho(const Vec3& v) const {
+    const Vec3 q = v - origin;
+    return kind == Line ? Vec3(q - q.dot(dir) * dir) : q;
+  }
+};
+
+// One triangle's share: the range of r over it, and c (0 when no side of it is bounded).
+struct Share {
+  double lo = 0.0, hi = 0.0, c = 0.0;
+};
+
+Share share(const Core& core, const std::array<Vec3, 3>& t) {
+  Share s;
+  const Vec3 n = normal_of(t[0], t[1], t[2]);
+  const double len = n.norm();
+  if (core.kind == Core::Plane) {
+    const double h0 = core.dir.dot(t[0]) - core.offset, h1 = core.dir.dot(t[1]) - core.offset,
+                 h2 = core.dir.dot(t[2]) - core.offset;
+    s.lo = std::min({h0, h1, h2});
+    s.hi = std::max({h0, h1, h2});
+    s.c = len > 0.0 ? std::abs(n.dot(core.dir)) / len : 0.0;
+    return s;
+  }
+  const Vec3 r0 = core.rho(t[0]), r1 = core.rho(t[1]), r2 = core.rho(t[2]);
+  s.hi = std::max({r0.norm(), r1.norm(), r2.norm()});
+  if (len > 0.0 && s.hi > 0.0) {
+    // u·ρ is linear over the triangle, so on a side where it stays positive it bounds |ρ| = r from
+    // below there too: r's minimum without a point–triangle distance.
+    const Vec3 u = n / len;
+    const double out = std::min({u.dot(r0), u.dot(r1), u.dot(r2)});
+    const double in = std::min({-u.dot(r0), -u.dot(r1), -u.dot(r2)});
+    if (out > 0.0 || in > 0.0) {
+      s.lo = std::max(out, in);
+      s.c = s.lo / s.hi;
+      return s;
+    }
+  }
+  s.lo = point_triangle_distance(Vec3::Zero(), r0, r1, r2);  // r's minimum: the core to the triangle
+  return s;
+}
+
+// The steep sets for one core, or nullopt when the shell is too thick for it to say anything.
+std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::array<Vec3, 3>>& ta,
+                                       const std::vector<std::array<Vec3, 3>>& tb, double level, double slack) {
+  std::vector<Share> sa(ta.size()), sb(tb.size());
+  double lo_a = std::numeric_limits<double>::infinity(), hi_a = -lo_a, lo_b = lo_a, hi_b = -lo_a;
+  for (std::size_t i = 0; i < ta.size(); ++i) {
+    sa[i] = share(core, ta[i]);
+    lo_a = std::min(lo_a, sa[i].lo), hi_a = std::max(hi_a, sa[i].hi);
+  }
+  for (std::size_t j = 0; j < tb.size(); ++j) {
+    sb[j] = share(core, tb[j]);
+    lo_b = std::min(lo_b, sb[j].lo), hi_b = std::max(hi_b, sb[j].hi);
+  }
+  // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: straddle(X over Y)
+  // <= (hi_a - lo_b) / c_Y and straddle(Y over X) <= (hi_b - lo_a) / c_X. The shell's ends and the
+  // foot points carry the rounding of r (slack each), the depth its own.
+  const double room = level - slack;
+  const double d_ab = std::max(0.0, hi_a - lo_b) + 2.0 * slack, d_ba = std::max(0.0, hi_b - lo_a) + 2.0 * slack;
+  const double grow = 1.0 + 1e-9;
+  double kappa_a, kappa_b;  // a triangle is steep below these
+  if (core.kind == Core::Plane) kappa_a = kappa_b = std::min(d_ab, d_ba) / room * grow;
+  else kappa_a = d_ba / room * grow, kappa_b = d_ab / room * grow;
+  if (!(kappa_a < 1.0) && !(kappa_b < 1.0)) return std::nullopt;
+  CrossingBound b;
+  b.steep_a.resize(ta.size());
+  b.steep_b.resize(tb.size());
+  bool any_a = false, any_b = false;
+  for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(sa[i].c >= kappa_a)) != 0;
+  for (std::size_t j = 0; j < tb.size(); ++j) any_b |= (b.steep_b[j] = !(sb[j].c >= kappa_b)) != 0;
+  b.any = any_a && any_b;
+  return b;
+}
+
+// The plane of A's largest triangle (the first of equal ones); nullopt when none has an area.
+std::optional<Core> plane_core(const std::vector<std::array<Vec3, 3>>& ta) {
+  std::size_t best = 0;
+  double best_area = 0.0;
+  for (std::size_t i = 0; i < ta.size(); ++i) {
+    const double a = normal_of(ta[i][0], ta[i][1], ta[i][2]).squaredNorm();
+    if (a > best_area) best_area = a, best = i;
+  }
+  if (!(best_area > 0.0)) return std::nullopt;
+  Core core;
+  core.dir = normal_of(ta[best][0], ta[best][1], ta[best][2]).normalized();
+  core.offset = core.dir.dot(ta[best][0]);
+  return core;
+}
+
+// An axis fitted to A's triangles (a face of revolution without its analytic form): the direction
+// their normals avoid, through the point nearest to their normal lines. Any line is a valid core;
+// a good one only makes the shell thin.
+std::optional<Core> fitted_axis(const std::vector<std::array<Vec3, 3>>& ta) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  Vec3 mean = Vec3::Zero();
+  double weight = 0.0;
+  for (const auto& t : ta) {
+    const Vec3 n = normal_of(t[0], t[1], t[2]);
+    const double len = n.norm();
+    if (!(len > 0.0)) continue;
+    m += n * n.transpose() / len;
+    mean += len * (t[0] + t[1] + t[2]) / 3.0;
+    weight += len;
+  }
+  if (!(weight > 0.0)) return std::nullopt;
+  mean /= weight;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(1) > 1e-3 * eig.eigenvalues()(2))) return std::nullopt;
+  const Vec3 d = eig.eigenvectors().col(0).normalized();
+  Eigen::Matrix3d lhs = weight * d * d.transpose();
+  Vec3 rhs = weight * d * d.dot(mean);
+  for (const auto& t : ta) {
+    const Vec3 n = normal_of(t[0], t[1], t[2]);
+    const double len = n.norm();
+    if (!(len > 0.0)) continue;
+    const Vec3 u = n / len;
+    const Eigen::Matrix3d proj = Eigen::Matrix3d::Identity() - u * u.transpose();
+    lhs += len * proj;
+    rhs += len * proj * ((t[0] + t[1] + t[2]) / 3.0);
+  }
+  const Vec3 origin = lhs.ldlt().solve(rhs);
+  if (!origin.allFinite()) return std::nullopt;
+  Core core;
+  core.kind = Core::Line;
+  core.origin = origin;
+  core.dir = d;
+  return core;
+}
+
+}  // namespace
+
+CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& core_a,
+                             const std::vector<std::uint32_t>& la, std::size_t begin, std::size_t end,
+                             const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack) {
+  std::vector<std::array<Vec3, 3>> ta(end - begin);
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto& t = mesh_a.triangles[la[i]];
+    ta[i - begin] = {mesh_a.vertices[t[0]], mesh_a.vertices[t[1]], mesh_a.vertices[t[2]]};
+  }
+  CrossingBound fallback;
+  fallback.steep_a.assign(ta.size(), 1);
+  fallback.steep_b.assign(tri_b.size(), 1);
+  fallback.any = !ta.empty() && !tri_b.empty();
+  if (!fallback.any || !(level > slack)) return fallback;  // no room: everything may cross
+  // Cores, the likeliest first: A's own analytic axis or centre; for a plane a plane; for another
+  // face a fitted axis, then the plane of its largest triangle.
+  std::optional<CrossingBound> best;
+  auto steep_pairs = [](const CrossingBound& b) {
+    std::size_t na = 0, nb = 0;
+    for (char s : b.steep_a) na += s != 0;
+    for (char s : b.steep_b) nb += s != 0;
+    return na * nb;
+  };
+  auto consider = [&](const std::optional<Core>& c) {
+    if (!c) return false;
+    std::optional<CrossingBound> b = bound_for(*c, ta, tri_b, level, slack);
+    if (b && (!best || steep_pairs(*b) < steep_pairs(*best))) best = std::move(b);
+    return best && !best->any;
+  };
+  switch (core_a.shape) {
+    case SurfaceShape::Cylinder:
+    case SurfaceShape::Sphere: {
+      Core c;
+      c.kind = core_a.shape == SurfaceShape::Cylinder ? Core::Line : Core::Point;
+      c.origin = core_a.origin;
+      c.dir = core_a.axis.normalized();
+      consider(c);
+      break;
+    }
+    case SurfaceShape::Plane: consider(plane_core(ta)); break;
+    default:
+      if (!consider(fitted_axis(ta))) consider(plane_core(ta));
+  }
+  return best ? *best : fallback;
+}
+
+}  // namespace cadclash::detail
