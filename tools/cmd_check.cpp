@@ -255,6 +255,7 @@ struct Runner {
   std::function<std::vector<StepResult>(std::span<const TrajectoryRow>, const CollideOptions&, std::vector<Diagnostic>&,
                                         const std::string&)>
       replay;
+  std::function<void()> before_html;  // makes the model whole for the 3D view, when it is not
 };
 
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
@@ -358,6 +359,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
       return kExitInputError;
     }
   }
+  if (primary && !o.html.empty() && runner.before_html) runner.before_html();
   if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
     return kExitInputError;
   if (input_error) return kExitInputError;
@@ -377,6 +379,9 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
   if (!sel) return kExitInputError;
   const CollideOptions copt = collide_options(o);
   Scene scene(m, *sel);
+#if CADCLASH_HAS_MPI
+  if (mpi != nullptr) mpi->note_parts(scene);
+#endif
   // A progress line for each query or replay, gone before its results are printed (never under mpirun).
   const bool progress = show_progress(o.in.quiet);
   auto with_progress = [](CollideOptions c, ProgressLine& line) {
@@ -391,7 +396,8 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
                     const std::string& file) {
                   ProgressLine line(progress, std::cerr);
                   return replay_trajectory(scene, r, with_progress(c, line), ds, file);
-                }};
+                },
+                {}};
   bool primary = true;
 #if CADCLASH_HAS_MPI
   if (mpi != nullptr) {
@@ -399,10 +405,30 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
     runner.check = [&](const CollideOptions& c) { return mpi->check(scene, m, c); };
     runner.replay = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
                         const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
+    runner.before_html = [&] { mpi->mesh_every_part(m); };
   }
 #endif
   return finish_check(o, imported, rows, runner, scene, copt, primary, review);
 }
+
+#if CADCLASH_HAS_MPI
+// Part meshing (cmd_check_mpi.h) on what the import read without triangles, printing `messages` (what
+// it said); when part meshing cannot give the eager import's model, every rank imports eagerly.
+void mesh_parts_or_import(const CheckOptions& o, ImportResult& imported, const std::string& messages, MpiCheck& mpi) {
+  std::optional<SceneSelection> sel;
+  {
+    std::ostringstream quiet;  // check_imported says why a selection fails
+    std::streambuf* err = std::cerr.rdbuf(quiet.rdbuf());
+    sel = scene_selection(imported.model, o);
+    std::cerr.rdbuf(err);
+  }
+  if (sel && mpi.mesh_parts_where_needed(imported.model, *sel, collide_options(o))) {
+    std::cerr << messages;
+    return;
+  }
+  imported = import_inputs(o.in);
+}
+#endif
 
 int run_check(const CheckOptions& o, const Launch& launch) {
   if (!o.html.empty() && !html_report_available()) {
@@ -417,7 +443,21 @@ int run_check(const CheckOptions& o, const Launch& launch) {
   // Before the import: a bad baseline or approvals file should not cost a long import first.
   const std::optional<ReviewInputs> review = load_review_inputs(o.review, !o.path_csv.empty());
   if (!review) return kExitInputError;
-  ImportResult imported = import_inputs(o.in);
+  // Under mpirun an eager check reads the B-rep without triangles and meshes whole parts where the
+  // ranks' shares need them (part meshing, cmd_check_mpi.h); what that import says on stderr waits
+  // until it is known to stand.
+  const bool by_parts = CADCLASH_HAS_MPI && launch.by_mpirun && !o.in.lazy && o.in.import_time_limit <= 0.0;
+  std::ostringstream import_messages;
+  ImportResult imported;
+  if (by_parts) {
+    InputOptions lazy = o.in;
+    lazy.lazy = true;
+    std::streambuf* err = std::cerr.rdbuf(import_messages.rdbuf());
+    imported = import_inputs(lazy);
+    std::cerr.rdbuf(err);
+  } else {
+    imported = import_inputs(o.in);
+  }
   std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
   if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
 #if CADCLASH_HAS_MPI
@@ -426,7 +466,11 @@ int run_check(const CheckOptions& o, const Launch& launch) {
     // rank must have read the same input before any collective, or the ranks would wait for each other.
     MpiCheck mpi;
     const std::string trajectory = rows ? std::to_string(rows->size()) + " trajectory rows" : "unreadable trajectory";
-    if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) return kExitInputError;
+    if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) {
+      std::cerr << import_messages.str();
+      return kExitInputError;
+    }
+    if (by_parts) mesh_parts_or_import(o, imported, import_messages.str(), mpi);
     const int code = rows ? check_imported(o, imported, *rows, *review, &mpi) : kExitInputError;
     if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
     return mpi.agree(code);

@@ -1,6 +1,7 @@
 #include "cmd_check_mpi.h"
 
 #include "cadclash/distributed.h"
+#include "cadclash/tessellate.h"
 
 #include <sys/resource.h>
 
@@ -46,6 +47,8 @@ struct MpiCheck::State {
   // One history for every check() of the scene (--repeat): what an earlier query tessellated or
   // built is not counted again, as in one process.
   std::optional<MergeHistory> history;
+  std::optional<PartMeshing> parts;  // part meshing, when mesh_parts_where_needed set it up
+  PartMeshing* part_meshing() { return parts ? &*parts : nullptr; }
   void add(const std::vector<RankStats>& r, double merge) {
     merge_seconds += merge;
     if (ranks.empty()) {
@@ -88,9 +91,39 @@ bool MpiCheck::same_input_everywhere(const Model& model, const std::vector<Diagn
   return same;
 }
 
+bool MpiCheck::mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options) {
+  PartMeshing pm;
+  pm.mesher.mesh = [&model](std::span<const PartId> parts) {
+    std::vector<Diagnostic> errors;
+    bool complete = true;
+    tessellate_parts(model, parts, errors, complete);
+    return errors.empty() && complete;
+  };
+  pm.mesher.release = [&model](std::span<const PartId> parts) { release_part_triangles(model, parts); };
+  bool ok = false;
+  {
+    Scene boxes(model, selection);
+    ok = share_part_facts(boxes, model, options, brep_parts_share_edges(model), pm, MPI_COMM_WORLD);
+  }
+  if (ok) state_->parts = std::move(pm);
+  return ok;
+}
+
+void MpiCheck::note_parts(Scene& scene) {
+  if (state_->parts) note_surface_facts(scene, *state_->parts);
+}
+
+void MpiCheck::mesh_every_part(Model& model) {
+  if (!state_->parts) return;
+  std::vector<PartId> all(model.parts.size());
+  for (PartId p = 0; p < all.size(); ++p) all[p] = p;
+  state_->parts->mesher.mesh(all);  // a failure would have shown in mesh_parts_where_needed
+}
+
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
   if (!state_->history) state_->history.emplace(model.surfaces.size(), scene.memory());
-  DistributedCheck c = check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD);
+  DistributedCheck c =
+      check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD, state_->part_meshing());
   state_->add(c.ranks, c.merge_seconds);
   return std::move(c.report);
 }
@@ -98,7 +131,8 @@ Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options
 std::vector<StepResult> MpiCheck::replay(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                          const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                          const std::string& file) {
-  DistributedReplay r = replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD);
+  DistributedReplay r =
+      replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD, state_->part_meshing());
   state_->add(r.ranks, r.merge_seconds);
   return std::move(r.steps);
 }
@@ -112,8 +146,10 @@ void MpiCheck::print_ranks(std::ostream& os) const {
        << s.cost << "), " << s.triangles << " triangles, " << std::fixed << std::setprecision(3) << s.seconds
        << " s (CPU " << s.cpu_seconds << " s; plan " << s.plan_seconds << " s), peak memory " << std::setprecision(1)
        << static_cast<double>(s.peak_memory_bytes) / (1024.0 * 1024.0) << " MiB, results "
-       << static_cast<double>(s.result_bytes) / 1024.0 << " KiB\n"
-       << std::defaultfloat;
+       << static_cast<double>(s.result_bytes) / 1024.0 << " KiB; model triangles held " << s.held_triangles;
+    if (state_->parts)
+      os << ", meshed here " << s.meshed_triangles << " of the model's " << s.model_triangles;
+    os << '\n' << std::defaultfloat;
     slowest = std::max(slowest, s.seconds);
     sum += s.seconds;
   }

@@ -66,6 +66,16 @@ class MpiCheck {
   // stderr which rank read what (a file missing or different on its host).
   // `extra`: what else every rank read (the trajectory), in words.
   bool same_input_everywhere(const Model& model, const std::vector<Diagnostic>& diagnostics, const std::string& extra);
+  // Part meshing (cadclash/distributed.h): `model` was imported without triangles (lazily) for a
+  // check that asked for an eager import, and every rank now meshes (tessellate_parts) the parts it
+  // owns and learns the other parts' facts; check() and replay() then mesh on each rank the parts its
+  // share reaches. Collective. False on every rank when that cannot give the eager import's model (a
+  // face that does not mesh, parts sharing edges): import eagerly then.
+  bool mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options);
+  // With part meshing: the checking scene (built after mesh_parts_where_needed) told the facts.
+  void note_parts(Scene& scene);
+  // With part meshing: every part not meshed here meshed now (rank 0, before the HTML report).
+  void mesh_every_part(Model& model);
   // Scene::check split over the ranks; the merged report on rank 0 (empty elsewhere).
   Report check(Scene& scene, Model& model, const CollideOptions& options);
   // replay_trajectory split over the ranks; the steps on rank 0.
@@ -73,8 +83,9 @@ class MpiCheck {
                                  const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                  const std::string& file);
   // Rank 0: one line per rank (instance pairs, estimated cost, triangles, seconds, peak memory at the
-  // end of its part, bytes sent), rank 0's peak after merging and writing, and the load imbalance
-  // and merge time, over the queries run so far.
+  // end of its part, bytes sent, triangles its model holds and, with part meshing, the triangles it
+  // meshed of the model's), rank 0's peak after merging and writing, and the load imbalance and merge
+  // time, over the queries run so far.
   void print_ranks(std::ostream& os) const;
   // Rank 0's exit code, on every rank.
   int agree(int code);

@@ -40,6 +40,7 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   bvh_ready.assign(model.surfaces.size(), 0);
   refined.resize(model.surfaces.size());
   noted_deflection.assign(model.surfaces.size(), -1.0);
+  noted_triangles.assign(model.surfaces.size(), kUntessellatedCost);
   in_a.assign(n, selection.set_a.empty() ? 1 : 0);
   in_b.assign(n, selection.set_b.empty() ? 1 : 0);
   for (InstanceId i : selection.set_a) {

@@ -39,6 +39,7 @@ struct SceneData {
   std::vector<char> in_a, in_b;
   // Per surface: the deflection another process tessellated it at (Scene::note_deflection); < 0: none.
   std::vector<double> noted_deflection;
+  std::vector<std::uint64_t> noted_triangles;  // ... and into how many triangles (plan costs)
   std::set<std::pair<InstanceId, InstanceId>> excluded;
   std::unordered_map<std::string, InstanceId> by_path;
 

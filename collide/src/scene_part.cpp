@@ -12,7 +12,8 @@ namespace {
 
 std::uint64_t triangles_of(const detail::SceneData& s, SurfaceId sid) {
   const Surface& surf = s.model.surfaces[sid];
-  return surf.has_triangles ? surf.mesh.triangles.size() : kUntessellatedCost;
+  if (surf.has_triangles) return surf.mesh.triangles.size();
+  return s.noted_deflection[sid] >= 0.0 ? s.noted_triangles[sid] : kUntessellatedCost;
 }
 
 // Each pair's estimated cost (PlannedPair::cost) from its candidate surface pairs.
@@ -124,9 +125,10 @@ PartialCheck Scene::check_part(const CollideOptions& o, const CheckPlan& plan, s
   return out;
 }
 
-void Scene::note_deflection(SurfaceId s, double deflection) {
+void Scene::note_deflection(SurfaceId s, double deflection, std::uint64_t triangles) {
   assert(s < impl_->noted_deflection.size());
   impl_->noted_deflection[s] = deflection;
+  impl_->noted_triangles[s] = triangles;
 }
 
 }  // namespace cadclash

@@ -137,11 +137,13 @@ void share_deflections(Scene& scene, Model& model, std::vector<std::pair<Surface
 }
 
 std::vector<RankStats> gather_stats(const RankStats& mine, int rank, int size, MPI_Comm comm) {
-  constexpr int kFields = 8;
-  const double v[kFields] = {static_cast<double>(mine.instance_pairs), static_cast<double>(mine.cost),
-                             static_cast<double>(mine.triangles),      mine.seconds,
-                             mine.plan_seconds,                        static_cast<double>(mine.result_bytes),
-                             static_cast<double>(mine.peak_memory_bytes), mine.cpu_seconds};
+  constexpr int kFields = 11;
+  const double v[kFields] = {static_cast<double>(mine.instance_pairs),    static_cast<double>(mine.cost),
+                             static_cast<double>(mine.triangles),         mine.seconds,
+                             mine.plan_seconds,                           static_cast<double>(mine.result_bytes),
+                             static_cast<double>(mine.peak_memory_bytes), mine.cpu_seconds,
+                             static_cast<double>(mine.held_triangles),    static_cast<double>(mine.meshed_triangles),
+                             static_cast<double>(mine.model_triangles)};
   std::vector<double> all(rank == 0 ? kFields * static_cast<std::size_t>(size) : 0);
   check_mpi(MPI_Gather(v, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, comm), "MPI_Gather", comm);
   std::vector<RankStats> out;
@@ -157,6 +159,9 @@ std::vector<RankStats> gather_stats(const RankStats& mine, int rank, int size, M
     s.result_bytes = static_cast<std::uint64_t>(x[5]);
     s.peak_memory_bytes = static_cast<std::uint64_t>(x[6]);
     s.cpu_seconds = x[7];
+    s.held_triangles = static_cast<std::uint64_t>(x[8]);
+    s.meshed_triangles = static_cast<std::uint64_t>(x[9]);
+    s.model_triangles = static_cast<std::uint64_t>(x[10]);
     out.push_back(s);
   }
   return out;
@@ -173,10 +178,78 @@ void add_stats(RankStats& into, const RankStats& s) {
   into.plan_seconds += s.plan_seconds;
   into.result_bytes += s.result_bytes;
   into.peak_memory_bytes = std::max(into.peak_memory_bytes, s.peak_memory_bytes);
+  into.held_triangles = s.held_triangles;
+  into.meshed_triangles = s.meshed_triangles;
+  into.model_triangles = s.model_triangles;
+}
+
+bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& options, bool share_edges,
+                      PartMeshing& pm, MPI_Comm comm) {
+  assert(pm.mesher.mesh && pm.mesher.release);
+  MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
+  if (share_edges) return false;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const CheckPlan plan = boxes_scene.plan(options);  // boxes only, the same on every replica
+  const std::vector<int> owners = mesh_owners(model, plan, size);
+  std::vector<std::vector<PartId>> owned(static_cast<std::size_t>(size));
+  for (PartId p = 0; p < owners.size(); ++p) owned[static_cast<std::size_t>(owners[p])].push_back(p);
+  const std::vector<PartId>& mine = owned[static_cast<std::size_t>(rank)];
+  pm.held.assign(model.parts.size(), 0);
+  pm.facts_only.assign(model.parts.size(), 0);
+  pm.facts.assign(model.surfaces.size(), SurfaceFacts{});
+  pm.model_triangles = 0;
+  const std::uint64_t before = held_triangles(model);  // mesh files' triangles come with the import
+  int failed = (mine.empty() || pm.mesher.mesh(mine)) ? 0 : 1;
+  for (PartId p : mine) pm.held[p] = pm.facts_only[p] = 1;
+  pm.meshed_triangles += held_triangles(model) - before;
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce", comm);
+  if (failed) return false;
+
+  // Every rank's facts, as doubles: box min, box max, deflection, triangles, has_triangles.
+  constexpr int kPer = 9;
+  std::vector<double> mine_v;
+  for (const SurfaceFacts& f : surface_facts(model, mine)) {
+    const double v[kPer] = {f.box.min().x(), f.box.min().y(), f.box.min().z(), f.box.max().x(),
+                            f.box.max().y(), f.box.max().z(), f.deflection,    static_cast<double>(f.triangles),
+                            f.has_triangles ? 1.0 : 0.0};
+    mine_v.insert(mine_v.end(), v, v + kPer);
+  }
+  const int count = static_cast<int>(mine_v.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
+  check_mpi(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "MPI_Allgather", comm);
+  long long total = 0;
+  for (int r = 0; r < size; ++r) {
+    offsets[static_cast<std::size_t>(r)] = static_cast<int>(total);
+    total += counts[static_cast<std::size_t>(r)];
+  }
+  if (total > INT32_MAX) {
+    std::fprintf(stderr, "cadclash check: the surfaces' facts take more than one MPI message holds\n");
+    MPI_Abort(comm, 1);
+  }
+  std::vector<double> all(static_cast<std::size_t>(total));
+  check_mpi(MPI_Allgatherv(mine_v.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+                           comm),
+            "MPI_Allgatherv", comm);
+  for (int r = 0; r < size; ++r) {
+    std::vector<SurfaceFacts> facts;
+    const double* x = all.data() + offsets[static_cast<std::size_t>(r)];
+    for (int i = 0; i + kPer <= counts[static_cast<std::size_t>(r)]; i += kPer) {
+      SurfaceFacts f;
+      f.box = Aabb(Vec3(x[i], x[i + 1], x[i + 2]), Vec3(x[i + 3], x[i + 4], x[i + 5]));
+      f.deflection = x[i + 6];
+      f.triangles = static_cast<std::uint64_t>(x[i + 7]);
+      f.has_triangles = x[i + 8] != 0.0;
+      facts.push_back(f);
+    }
+    apply_surface_facts(model, owned[static_cast<std::size_t>(r)], facts, pm);
+  }
+  return true;
 }
 
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& o, MergeHistory& history,
-                                   MPI_Comm comm) {
+                                   MPI_Comm comm, PartMeshing* parts) {
   assert(o.memory_budget_bytes == 0);
   MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
   int rank = 0, size = 1;
@@ -188,6 +261,11 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   const std::vector<std::uint32_t> mine = my_part(plan, rank, size, comm);
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = process_cpu_seconds();
+  if (parts != nullptr && !share_parts(model, plan, mine, *parts)) {
+    // share_part_facts meshed every part once without a failure: the same meshing cannot fail now.
+    std::fprintf(stderr, "cadclash check: rank %d: a part that meshed on its owner failed to mesh here\n", rank);
+    MPI_Abort(comm, 1);
+  }
   const PartialCheck part = run_part(scene, model, o, plan, mine, rank, size, comm);
   RankStats stats;
   stats.rank = rank;
@@ -200,6 +278,11 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   const std::vector<std::uint8_t> my_bytes = partial_check_bytes(part);
   stats.result_bytes = my_bytes.size();
   stats.peak_memory_bytes = peak_memory_bytes();
+  stats.held_triangles = held_triangles(model);
+  if (parts != nullptr) {
+    stats.meshed_triangles = parts->meshed_triangles;
+    stats.model_triangles = parts->model_triangles;
+  }
 
   const std::vector<std::vector<std::uint8_t>> bytes = gather_bytes(my_bytes, rank, size, comm);
   DistributedCheck out;
@@ -228,7 +311,7 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
 
 DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                      const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
-                                     const std::string& file, MPI_Comm comm) {
+                                     const std::string& file, MPI_Comm comm, PartMeshing* parts) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   DistributedReplay out;
@@ -253,7 +336,7 @@ DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const
       step_options.time_budget_seconds = left;
     }
     k = apply_trajectory_step(scene, rows, k, diagnostics, file);
-    DistributedCheck c = check_distributed(scene, model, step_options, history, comm);
+    DistributedCheck c = check_distributed(scene, model, step_options, history, comm, parts);
     if (rank == 0) {
       last_cut_by_time = !c.report.complete && c.report.stopped_by.find("time") != std::string::npos;
       out.merge_seconds += c.merge_seconds;

@@ -6,6 +6,7 @@
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepLib.hxx>
+#include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <ShapeFix_Face.hxx>
 #include <Standard_Failure.hxx>
@@ -16,10 +17,13 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <cstddef>
 #include <exception>
+#include <mutex>
+#include <shared_mutex>
 
 namespace cadclash {
 namespace {
@@ -107,8 +111,8 @@ std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& 
 
 // The triangles of every face of the part at `deflection` (eager import): faces left without them
 // are listed as errors and make the import incomplete.
-void mesh_faces(const BrepPartInput& in, BrepSource::Impl& impl, double deflection, const TessellationOptions& options,
-                const detail::MeshDeadline& deadline, std::vector<Surface>& surfaces, std::vector<Diagnostic>& diagnostics,
+void mesh_faces(BrepSource::Impl& impl, double deflection, const TessellationOptions& options,
+                const detail::MeshDeadline& deadline, std::span<Surface> surfaces, std::vector<Diagnostic>& diagnostics,
                 bool& complete) {
   const std::size_t n = impl.faces.size();
   // One BRepMesh call over all faces of the part: shared edges are discretised once and BRepMesh
@@ -144,7 +148,7 @@ void mesh_faces(const BrepPartInput& in, BrepSource::Impl& impl, double deflecti
         good[i] = 1;
       } else {
         surfaces[i].mesh = {};
-        diagnostics.push_back(Diagnostic{Severity::Error, in.source_file, 0, impl.entity_ids[i],
+        diagnostics.push_back(Diagnostic{Severity::Error, impl.source_file, 0, impl.entity_ids[i],
                                          failure_message(impl, i, face_why.empty() ? why : face_why)});
         complete = false;
       }
@@ -232,16 +236,32 @@ void prepare_part(const BrepPartInput& in, const TessellationOptions& options, P
 // Whether two of the parts share an edge: healing and the plane pcurves write into edges, so such
 // parts are done one after another. Parts of a file are distinct shapes, but a file may let two
 // products reach one edge entity.
-bool parts_share_edges(std::span<const BrepPartInput> parts) {
+template <class Shapes>
+bool shapes_share_edges(const Shapes& shapes) {
   TopTools_IndexedMapOfShape all;
   int sum = 0;
-  for (const BrepPartInput& in : parts) {
+  for (const TopoDS_Shape& shape : shapes) {
     TopTools_IndexedMapOfShape edges;
-    TopExp::MapShapes(*in.shape, TopAbs_EDGE, edges);
+    TopExp::MapShapes(shape, TopAbs_EDGE, edges);
     sum += edges.Extent();
     for (Standard_Integer e = 1; e <= edges.Extent(); ++e) all.Add(edges(e));
   }
   return all.Extent() != sum;
+}
+
+bool parts_share_edges(std::span<const BrepPartInput> parts) {
+  std::vector<TopoDS_Shape> shapes;
+  for (const BrepPartInput& in : parts) shapes.push_back(*in.shape);
+  return shapes_share_edges(shapes);
+}
+
+// A part's faces as one compound (what its edges are).
+TopoDS_Shape faces_compound(const BrepSource::Impl& impl) {
+  TopoDS_Compound compound;
+  BRep_Builder builder;
+  builder.MakeCompound(compound);
+  for (const TopoDS_Face& f : impl.faces) builder.Add(compound, f);
+  return compound;
 }
 
 // f(0) ... f(n - 1), on OpenMP threads when `parallel` (a part per thread at a time: the OpenMP loops
@@ -289,7 +309,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
       PartWork& w = work[k];
       if (!w.surfaces.empty())
-        mesh_faces(parts[k], *w.impl, w.deflection, options, deadline, w.surfaces, w.diagnostics, w.complete);
+        mesh_faces(*w.impl, w.deflection, options, deadline, w.surfaces, w.diagnostics, w.complete);
       meter.add(1, parts[k].name);
     });
     meter.finish();
@@ -313,6 +333,85 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
     for (Surface& s : w.surfaces) model.surfaces.push_back(std::move(s));
   }
   return ids;
+}
+
+namespace {
+
+// The part's BrepSource when it has one (a B-rep part), else null.
+BrepSource* brep_source_of(const Model& model, PartId p) {
+  return dynamic_cast<BrepSource*>(model.parts[p].source.get());
+}
+
+bool holds_triangles(const Model& model, PartId p) {
+  const Part& part = model.parts[p];
+  for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s)
+    if (model.surfaces[s].has_triangles) return true;
+  return false;
+}
+
+}  // namespace
+
+std::size_t tessellate_parts(Model& model, std::span<const PartId> parts, std::vector<Diagnostic>& diagnostics,
+                             bool& complete) {
+  std::vector<PartId> todo;
+  std::vector<BrepSource*> sources;
+  for (PartId p : parts) {
+    assert(p < model.parts.size());
+    BrepSource* source = brep_source_of(model, p);
+    if (source == nullptr || model.parts[p].surface_count == 0 || holds_triangles(model, p)) continue;
+    if (std::find(todo.begin(), todo.end(), p) != todo.end()) continue;
+    todo.push_back(p);
+    sources.push_back(source);
+  }
+  std::vector<TopoDS_Shape> shapes;
+  for (BrepSource* source : sources) shapes.push_back(faces_compound(*source->impl_));
+  const bool in_parallel = todo.size() > 1 && !shapes_share_edges(shapes);
+  std::vector<std::vector<Diagnostic>> found(todo.size());
+  std::vector<char> whole(todo.size(), 1);
+  for_each_part(todo.size(), in_parallel, [&](std::size_t k) {
+    BrepSource::Impl& impl = *sources[k]->impl_;
+    const Part& part = model.parts[todo[k]];
+    TessellationOptions options;  // what add_brep_parts was given, as the source keeps it
+    options.linear_deflection = impl.default_deflection;
+    options.angular_deflection = impl.angular_deflection;
+    options.verify_deflection = impl.verify_deflection;
+    bool part_complete = true;
+    std::lock_guard<std::shared_mutex> lock(impl.mutex);
+    mesh_faces(impl, impl.default_deflection, options, detail::MeshDeadline{},
+               std::span<Surface>(model.surfaces).subspan(part.first_surface, part.surface_count), found[k],
+               part_complete);
+    whole[k] = part_complete ? 1 : 0;
+  });
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    diagnostics.insert(diagnostics.end(), found[k].begin(), found[k].end());
+    complete = complete && whole[k] != 0;
+  }
+  return todo.size();
+}
+
+void release_part_triangles(Model& model, std::span<const PartId> parts) {
+  for (PartId p : parts) {
+    assert(p < model.parts.size());
+    BrepSource* source = brep_source_of(model, p);
+    if (source == nullptr) continue;
+    BrepSource::Impl& impl = *source->impl_;
+    {
+      std::lock_guard<std::shared_mutex> lock(impl.mutex);
+      for (const TopoDS_Face& f : impl.faces) BRepTools::Clean(f);
+    }
+    const Part& part = model.parts[p];
+    for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s) {
+      model.surfaces[s].mesh = TriangleMesh{};
+      model.surfaces[s].has_triangles = false;
+    }
+  }
+}
+
+bool brep_parts_share_edges(const Model& model) {
+  std::vector<TopoDS_Shape> shapes;
+  for (PartId p = 0; p < model.parts.size(); ++p)
+    if (const BrepSource* source = brep_source_of(model, p)) shapes.push_back(faces_compound(*source->impl_));
+  return shapes_share_edges(shapes);
 }
 
 }  // namespace cadclash

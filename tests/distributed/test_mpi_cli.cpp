@@ -1,6 +1,8 @@
 // `cadclash check` under mpirun on localhost (1, 2 and 4 ranks, oversubscribed): the JSON report
 // (--no-timings), the table on stdout and the HTML report are byte-identical to one process's; the
 // per-rank lines are printed; a rank that crashes is named with its unfinished instance pairs.
+// Without --lazy the ranks mesh whole parts where their shares need them (part meshing): still one
+// eagerly importing process's reports, with fewer triangles meshed per rank than the model holds.
 #include "../test_temp.h"
 #include "cadclash/export.h"
 #include "cadclash/import.h"
@@ -8,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +20,7 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 namespace cadclash {
 namespace {
@@ -107,10 +112,15 @@ TEST(MpiCli, As1RepeatedQuerySameReport) {
   expect_identical("check '" + as1_path() + "' --lazy --repeat 2", false);
 }
 
-// The rod of as1 moved over eight steps (CSV written from the imported poses), lazily tessellated at
-// a coarse deflection: steps reuse faces other ranks tessellated.
-TEST(MpiCli, As1TrajectorySameReport) {
+// Without --lazy: each rank meshes whole parts where its share needs them (part meshing), and the
+// reports, table and HTML are one eagerly importing process's.
+TEST(MpiCli, As1PartMeshingSameReportHtmlAndTable) {
   REQUIRE_AS1();
+  expect_identical("check '" + as1_path() + "' --tolerance 0.01 --clearance 1", true);
+}
+
+// The rod of as1 moved over eight steps (CSV written from the imported poses), at a coarse deflection.
+std::string as1_trajectory_csv() {
   const ImportResult as1 = import_file(as1_path());
   std::ostringstream csv;
   csv << "step,instance_path,tx,ty,tz,qw,qx,qy,qz\n";
@@ -126,8 +136,136 @@ TEST(MpiCli, As1TrajectorySameReport) {
           << p.translation().z() << ',' << q.w() << ',' << q.x() << ',' << q.y() << ',' << q.z() << '\n';
     }
   }
-  const std::string path = testing::write_scratch_file("as1_path.csv", csv.str());
-  expect_identical("check '" + as1_path() + "' --lazy --deflection 2 --path '" + path + "'", false);
+  return testing::write_scratch_file("as1_path.csv", csv.str());
+}
+
+// Lazily tessellated: steps reuse faces other ranks tessellated.
+TEST(MpiCli, As1TrajectorySameReport) {
+  REQUIRE_AS1();
+  expect_identical("check '" + as1_path() + "' --lazy --deflection 2 --path '" + as1_trajectory_csv() + "'", false);
+}
+
+// Part meshing: steps reach parts the rank has not meshed yet; the plan uses the deflections other
+// ranks' parts achieved (below the asked 2 mm).
+TEST(MpiCli, As1PartMeshingTrajectorySameReport) {
+  REQUIRE_AS1();
+  expect_identical("check '" + as1_path() + "' --deflection 2 --path '" + as1_trajectory_csv() + "'", false);
+}
+
+// `write_board_step OUT COPIES SHIFT [unshared]`: the truth tests' board (17 instances) COPIES times
+// side by side as a STEP assembly, moved SHIFT mm along x; unshared: a product per instance.
+std::string board_step(int copies, bool unshared, int shift = 0) {
+  const std::string out = scratch("board" + std::to_string(copies) + (unshared ? "u" : "s") + "_" +
+                                  std::to_string(shift) + ".step");
+  const std::string command = std::string("'") + CADCLASH_WRITE_BOARD_STEP + "' '" + CADCLASH_DATA_DIR +
+                              "/external' '" + out + "' " + std::to_string(copies) + " " + std::to_string(shift) +
+                              (unshared ? " unshared" : "") + " >/dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  return out;
+}
+
+// 59 boards in one STEP assembly (1003 instances of 7 B-rep parts), part meshing.
+TEST(MpiCli, ThousandInstanceStepSameReport) {
+  REQUIRE_AS1();
+  expect_identical("check '" + board_step(59, false) + "' --tolerance 0.01", false);
+}
+
+// "rank r of N: ... model triangles held H, meshed here M of the model's T": (H, M, T) per rank.
+std::vector<std::array<std::uint64_t, 3>> meshed_per_rank(const std::string& err, int ranks) {
+  std::vector<std::array<std::uint64_t, 3>> out;
+  for (int r = 0; r < ranks; ++r) {
+    const std::size_t at = err.find("rank " + std::to_string(r) + " of " + std::to_string(ranks) + ": ");
+    const std::size_t held = err.find("model triangles held ", at);
+    EXPECT_NE(at, std::string::npos) << err;
+    EXPECT_NE(held, std::string::npos) << err;
+    if (at == std::string::npos || held == std::string::npos) return {};
+    std::array<std::uint64_t, 3> v{};
+    std::istringstream line(err.substr(held, err.find('\n', held) - held));
+    std::string w;
+    line >> w >> w >> w >> v[0] >> w >> w >> w >> v[1] >> w >> w >> w >> v[2];
+    EXPECT_EQ(w, "model's") << err;
+    out.push_back(v);
+  }
+  return out;
+}
+
+// Four boards, a product per instance (68 parts): the pairs split by where the boards are, so a rank
+// meshes only the parts of its boards. Every part is meshed somewhere (the ranks' counts cover the
+// model), each rank meshes fewer triangles than the model, and one rank meshes all of it.
+TEST(MpiCli, RanksMeshOnlyThePartsTheirShareReaches) {
+  REQUIRE_AS1();
+  const std::string step = board_step(4, true);
+  const std::string args = "check '" + step + "' --tolerance 0.01 --no-timings --threads 1 --json ";
+  const Outcome single = run(0, args + "'" + scratch("parts_one.json") + "'");
+  ASSERT_EQ(single.code, 0) << single.err;
+  const std::string json = slurp(scratch("parts_one.json"));
+  const Outcome one = run(1, args + "'" + scratch("parts_np1.json") + "'");
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_TRUE(slurp(scratch("parts_np1.json")) == json);
+  const auto whole = meshed_per_rank(one.err, 1);
+  ASSERT_EQ(whole.size(), 1u);
+  const std::uint64_t model = whole[0][2];
+  EXPECT_GT(model, 0u);
+  EXPECT_EQ(whole[0][1], model);  // a single rank meshes everything ...
+  EXPECT_EQ(whole[0][0], model);  // ... and keeps it
+  for (int ranks : {2, 4}) {
+    const std::string out = scratch("parts_np" + std::to_string(ranks) + ".json");
+    const Outcome r = run(ranks, args + "'" + out + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(slurp(out) == json) << ranks << " ranks: the JSON reports differ";
+    EXPECT_TRUE(r.out == single.out) << ranks << " ranks: the tables differ";
+    std::uint64_t sum = 0;
+    for (const auto& [held, meshed, total] : meshed_per_rank(r.err, ranks)) {
+      EXPECT_EQ(total, model) << r.err;
+      EXPECT_LT(meshed, model) << ranks << " ranks:\n" << r.err;
+      EXPECT_LE(held, meshed) << r.err;
+      EXPECT_LE(meshed, model / static_cast<std::uint64_t>(ranks) * 2) << ranks << " ranks:\n" << r.err;
+      sum += meshed;
+    }
+    EXPECT_GE(sum, model) << r.err;
+  }
+}
+
+// Two files, two boards and one board 1000 mm away, on two ranks, the pairs selected within the
+// boards (each file also holds an unused part at its origin, which write_board_step leaves as a free
+// shape: it would pair across the files). Rank 0's run lies within the first file (it holds about
+// 2/3 of the pairs), so rank 0 keeps nothing of the second file, though it reads it: it holds no more
+// triangles than the first file has. Rank 1 holds the second file's board and what its pairs reach
+// of the first.
+TEST(MpiCli, RankMeshesNothingOfAFileItsPairsDoNotReach) {
+  REQUIRE_AS1();
+  const std::string first = board_step(2, false), second = board_step(1, false, 1000);
+  const Outcome alone = run(1, "check '" + first + "' --tolerance 0.01 --no-timings --threads 1");
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  const auto first_only = meshed_per_rank(alone.err, 1);
+  ASSERT_EQ(first_only.size(), 1u);
+  const std::uint64_t in_first = first_only[0][2];
+  const std::string boards = "/" + std::filesystem::path(first).filename().string() + "/board /" +
+                             std::filesystem::path(second).filename().string() + "/board";
+  const std::string args = "check '" + first + "' '" + second + "' --select-a " + boards + " --select-b " + boards +
+                           " --tolerance 0.01 --no-timings --threads 1 --json ";
+  const Outcome single = run(0, args + "'" + scratch("files_one.json") + "'");
+  ASSERT_EQ(single.code, 0) << single.err;
+  const Outcome two = run(2, args + "'" + scratch("files_np2.json") + "'");
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_TRUE(slurp(scratch("files_np2.json")) == slurp(scratch("files_one.json")));
+  EXPECT_TRUE(two.out == single.out);
+  const auto ranks = meshed_per_rank(two.err, 2);
+  ASSERT_EQ(ranks.size(), 2u);
+  const std::uint64_t model = ranks[0][2];
+  ASSERT_GT(model, in_first);
+  EXPECT_LE(ranks[0][0], in_first) << "rank 0 holds parts of the second file:\n" << two.err;
+  EXPECT_GT(ranks[1][0], 0u) << two.err;
+  EXPECT_LT(ranks[1][0], model) << two.err;
+}
+
+// With --lazy every rank reads and keeps the B-rep and tessellates face by face: no part meshing.
+TEST(MpiCli, LazyRanksSayNothingOfPartMeshing) {
+  REQUIRE_AS1();
+  const Outcome r = run(2, "check '" + as1_path() + "' --lazy --no-timings");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("model triangles held "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("meshed here"), std::string::npos) << r.err;
 }
 
 // 56 copies of as1 in one .glb (1008 instances, meshes only).
@@ -166,16 +304,23 @@ TEST(MpiCli, UnmeshableFacesReportedAsInOneProcess) {
                                  std::filesystem::copy_options::overwrite_existing);
       files += " '" + to + "'";
     }
-  const std::string args = "check" + files + " --lazy --no-timings --json ";
-  const Outcome one = run(0, args + "'" + scratch("bad_one.json") + "'");
-  ASSERT_EQ(one.code, 1) << one.err;
-  const std::string json = slurp(scratch("bad_one.json"));
-  ASSERT_NE(json.find("#132"), std::string::npos) << json;  // the degenerate STEP face, by its id
-  for (int ranks : {2, 3}) {
-    const Outcome r = run(ranks, args + "'" + scratch("bad_np.json") + "'");
-    EXPECT_EQ(r.code, 1) << r.err;
-    EXPECT_TRUE(slurp(scratch("bad_np.json")) == json) << ranks << " ranks:\n" << slurp(scratch("bad_np.json"));
-    EXPECT_TRUE(r.out == one.out) << ranks << " ranks";
+  // Lazily: the faces fail during the check. Without --lazy, in the import: part meshing cannot
+  // rebuild the eager import's diagnostics, so every rank imports eagerly after all (same stderr).
+  for (const char* lazy : {" --lazy", ""}) {
+    SCOPED_TRACE(lazy);
+    const std::string args = "check" + files + lazy + " --no-timings --json ";
+    const Outcome one = run(0, args + "'" + scratch("bad_one.json") + "'");
+    ASSERT_EQ(one.code, 1) << one.err;
+    const std::string json = slurp(scratch("bad_one.json"));
+    ASSERT_NE(json.find("#132"), std::string::npos) << json;  // the degenerate STEP face, by its id
+    for (int ranks : {2, 3}) {
+      const Outcome r = run(ranks, args + "'" + scratch("bad_np.json") + "'");
+      EXPECT_EQ(r.code, 1) << r.err;
+      EXPECT_TRUE(slurp(scratch("bad_np.json")) == json) << ranks << " ranks:\n" << slurp(scratch("bad_np.json"));
+      EXPECT_TRUE(r.out == one.out) << ranks << " ranks";
+      EXPECT_EQ(r.err.substr(0, one.err.size()), one.err) << ranks << " ranks";  // the import's messages once
+      EXPECT_EQ(r.err.find("meshed here"), std::string::npos) << r.err;
+    }
   }
 }
 

@@ -436,10 +436,10 @@ class Scene {
   // cannot be split).
   PartialCheck check_part(const CollideOptions& options, const CheckPlan& plan, std::span<const std::uint32_t> part);
 
-  // Surface `s`, which has no triangles here, was tessellated by another process at `deflection`:
-  // search reaches use it, as they would in the process that holds its triangles. Precondition:
-  // s < model.surfaces.size().
-  void note_deflection(SurfaceId s, double deflection);
+  // Surface `s`, which has no triangles here, was tessellated by another process at `deflection`
+  // (into `triangles` triangles): search reaches use it, as they would in the process that holds its
+  // triangles, and plan() costs it at `triangles`. Precondition: s < model.surfaces.size().
+  void note_deflection(SurfaceId s, double deflection, std::uint64_t triangles = kUntessellatedCost);
 
  private:
   struct Impl;

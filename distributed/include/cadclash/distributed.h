@@ -2,11 +2,12 @@
 // the report one process gives.
 //
 // How (collide.h, "One check split over processes"): every rank imports the same files and builds
-// the same Scene (replicated: assembly, B-rep, poses); every rank computes the plan (broad phase and
-// surface level: boxes only; the same pairs everywhere); rank 0 splits its pairs into contiguous runs
-// of equal estimated cost; each rank checks its run (check_part), tessellating only the surfaces its pairs
-// reach (with lazy tessellation; otherwise the import already tessellated everything); rank 0 gathers
-// the parts and merges them in a fixed order. The merged Report equals Scene::check()'s in every
+// the same Scene (replicated: assembly, B-rep, poses, surface boxes); every rank computes the plan
+// (broad phase and surface level: boxes only; the same pairs everywhere); rank 0 splits its pairs
+// into contiguous runs of equal estimated cost; each rank checks its run (check_part), tessellating
+// only what its pairs reach: with lazy tessellation the surfaces, face by face; with part meshing
+// (below: the import read no triangles, and whole parts are meshed as an eager import meshes them)
+// the parts. Rank 0 gathers the parts and merges them in a fixed order. The merged Report equals Scene::check()'s in every
 // field a `--no-timings` report holds, for any number of ranks and threads (pairs, counters,
 // diagnostics, unexamined pairs, memory_charged, model_memory); timings are the slowest rank's.
 //
@@ -18,6 +19,7 @@
 #include "cadclash/collide.h"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -75,20 +77,93 @@ MergedCheck merge_parts(const CheckPlan& plan, std::span<const PartialCheck> par
 std::vector<std::uint8_t> partial_check_bytes(const PartialCheck& p);
 std::optional<PartialCheck> partial_check_from_bytes(std::span<const std::uint8_t> bytes, std::string& error);
 
+// ---------------------------------------------------------------------------------------------
+// Whole parts meshed where they are needed (no MPI)
+// ---------------------------------------------------------------------------------------------
+// A replica may hold the B-rep without triangles (a lazy import) and mesh a part only when its share
+// of the work reaches it, exactly as one process's eager import meshes it (tessellate_parts in
+// cadclash/tessellate.h; this module does not link OCCT, so the meshing comes as a PartMesher). The
+// plan needs, of every surface, what the eager import gives it: its box (extended by its
+// triangles'), its achieved deflection and (for the cost estimates) its triangle count. So each part
+// is meshed first on one rank, its owner (mesh_owners), which sends these facts to every rank
+// (share_part_facts under MPI); a rank keeps the triangles of its owned parts only when its share
+// reaches them (share_parts). Per rank, meshing = its owned parts + the other parts its shares reach.
+
+// Meshes whole parts as the eager import does, and drops them again (tessellate_parts,
+// release_part_triangles). mesh returns false when a face could not be meshed.
+struct PartMesher {
+  std::function<bool(std::span<const PartId>)> mesh;
+  std::function<void(std::span<const PartId>)> release;
+};
+
+// What the plan needs of a surface whose part may be meshed on another rank.
+struct SurfaceFacts {
+  Aabb box;                     // Surface::aabb after meshing
+  double deflection = 0.0;      // Surface::deflection after meshing
+  std::uint64_t triangles = 0;  // its triangles
+  bool has_triangles = false;   // meshing gave it triangles
+};
+
+// One replica's part meshing: what it holds and what the whole model's surfaces are.
+struct PartMeshing {
+  PartMesher mesher;
+  std::vector<SurfaceFacts> facts;  // per surface of the model, once share_part_facts ran
+  std::vector<char> held;           // per part: its triangles are here
+  std::vector<char> facts_only;     // per part: meshed here for its facts, not reached by a share yet
+  std::uint64_t meshed_triangles = 0;  // triangles this replica meshed so far (released ones included)
+  std::uint64_t model_triangles = 0;   // triangles of every B-rep surface of the model (from the facts)
+};
+
+// The parts of the instances of plan.pairs[k], k in `pairs`: ascending, each once.
+std::vector<PartId> parts_of_pairs(const Model& model, const CheckPlan& plan, std::span<const std::uint32_t> pairs);
+
+// Per part, the rank that meshes it first: the first rank, in split_by_cost(plan, ranks), whose run
+// reaches the part; a part no pair reaches goes to the rank with the fewest surfaces owned so far
+// (lowest rank on ties). The same on every replica of the same plan. Precondition: ranks >= 1.
+std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int ranks);
+
+// The facts of every surface of `parts` as `model` holds them now, in part then surface order.
+std::vector<SurfaceFacts> surface_facts(const Model& model, std::span<const PartId> parts);
+
+// `facts` (surface_facts of `parts`, from whichever replica meshed them) into pm.facts; for parts
+// whose triangles are not here, into the model's surfaces too (box and deflection). Precondition:
+// pm.facts sized for model.surfaces.
+void apply_surface_facts(Model& model, std::span<const PartId> parts, std::span<const SurfaceFacts> facts,
+                         PartMeshing& pm);
+
+// Tells `scene` (built on the model after apply_surface_facts) the deflection and triangle count of
+// every surface that has triangles on some replica, for when it has none here (Scene::note_deflection).
+void note_surface_facts(Scene& scene, const PartMeshing& pm);
+
+// Before a replica checks `pairs` of `plan`: the parts they reach are meshed here (those not held),
+// and the parts meshed for their facts only that they do not reach are released. Returns false when
+// a face failed to mesh.
+bool share_parts(Model& model, const CheckPlan& plan, std::span<const std::uint32_t> pairs, PartMeshing& pm);
+
+// Triangles of the surfaces that have them in `model`.
+std::uint64_t held_triangles(const Model& model);
+
 // One rank's share of a query (or of a whole trajectory: summed over its steps).
 struct RankStats {
   int rank = 0;
   std::uint64_t instance_pairs = 0;  // assigned to it
   std::uint64_t cost = 0;            // their estimated cost (PlannedPair::cost)
   std::uint64_t triangles = 0;       // triangles its scene holds afterwards (model_memory.triangle_count)
-  double seconds = 0.0;              // wall time of its check_part() calls
+  double seconds = 0.0;              // wall time of its check_part() calls (and share_parts() before them)
   double cpu_seconds = 0.0;          // CPU time of the process (all its threads) during them
   double plan_seconds = 0.0;         // wall time of its plan() calls (every rank plans every pair)
   std::uint64_t result_bytes = 0;    // bytes of its results sent to rank 0
   std::uint64_t peak_memory_bytes = 0;  // the process's peak resident set (getrusage)
+  // Triangles its model holds after its part (every surface with triangles; B-rep ones meshed here
+  // and those of mesh files, which every rank reads); with part meshing, the triangles it meshed so
+  // far (released ones included) and the model's (every B-rep surface, once); else 0.
+  std::uint64_t held_triangles = 0;
+  std::uint64_t meshed_triangles = 0;
+  std::uint64_t model_triangles = 0;
 };
 
-// `s` added to `into`: sums, except triangles (the latest) and peak memory (the larger).
+// `s` added to `into`: sums, except triangles, held, meshed and model triangles (the latest) and
+// peak memory (the larger).
 void add_stats(RankStats& into, const RankStats& s);
 
 #if CADCLASH_HAS_MPI
@@ -114,8 +189,21 @@ struct DistributedCheck {
 // `model` is the scene's model (instance paths for that message, part ids for the merge). Surfaces
 // tessellated by another rank get the achieved deflection on every rank: in `model` (the report's
 // "deflection" of a surface) and in the scene (Scene::note_deflection: the next query's reaches).
+// With `parts` (part meshing: `model` imported without triangles, share_part_facts done, `scene`
+// built afterwards and told note_surface_facts), each rank first meshes the parts its run reaches
+// (share_parts); the merged report is then the one of one process that imported eagerly.
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& options,
-                                   MergeHistory& history, MPI_Comm comm);
+                                   MergeHistory& history, MPI_Comm comm, PartMeshing* parts = nullptr);
+
+// Part meshing's first step, collective: every rank plans `boxes_scene` (a Scene over `model`, a
+// lazy import: nothing meshed; the selection of the real check), meshes the parts mesh_owners gives
+// it (pm.mesher) and receives the facts of every other part (MPI_Allgatherv), which
+// apply_surface_facts writes into pm and `model`. Afterwards build the checking Scene on `model` and
+// call note_surface_facts. Returns false on every rank when a face failed to mesh on some rank or
+// two B-rep parts share an edge (`share_edges`, the same on every rank): the eager import's
+// diagnostics cannot then be rebuilt, import eagerly instead. Precondition: pm.mesher set.
+bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& options, bool share_edges,
+                      PartMeshing& pm, MPI_Comm comm);
 
 // replay_trajectory (collide.h) over the ranks: the same steps, diagnostics and time-budget
 // behaviour; each step's check split and merged as check_distributed does. `ranks` (rank 0) sums the
@@ -127,7 +215,7 @@ struct DistributedReplay {
 };
 DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                      const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
-                                     const std::string& file, MPI_Comm comm);
+                                     const std::string& file, MPI_Comm comm, PartMeshing* parts = nullptr);
 #endif
 
 }  // namespace cadclash

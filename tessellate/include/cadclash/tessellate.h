@@ -179,6 +179,10 @@ class BrepSource final : public SurfaceSource {
   // Back from save_brep_source's bytes; nullptr and `why` when they are not whole. The bytes must be
   // ones save_brep_source wrote (check a cache entry's checksum first): OCCT's shape reader trusts them.
   friend std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
+  friend std::size_t tessellate_parts(Model& model, std::span<const PartId> parts,
+                                      std::vector<Diagnostic>& diagnostics, bool& complete);
+  friend void release_part_triangles(Model& model, std::span<const PartId> parts);
+  friend bool brep_parts_share_edges(const Model& model);
 
  private:
   std::unique_ptr<Impl> impl_;
@@ -186,6 +190,31 @@ class BrepSource final : public SurfaceSource {
 
 std::string save_brep_source(const BrepSource& source);
 std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
+
+// Whole parts meshed later (distributed checks: a rank meshes only the parts its share of the work
+// reaches, and must get the triangles one process's eager import gets).
+//
+// Meshes every face of the listed B-rep parts that a lazy add_brep_parts left without triangles
+// exactly as an eager add_brep_parts would have: one BRepMesh call over the part's faces, the same
+// triangles, achieved deflections (Surface::deflection) and boxes (the exact face box extended by its
+// triangles'), at the deflection, angular deflection and verification the part was loaded with, no
+// time limit. A face that fails gets the eager import's error, appended to `diagnostics` in the order
+// of `parts`, and sets `complete` false. Parts without a BrepSource, parts any of whose surfaces
+// already has triangles, and repeats are skipped. Parts are meshed in parallel unless they share
+// edges. Returns how many parts it meshed. Identical to the eager import only when no two B-rep parts
+// of the model share an edge (brep_parts_share_edges), since meshing writes into edges.
+// Preconditions: every id < model.parts.size(); no other thread uses these parts meanwhile.
+std::size_t tessellate_parts(Model& model, std::span<const PartId> parts, std::vector<Diagnostic>& diagnostics,
+                             bool& complete);
+
+// Drops the triangles of the listed B-rep parts: the surfaces' meshes (has_triangles false; their
+// deflection and box stay) and the triangulations BRepMesh stored in the faces, so that
+// tessellate_parts makes the same ones again. Parts without a BrepSource are skipped.
+// Preconditions: every id < model.parts.size(); nothing (a Scene's hierarchy) refers to the triangles.
+void release_part_triangles(Model& model, std::span<const PartId> parts);
+
+// True when two B-rep parts of the model share an edge (a file may let two products reach one edge).
+bool brep_parts_share_edges(const Model& model);
 
 // =============================================================================================
 // Raw meshes: repair and segmentation (CGAL Polygon_mesh_processing)
