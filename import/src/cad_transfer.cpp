@@ -89,14 +89,7 @@ Handle(TDocStd_Document) new_xcaf_document() {
 
 std::string pack_transfer(const Transfer& t) {
   ByteWriter w;
-  w.u64(t.diagnostics.size());
-  for (const Diagnostic& d : t.diagnostics) {
-    w.u64(static_cast<std::uint64_t>(d.severity));
-    w.str(d.file);
-    w.i64(d.line);
-    w.i64(d.step_id);
-    w.str(d.message);
-  }
+  write_diagnostics(w, t.diagnostics);
   w.u64(t.complete ? 1 : 0);
   w.u64(static_cast<std::uint64_t>(t.kind));
   w.f64(t.declared_uncertainty);
@@ -133,15 +126,9 @@ std::string pack_transfer(const Transfer& t) {
 
 bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   ByteReader r{bytes};
-  const std::uint64_t n = r.u64();
-  for (std::uint64_t i = 0; r.ok && i < n; ++i) {
-    Diagnostic d;
-    d.severity = r.u64() == 0 ? Severity::Warning : Severity::Error;
-    d.file = r.str();
-    d.line = r.i64();
-    d.step_id = r.i64();
-    d.message = r.str();
-    t.diagnostics.push_back(std::move(d));
+  {
+    std::vector<Diagnostic> read = read_diagnostics(r);
+    t.diagnostics.insert(t.diagnostics.end(), std::make_move_iterator(read.begin()), std::make_move_iterator(read.end()));
   }
   t.complete = r.u64() == 1;
   t.kind = static_cast<SourceKind>(r.u64());

@@ -93,14 +93,7 @@ bool get_surface(ByteReader& r, Surface& s) {
 
 std::optional<std::string> save_import(const ImportResult& result) {
   ByteWriter w;
-  w.u64(result.diagnostics.size());
-  for (const Diagnostic& d : result.diagnostics) {
-    w.u64(static_cast<std::uint64_t>(d.severity));
-    w.str(d.file);
-    w.i64(d.line);
-    w.i64(d.step_id);
-    w.str(d.message);
-  }
+  write_diagnostics(w, result.diagnostics);
   w.u64(result.complete ? 1 : 0);
   const Model& m = result.model;
   w.u64(m.parts.size());
@@ -133,14 +126,7 @@ std::optional<std::string> save_import(const ImportResult& result) {
 bool load_import(std::string_view bytes, ImportResult& result, std::string& why) {
   ByteReader r{bytes};
   why = "its contents are cut short or inconsistent";
-  result.diagnostics.resize(r.count(40));
-  for (Diagnostic& d : result.diagnostics) {
-    d.severity = r.u64() == 0 ? Severity::Warning : Severity::Error;
-    d.file = r.str();
-    d.line = r.i64();
-    d.step_id = r.i64();
-    d.message = r.str();
-  }
+  result.diagnostics = read_diagnostics(r);
   result.complete = r.u64() == 1;
   Model& m = result.model;
   m.parts.resize(r.count(40));

@@ -7,11 +7,14 @@
 // stored B-rep part's magic (brep_store.cpp).
 #pragma once
 
+#include "cadclash/model.h"
+
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace cadclash::detail {
 
@@ -61,5 +64,29 @@ struct ByteReader {
   }
   bool at_end() const { return ok && at == in.size(); }
 };
+
+// Diagnostics as the stored records hold them: a count, then per diagnostic its severity, file,
+// line, STEP #id and message (at least 40 bytes each).
+inline void write_diagnostics(ByteWriter& w, const std::vector<Diagnostic>& ds) {
+  w.u64(ds.size());
+  for (const Diagnostic& d : ds) {
+    w.u64(static_cast<std::uint64_t>(d.severity));
+    w.str(d.file);
+    w.i64(d.line);
+    w.i64(d.step_id);
+    w.str(d.message);
+  }
+}
+inline std::vector<Diagnostic> read_diagnostics(ByteReader& r) {
+  std::vector<Diagnostic> ds(r.count(40));
+  for (Diagnostic& d : ds) {
+    d.severity = r.u64() == 0 ? Severity::Warning : Severity::Error;
+    d.file = r.str();
+    d.line = r.i64();
+    d.step_id = r.i64();
+    d.message = r.str();
+  }
+  return ds;
+}
 
 }  // namespace cadclash::detail
