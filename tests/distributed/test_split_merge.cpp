@@ -26,6 +26,13 @@ std::string as1_path() { return std::string(CADCLASH_DATA_DIR) + "/external/as1-
 #define REQUIRE_AS1() \
   if (!std::filesystem::exists(as1_path())) GTEST_SKIP() << "needs data/external/as1-tu-203.stp (scripts/setup.sh)"
 
+// The id of as1's rod (the trajectories here move it), or kInvalidId.
+InstanceId rod_of(const Model& m) {
+  for (InstanceId i = 0; i < m.instances.size(); ++i)
+    if (m.instances[i].path == "/as1/ROD-ASSEMBLY/ROD") return i;
+  return kInvalidId;
+}
+
 Model import_as1(bool lazy, double deflection = 0.1) {
   ImportOptions io;
   io.lazy = lazy;
@@ -153,11 +160,7 @@ TEST(SplitMerge, As1AllTrianglePairsVersion2) {
 TEST(SplitMerge, As1LazyTrajectory) {
   REQUIRE_AS1();
   const Model as1 = import_as1(true, 2.0);
-  const InstanceId rod = [&] {
-    for (InstanceId i = 0; i < as1.instances.size(); ++i)
-      if (as1.instances[i].path == "/as1/ROD-ASSEMBLY/ROD") return i;
-    return kInvalidId;
-  }();
+  const InstanceId rod = rod_of(as1);
   ASSERT_NE(rod, kInvalidId);
   CollideOptions o;
   o.tolerance = 0.01;
@@ -316,7 +319,9 @@ TEST(SplitMerge, As1PartMeshingIsTheEagerProcess) {
       }
       EXPECT_GE(meshed, split.meshing(0).model_triangles);
       EXPECT_EQ(split.meshing(0).model_triangles, triangle_count(eager));
-      if (parts == 1) EXPECT_EQ(split.meshing(0).meshed_triangles, triangle_count(eager));
+      if (parts == 1) {
+        EXPECT_EQ(split.meshing(0).meshed_triangles, triangle_count(eager));
+      }
     }
   }
 }
@@ -326,11 +331,7 @@ TEST(SplitMerge, As1PartMeshingIsTheEagerProcess) {
 TEST(SplitMerge, As1PartMeshingTrajectory) {
   REQUIRE_AS1();
   Model eager = import_as1(false, 2.0);
-  const InstanceId rod = [&] {
-    for (InstanceId i = 0; i < eager.instances.size(); ++i)
-      if (eager.instances[i].path == "/as1/ROD-ASSEMBLY/ROD") return i;
-    return kInvalidId;
-  }();
+  const InstanceId rod = rod_of(eager);
   ASSERT_NE(rod, kInvalidId);
   CollideOptions o;
   o.tolerance = 0.01;
