@@ -158,7 +158,9 @@ TEST(ContactClass, PlaneTangentToFacetedCylinderTouches) {
   o.decision = DecisionMode::Certified;
   r = collide(m, 0, 1, o);
   EXPECT_TRUE(r.pairs.empty());
-  if (fast_touches) EXPECT_EQ(r.counters.decided_analytic, 1u);
+  if (fast_touches) {
+    EXPECT_EQ(r.counters.decided_analytic, 1u);
+  }
   m.instances[1].pose.translation().x() -= 0.05;
   o.decision = DecisionMode::Fast;
   // A mesh without a recorded deflection is taken literally: the gap is a clearance.
