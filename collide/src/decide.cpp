@@ -232,14 +232,14 @@ bool near_outline(const Outline& outline, const Vec3& p, double margin) {
   if (tree.empty() || !(margin >= 0.0)) return false;
   // Both distances are a few roundings of the coordinates' magnitude M off (well within the slack
   // the callers add to their margins); 2^-40 M covers them, so pruning never changes the answer
-  // (the nodes' float boxes, rounded outward, only prune less).
+  // (the nodes' grid boxes, rounded outward, only prune less).
   const Aabb& root = tree.root;
   const double mag = std::max({p.cwiseAbs().maxCoeff(), root.min().cwiseAbs().maxCoeff(), root.max().cwiseAbs().maxCoeff()});
   const double prune = margin + 0x1p-40 * mag;
   const double m2 = margin * margin;
   bool near = false;
   walk_bvh(
-      tree, [&](const SurfaceBvh::Node& node) { return node.box().exteriorDistance(p) <= prune; },
+      tree, [&](const SurfaceBvh::Node& node) { return tree.node_box(node).exteriorDistance(p) <= prune; },
       [&](std::uint32_t i) {
         const auto& [a, b] = outline.segments[i];
         near = (closest_on_segment(p, a, b) - p).squaredNorm() <= m2;

@@ -12,19 +12,48 @@ namespace {
 
 constexpr std::uint32_t kLeaf = SurfaceBvh::kLeafSize;
 
-// The nearest float not above (below) x: node boxes must contain the exact boxes they stand for.
-float float_down(double x) {
-  const float f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+// The grid step of one axis: the smallest power of two whose kGrid steps from the root's low end
+// reach its high end as decode computes them (1 for a flat extent: every coordinate is then 0), and
+// at least 2^-49 of the coordinates' magnitude: a step below their rounding would make decode flat
+// over long runs of coordinates, and the encoding's corrections (grid_at_or_below) long walks.
+// Normal doubles only (2^-1022 .. 2^1023); at 2^1023 the top of the grid is +inf, above any hi.
+std::int16_t step_exponent(double lo, double hi) {
+  if (!(hi > lo)) return 0;
+  const double extent = hi - lo;
+  const double magnitude = std::max(std::abs(lo), std::abs(hi));
+  int e = std::isfinite(extent) ? std::ilogb(extent / SurfaceBvh::kGrid) : 1023;
+  if (magnitude > 0.0 && std::isfinite(magnitude)) e = std::max(e, std::ilogb(magnitude) - 49);
+  e = std::clamp(e, -1022, 1023);
+  while (e < 1023 && lo + SurfaceBvh::kGrid * power_of_two(e) < hi) ++e;
+  return static_cast<std::int16_t>(e);
 }
-float float_up(double x) {
-  const float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+
+// The largest grid coordinate whose decoded value is <= x (-1: none), and the smallest whose
+// decoded value is >= x (kGrid + 1: none). decode is monotone, and with steps well above the
+// coordinates' rounding the first guess is off by a step or two, which the walks correct.
+std::int32_t grid_at_or_below(const SurfaceBvh& b, int k, double x) {
+  if (!(x >= b.decode(k, 0))) return -1;
+  if (x >= b.decode(k, SurfaceBvh::kGrid)) return SurfaceBvh::kGrid;
+  const double guess = std::floor((x - b.root.min()[k]) / b.step(k));
+  auto q = static_cast<std::int32_t>(std::clamp(guess, 0.0, double(SurfaceBvh::kGrid)));
+  while (q > 0 && b.decode(k, q) > x) --q;
+  while (q < SurfaceBvh::kGrid && b.decode(k, q + 1) <= x) ++q;
+  return q;
+}
+std::int32_t grid_at_or_above(const SurfaceBvh& b, int k, double x) {
+  if (!(x <= b.decode(k, SurfaceBvh::kGrid))) return SurfaceBvh::kGrid + 1;
+  if (x <= b.decode(k, 0)) return 0;
+  const double guess = std::ceil((x - b.root.min()[k]) / b.step(k));
+  auto q = static_cast<std::int32_t>(std::clamp(guess, 0.0, double(SurfaceBvh::kGrid)));
+  while (q < SurfaceBvh::kGrid && b.decode(k, q) < x) ++q;
+  while (q > 0 && b.decode(k, q - 1) >= x) --q;
+  return q;
 }
 
 struct Builder {
   std::span<const Aabb> boxes;
   std::vector<Vec3> centroids;
+  std::vector<std::uint32_t> order;
   SurfaceBvh& bvh;
   std::uint32_t used = 1;  // nodes handed out (the root first)
 
@@ -32,13 +61,15 @@ struct Builder {
     Aabb box;
     Aabb centre_box;
     for (std::uint32_t i = begin; i < end; ++i) {
-      box.extend(boxes[bvh.order[i]]);
-      centre_box.extend(centroids[bvh.order[i]]);
+      box.extend(boxes[order[i]]);
+      centre_box.extend(centroids[order[i]]);
     }
     SurfaceBvh::Node& n = bvh.nodes[index];
+    // The items lie in the root box, so both coordinates exist (decode(0) = root low end,
+    // decode(kGrid) >= root high end).
     for (int k = 0; k < 3; ++k) {
-      n.lo[k] = float_down(box.min()[k]);
-      n.hi[k] = float_up(box.max()[k]);
+      n.lo[k] = static_cast<std::uint16_t>(grid_at_or_below(bvh, k, box.min()[k]));
+      n.hi[k] = static_cast<std::uint16_t>(grid_at_or_above(bvh, k, box.max()[k]));
     }
     if (end - begin <= kLeaf) {
       n.bits = begin << 4 | (end - begin);
@@ -51,7 +82,7 @@ struct Builder {
     const std::uint32_t half = (end - begin) / 2;
     const std::uint32_t mid = begin + (half + kLeaf - 1) / kLeaf * kLeaf;
     // Ties broken by index so the tree (and every counter) is the same on every run.
-    std::nth_element(bvh.order.get() + begin, bvh.order.get() + mid, bvh.order.get() + end,
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                      [&](std::uint32_t a, std::uint32_t b) {
                        const double ca = centroids[a][axis], cb = centroids[b][axis];
                        return ca < cb || (ca == cb && a < b);
@@ -65,14 +96,18 @@ struct Builder {
   }
 };
 
-// The overlap test of boxes_overlap, against a node's rounded box (never empty).
-inline bool node_overlaps(const SurfaceBvh::Node& n, const Aabb& q) {
-  for (int k = 0; k < 3; ++k)
-    if (!(double(n.lo[k]) <= q.max()[k] && q.min()[k] <= double(n.hi[k]))) return false;
-  return true;
-}
-
 }  // namespace
+
+// Node n meets `query` (boxes_overlap's test on its decoded box) exactly when its grid coordinates
+// reach these: decode is monotone.
+GridBox grid_box(const SurfaceBvh& bvh, const Aabb& query) {
+  GridBox g;
+  for (int k = 0; k < 3; ++k) {
+    g.lo[k] = grid_at_or_above(bvh, k, query.min()[k]);
+    g.hi[k] = grid_at_or_below(bvh, k, query.max()[k]);
+  }
+  return g;
+}
 
 SurfaceBvh build_box_bvh(std::span<const Aabb> boxes) {
   SurfaceBvh bvh;
@@ -84,14 +119,24 @@ SurfaceBvh build_box_bvh(std::span<const Aabb> boxes) {
   // A binary tree with ceil(n / kLeafSize) leaves (see Builder::node) has twice that less one nodes.
   bvh.node_count = 2 * ((n + kLeaf - 1) / kLeaf) - 1;
   bvh.nodes = std::make_unique<SurfaceBvh::Node[]>(bvh.node_count);
-  bvh.order = std::make_unique<std::uint32_t[]>(n);
-  Builder b{boxes, std::vector<Vec3>(n), bvh};
+  for (int k = 0; k < 3; ++k) bvh.step_exponent[k] = step_exponent(bvh.root.min()[k], bvh.root.max()[k]);
+  Builder b{boxes, std::vector<Vec3>(n), std::vector<std::uint32_t>(n), bvh};
   for (std::uint32_t t = 0; t < n; ++t) {
     b.centroids[t] = boxes[t].center();
-    bvh.order[t] = t;
+    b.order[t] = t;
   }
   b.node(0, 0, n);
   assert(b.used == bvh.node_count);
+  bvh.wide = n > 65536;
+  bvh.order = std::make_unique<std::uint16_t[]>(bvh.wide ? 2 * std::size_t{n} : n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (bvh.wide) {
+      bvh.order[2 * i] = static_cast<std::uint16_t>(b.order[i] & 0xffffu);
+      bvh.order[2 * i + 1] = static_cast<std::uint16_t>(b.order[i] >> 16);
+    } else {
+      bvh.order[i] = static_cast<std::uint16_t>(b.order[i]);
+    }
+  }
   return bvh;
 }
 
@@ -105,11 +150,12 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
                        std::vector<std::uint32_t>& out, std::uint64_t& box_tests) {
   if (bvh.empty() || query.isEmpty()) return;
   const std::size_t start = out.size();
+  const GridBox grid = grid_box(bvh, query);
   walk_bvh(
       bvh,
       [&](const SurfaceBvh::Node& node) {
         ++box_tests;
-        return node_overlaps(node, query);
+        return node_meets(node, grid);
       },
       [&](std::uint32_t t) {
         ++box_tests;
@@ -137,12 +183,12 @@ double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, cons
   stack[top++] = 0;
   while (top > 0) {
     const SurfaceBvh::Node& node = bvh.nodes[stack[--top]];
-    if (node.box().exteriorDistance(p) > std::min(best, reach)) continue;
+    if (bvh.node_box(node).exteriorDistance(p) > std::min(best, reach)) continue;
     if (const std::uint32_t count = node.count(); count > 0) {
-      for (std::uint32_t i = node.first(); i < node.first() + count; ++i) visit(bvh.order[i]);
+      for (std::uint32_t i = node.first(); i < node.first() + count; ++i) visit(bvh.item(i));
     } else {
-      const bool left_nearer = bvh.nodes[node.first()].box().squaredExteriorDistance(p) <=
-                               bvh.nodes[node.first() + 1].box().squaredExteriorDistance(p);
+      const bool left_nearer = bvh.node_box(bvh.nodes[node.first()]).squaredExteriorDistance(p) <=
+                               bvh.node_box(bvh.nodes[node.first() + 1]).squaredExteriorDistance(p);
       stack[top++] = left_nearer ? node.first() + 1 : node.first();
       stack[top++] = left_nearer ? node.first() : node.first() + 1;
     }

@@ -2,16 +2,20 @@
 // frame. Built once per surface and queried with a box (the surface-pair OAABB). Internal to
 // cadclash::collide.
 //
-// Layout (issue 16: the whole collision model in <= 48 bytes per triangle): 28-byte nodes with
-// float boxes rounded outward (each contains the exact double box of its items), leaves of up to
-// kLeafSize items, all full but the last, no tree at all for small surfaces, and no per-item boxes:
-// items are tested on their exact double boxes, computed from the vertices the model already holds. Culling by the rounded
-// node boxes only ever keeps more, and every item is judged on its exact box, so a query returns the
-// same items as a tree of exact boxes would; only the number of node tests differs.
+// Layout (issue 16: the whole collision model in <= 48 bytes per triangle): 16-byte nodes whose
+// boxes are 16-bit coordinates on a grid over the tree's exact root box (a power-of-two step per
+// axis), rounded outward, so each decoded node box contains the exact double box of its items;
+// leaves of up to kLeafSize items, all full but the last; item indices in 16 bits when they fit;
+// no tree at all for small surfaces, and no per-item boxes: items are tested on their exact double
+// boxes, computed from the vertices the model already holds. Culling by the rounded node boxes only
+// ever keeps more, and every item is judged on its exact box, so a query returns the same items as
+// a tree of exact boxes would; only the number of node tests differs.
 #pragma once
 
 #include "cadclash/collide.h"
 
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -19,32 +23,61 @@
 
 namespace cadclash::detail {
 
+// 2^e for a normal double exponent e (-1022..1023), without a library call.
+inline double power_of_two(int e) { return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52); }
+
 struct SurfaceBvh {
   static constexpr std::uint32_t kLeafSize = 8;
   // Up to this many items there is no tree: a query scans the items (a surface this small is mostly
   // a strip along a fillet or a chamfer; a tree would cost more bytes than its triangles).
   static constexpr std::uint32_t kFlatLimit = 2 * kLeafSize;
+  static constexpr std::int32_t kGrid = 65535;  // largest grid coordinate
   struct Node {
-    float lo[3], hi[3];  // rounded outward from the exact box of the node's items
-    // Leaf: (first index into `order`) << 4 | count, count in 1..kLeafSize. Inner: (left child) << 4;
-    // the right child is left + 1.
+    // Grid coordinates (node_box decodes them): lo rounded down, hi up from the items' exact box.
+    std::uint16_t lo[3], hi[3];
+    // Leaf: (first index into the item order) << 4 | count, count in 1..kLeafSize. Inner: (left
+    // child) << 4; the right child is left + 1.
     std::uint32_t bits = 0;
     std::uint32_t count() const { return bits & 15u; }
     std::uint32_t first() const { return bits >> 4; }
-    Aabb box() const {
-      return Aabb(Vec3(double(lo[0]), double(lo[1]), double(lo[2])), Vec3(double(hi[0]), double(hi[1]), double(hi[2])));
-    }
   };
-  static_assert(sizeof(Node) == 28);
+  static_assert(sizeof(Node) == 16);
 
-  Aabb root;                 // exact box of every item; empty when there are none
+  Aabb root;                 // exact box of every item; empty when there are none (the grid's origin: root.min())
   std::uint32_t items = 0;   // number of items
   std::uint32_t node_count = 0;           // 0: no tree (items <= kFlatLimit); nodes[0] is the root
   std::unique_ptr<Node[]> nodes;          // node_count nodes
-  std::unique_ptr<std::uint32_t[]> order; // with a tree: item indices, leaves hold contiguous runs
+  // With a tree: item indices, leaves hold contiguous runs; 16 bits each, or two halves (low first)
+  // each when `wide` (more than 65536 items).
+  std::unique_ptr<std::uint16_t[]> order;
+  std::int16_t step_exponent[3] = {0, 0, 0};  // grid step per axis: 2^step_exponent
+  bool wide = false;
 
+  double step(int k) const { return power_of_two(step_exponent[k]); }
   bool empty() const { return items == 0; }
+  std::uint32_t item(std::uint32_t i) const {
+    return wide ? std::uint32_t{order[2 * i]} | std::uint32_t{order[2 * i + 1]} << 16 : order[i];
+  }
+  // A grid coordinate of axis k as a double: monotone in q, root.min()[k] at 0, >= root.max()[k] at kGrid.
+  double decode(int k, std::int32_t q) const { return root.min()[k] + double(q) * step(k); }
+  // The node's box: contains the exact box of its items.
+  Aabb node_box(const Node& n) const {
+    return Aabb(Vec3(decode(0, n.lo[0]), decode(1, n.lo[1]), decode(2, n.lo[2])),
+                Vec3(decode(0, n.hi[0]), decode(1, n.hi[1]), decode(2, n.hi[2])));
+  }
 };
+
+// A query box on a tree's grid: node n meets the box exactly when its decoded box does, i.e. when
+// n.lo[k] <= hi[k] and n.hi[k] >= lo[k] on every axis.
+struct GridBox {
+  std::array<std::int32_t, 3> lo, hi;
+};
+GridBox grid_box(const SurfaceBvh& bvh, const Aabb& query);
+inline bool node_meets(const SurfaceBvh::Node& n, const GridBox& q) {
+  bool in = true;
+  for (int k = 0; k < 3; ++k) in &= (std::int32_t{n.lo[k]} <= q.hi[k]) & (std::int32_t{n.hi[k]} >= q.lo[k]);
+  return in;
+}
 
 // The tree over items whose exact boxes are `boxes` (read during the build only).
 // Precondition: boxes.size() < 2^28.
@@ -53,12 +86,12 @@ SurfaceBvh build_box_bvh(std::span<const Aabb> boxes);
 // The bytes the tree holds besides the SurfaceBvh itself (nodes, order).
 inline std::uint64_t bvh_heap_bytes(const SurfaceBvh& b) {
   return b.node_count * std::uint64_t{sizeof(SurfaceBvh::Node)} +
-         (b.node_count > 0 ? b.items * std::uint64_t{sizeof(std::uint32_t)} : 0);
+         (b.node_count > 0 ? b.items * std::uint64_t{b.wide ? 4u : 2u} : 0);
 }
 
 // Depth-first walk, left child first: `enter(node)` says whether to descend into a node (judged on
-// its rounded box); `item(index)` is called for each item of an entered leaf, or for every item
-// 0..items-1 when there is no tree, and returns true to end the walk.
+// its grid box: node_meets, or node_box for distances); `item(index)` is called for each item of an
+// entered leaf, or for every item 0..items-1 when there is no tree, and returns true to end the walk.
 template <class Enter, class Item>
 void walk_bvh(const SurfaceBvh& b, Enter&& enter, Item&& item) {
   if (b.node_count == 0) {
@@ -74,7 +107,7 @@ void walk_bvh(const SurfaceBvh& b, Enter&& enter, Item&& item) {
     if (!enter(node)) continue;
     if (const std::uint32_t count = node.count(); count > 0) {
       for (std::uint32_t i = node.first(); i < node.first() + count; ++i)
-        if (item(b.order[i])) return;
+        if (item(b.item(i))) return;
     } else {
       stack[top++] = node.first() + 1;
       stack[top++] = node.first();

@@ -1,0 +1,132 @@
+// The per-surface tree's grid-encoded node boxes (surface_bvh.h): every decoded node box contains
+// the exact boxes of its items, and a query returns exactly the items whose exact box meets the
+// query box, at any placement and scale of the coordinates (far from the origin, tiny extents, flat
+// axes, huge magnitudes) and with more items than 16-bit indices hold.
+#include "surface_bvh.h"
+
+#include "cadclash/geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace cadclash {
+namespace {
+
+using detail::SurfaceBvh;
+
+// Random boxes of size up to `size` in a cube of side `extent` at `offset`; axis `flat` (0..2) has
+// no extent at all when given.
+std::vector<Aabb> random_boxes(std::size_t n, const Vec3& offset, double extent, double size, int flat,
+                               std::uint32_t seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Aabb> boxes(n);
+  for (auto& b : boxes) {
+    Vec3 lo(u(gen), u(gen), u(gen));
+    lo = offset + extent * lo;
+    Vec3 hi = lo + size * Vec3(u(gen), u(gen), u(gen));
+    if (flat >= 0) lo[flat] = hi[flat] = offset[flat];
+    b = Aabb(lo, hi);
+  }
+  return boxes;
+}
+
+// Walks the whole tree: every leaf item's exact box lies in the decoded box of every node above it,
+// and every item is reached once.
+void expect_nodes_contain_items(const SurfaceBvh& bvh, const std::vector<Aabb>& boxes) {
+  ASSERT_GT(bvh.node_count, 0u);
+  std::vector<int> seen(boxes.size(), 0);
+  struct Entry {
+    std::uint32_t node;
+    std::vector<Aabb> above;
+  };
+  std::vector<Entry> stack{{0, {}}};
+  while (!stack.empty()) {
+    Entry e = std::move(stack.back());
+    stack.pop_back();
+    const SurfaceBvh::Node& n = bvh.nodes[e.node];
+    e.above.push_back(bvh.node_box(n));
+    if (n.count() > 0) {
+      for (std::uint32_t i = n.first(); i < n.first() + n.count(); ++i) {
+        const std::uint32_t item = bvh.item(i);
+        ASSERT_LT(item, boxes.size());
+        ++seen[item];
+        for (const Aabb& box : e.above) ASSERT_TRUE(box.contains(boxes[item])) << "item " << item;
+      }
+    } else {
+      stack.push_back({n.first(), e.above});
+      stack.push_back({n.first() + 1, e.above});
+    }
+  }
+  for (std::size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "item " << i;
+}
+
+// The same answer as testing every item's exact box, for query boxes around and between items.
+void expect_queries_exact(const SurfaceBvh& bvh, const std::vector<Aabb>& boxes, std::uint32_t seed) {
+  std::mt19937 gen(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, boxes.size() - 1);
+  for (int q = 0; q < 200; ++q) {
+    Aabb query = boxes[pick(gen)];
+    query.extend(boxes[pick(gen)].center());
+    if (q % 3 == 0) query = Aabb(boxes[pick(gen)].max());  // a point: touching boxes count
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t i = 0; i < boxes.size(); ++i)
+      if (boxes_overlap(boxes[i], query)) expected.push_back(i);
+    std::vector<std::uint32_t> got;
+    bool stop = false;
+    const detail::GridBox grid = detail::grid_box(bvh, query);
+    detail::walk_bvh(
+        bvh, [&](const SurfaceBvh::Node& n) { return detail::node_meets(n, grid); },
+        [&](std::uint32_t i) {
+          if (boxes_overlap(boxes[i], query)) got.push_back(i);
+          return stop;
+        });
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, expected) << "query " << q;
+  }
+}
+
+struct GridCase {
+  const char* name;
+  Vec3 offset;
+  double extent, size;
+  int flat;
+  std::size_t items;
+};
+
+TEST(SurfaceBvh, DecodedNodeBoxesContainTheirItemsAndQueriesAreExact) {
+  const GridCase cases[] = {
+      {"unit", Vec3(0, 0, 0), 100.0, 1.0, -1, 1000},
+      {"far from the origin", Vec3(1e6, -2e6, 3e5), 10.0, 0.1, -1, 1000},
+      {"tiny extent far away (below float resolution)", Vec3(1e6, 1e6, 1e6), 1e-6, 1e-8, -1, 500},
+      {"extent near the coordinates' rounding", Vec3(1e3, 1e3, 1e3), 1e-11, 1e-12, -1, 300},
+      {"a flat axis", Vec3(-5, 7, 3.25), 50.0, 0.5, 2, 800},
+      {"huge magnitudes", Vec3(-1e300, 1e300, 0), 1e299, 1e297, -1, 500},
+      {"more items than 16-bit indices", Vec3(0.5, 0.25, -3), 1000.0, 0.2, -1, 70000},
+  };
+  for (const GridCase& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::vector<Aabb> boxes = random_boxes(c.items, c.offset, c.extent, c.size, c.flat, 7);
+    const SurfaceBvh bvh = detail::build_box_bvh(boxes);
+    EXPECT_EQ(bvh.wide, c.items > 65536);
+    expect_nodes_contain_items(bvh, boxes);
+    expect_queries_exact(bvh, boxes, 11);
+  }
+}
+
+// The tree's bytes are what the layout promises: 16 per node and 2 per item (4 past 65536 items).
+TEST(SurfaceBvh, BytesPerItem) {
+  const std::vector<Aabb> small = random_boxes(1000, Vec3::Zero(), 10.0, 0.1, -1, 3);
+  const SurfaceBvh a = detail::build_box_bvh(small);
+  EXPECT_EQ(a.node_count, 2u * 125u - 1u);
+  EXPECT_EQ(detail::bvh_heap_bytes(a), 16u * a.node_count + 2u * 1000u);
+  const std::vector<Aabb> flat_only = random_boxes(SurfaceBvh::kFlatLimit, Vec3::Zero(), 10.0, 0.1, -1, 3);
+  EXPECT_EQ(detail::bvh_heap_bytes(detail::build_box_bvh(flat_only)), 0u);
+}
+
+}  // namespace
+}  // namespace cadclash
