@@ -61,6 +61,24 @@ Share share(const Core& core, const std::array<Vec3, 3>& t) {
   return s;
 }
 
+// A line or point core: how deep triangles X whose points have r in [lo_x, hi_x] can straddle
+// triangle y (share `y`) when one of them intersects y. Outward (the side y's normal ν points away
+// from the core): r(f + h·ν) >= r(f) + h·c_y, so h <= (hi_x - lo_y) / c_y. Inward, at depth t:
+// r(f - t·ν)^2 <= r_f^2 - 2·t·r_f·c_y + t^2 (ρ_f·ν >= r_f·c_y, |ν⊥| <= 1), which is below lo_x^2,
+// so holds no point of X, for t between the roots t1 < t2 when lo_x^2 > r_f^2·(1 - c_y^2) for every
+// foot f. X's triangle meets y at depth 0 and its part over y is convex, so its depths cannot jump
+// that gap: they stay <= t1 = (r_f^2 - lo_x^2) / (r_f·c_y + sqrt(lo_x^2 - r_f^2·(1 - c_y^2))). Only
+// intersecting pairs count (the run measures no other), so the smaller bound holds for them.
+double over_curved(const Share& y, double lo_x, double hi_x, double slack) {
+  if (!(y.c > 0.0)) return std::numeric_limits<double>::infinity();
+  const double outward = (std::max(0.0, hi_x - y.lo) + 2.0 * slack) / y.c;
+  const double gap = lo_x * lo_x - y.hi * y.hi * (1.0 - y.c * y.c);
+  if (!(lo_x > 0.0 && gap > 1e-9 * lo_x * lo_x)) return outward;
+  const double inward =
+      (std::max(0.0, y.hi - lo_x) + 2.0 * slack) * (y.hi + lo_x + 2.0 * slack) / (y.lo * y.c + std::sqrt(gap));
+  return std::min(outward, inward);
+}
+
 // The steep sets for one core, or nullopt when the shell is too thick for it to say anything.
 std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::array<Vec3, 3>>& ta,
                                        const std::vector<std::array<Vec3, 3>>& tb, double level, double slack) {
@@ -74,22 +92,32 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
     sb[j] = share(core, tb[j]);
     lo_b = std::min(lo_b, sb[j].lo), hi_b = std::max(hi_b, sb[j].hi);
   }
-  // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: straddle(X over Y)
-  // <= (hi_a - lo_b) / c_Y and straddle(Y over X) <= (hi_b - lo_a) / c_X. The shell's ends and the
-  // foot points carry the rounding of r (slack each), the depth its own.
+  // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: per triangle
+  // (over_curved). The shell's ends and the foot points carry the rounding of r (slack each), the
+  // depth its own.
   const double room = level - slack;
-  const double d_ab = std::max(0.0, hi_a - lo_b) + 2.0 * slack, d_ba = std::max(0.0, hi_b - lo_a) + 2.0 * slack;
   const double grow = 1.0 + 1e-9;
-  double kappa_a, kappa_b;  // a triangle is steep below these
-  if (core.kind == Core::Plane) kappa_a = kappa_b = std::min(d_ab, d_ba) / room * grow;
-  else kappa_a = d_ba / room * grow, kappa_b = d_ab / room * grow;
-  if (!(kappa_a < 1.0) && !(kappa_b < 1.0)) return std::nullopt;
   CrossingBound b;
   b.steep_a.resize(ta.size());
   b.steep_b.resize(tb.size());
   bool any_a = false, any_b = false;
-  for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(sa[i].c >= kappa_a)) != 0;
-  for (std::size_t j = 0; j < tb.size(); ++j) any_b |= (b.steep_b[j] = !(sb[j].c >= kappa_b)) != 0;
+  if (core.kind == Core::Plane) {
+    const double d_ab = std::max(0.0, hi_a - lo_b) + 2.0 * slack, d_ba = std::max(0.0, hi_b - lo_a) + 2.0 * slack;
+    const double kappa = std::min(d_ab, d_ba) / room * grow;  // a triangle is steep below this
+    if (!(kappa < 1.0)) return std::nullopt;
+    for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(sa[i].c >= kappa)) != 0;
+    for (std::size_t j = 0; j < tb.size(); ++j) any_b |= (b.steep_b[j] = !(sb[j].c >= kappa)) != 0;
+  } else {
+    // x of A is steep when B's triangles may straddle it deeper than the level, and y of B when A's
+    // may straddle it: a pair is deeper only if both are.
+    for (std::size_t i = 0; i < ta.size(); ++i)
+      any_a |= (b.steep_a[i] = !(over_curved(sa[i], lo_b, hi_b, slack) * grow <= room)) != 0;
+    for (std::size_t j = 0; j < tb.size(); ++j)
+      any_b |= (b.steep_b[j] = !(over_curved(sb[j], lo_a, hi_a, slack) * grow <= room)) != 0;
+    if (any_a && any_b && std::all_of(b.steep_a.begin(), b.steep_a.end(), [](char c) { return c != 0; }) &&
+        std::all_of(b.steep_b.begin(), b.steep_b.end(), [](char c) { return c != 0; }))
+      return std::nullopt;
+  }
   b.any = any_a && any_b;
   return b;
 }
@@ -165,7 +193,7 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
   fallback.any = !ta.empty() && !tri_b.empty();
   if (!fallback.any || !(level > slack)) return fallback;  // no room: everything may cross
   // Cores, the likeliest first: A's own analytic axis or centre; for a plane a plane; for another
-  // face a fitted axis, then the plane of its largest triangle.
+  // face a fitted axis, then the plane of its largest triangle; then B's plane and fitted axis.
   std::optional<CrossingBound> best;
   auto steep_pairs = [](const CrossingBound& b) {
     std::size_t na = 0, nb = 0;
@@ -179,6 +207,7 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
     if (b && (!best || steep_pairs(*b) < steep_pairs(*best))) best = std::move(b);
     return best && !best->any;
   };
+  bool done = false;
   switch (core_a.shape) {
     case SurfaceShape::Cylinder:
     case SurfaceShape::Sphere: {
@@ -186,13 +215,14 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
       c.kind = core_a.shape == SurfaceShape::Cylinder ? Core::Line : Core::Point;
       c.origin = core_a.origin;
       c.dir = core_a.axis.normalized();
-      consider(c);
+      done = consider(c);
       break;
     }
-    case SurfaceShape::Plane: consider(plane_core(ta)); break;
-    default:
-      if (!consider(fitted_axis(ta))) consider(plane_core(ta));
+    case SurfaceShape::Plane: done = consider(plane_core(ta)); break;
+    default: done = consider(fitted_axis(ta)) || consider(plane_core(ta));
   }
+  // Then B's: the plane a pin stands on, the axis of a pin through a plate's hole.
+  if (!done && !consider(plane_core(tri_b))) consider(fitted_axis(tri_b));
   return best ? *best : fallback;
 }
 

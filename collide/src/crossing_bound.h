@@ -21,8 +21,11 @@ namespace cadclash::detail {
 // ρ̂ the direction away from the core, so on the side where n points away from it |h| <= (hi - lo) /
 // c_Y, c_Y = min over Y of n·ρ̂ (from Y's vertices: min_v n·ρ_v / max_v |ρ_v|; for a plane |n·u|).
 // Hence straddle(X, Y) <= (hi - lo) / c_Y and crossing_depth(X, Y) <= (hi - lo) / max(c_X, c_Y),
-// plus rounding below `slack`. A triangle is steep when its c is too small for that bound to stay
-// within `level`: only a steep triangle of A against a steep one of B can cross deeper than it.
+// plus rounding below `slack`. For a line or point core the side toward the core is bounded too
+// when X meets Y (crossing_bound.cpp, over_curved): a shaft through a hole crosses the plate's
+// triangles no deeper than the chords' sag. A triangle is steep when its bound does not stay within
+// `level`: only an intersecting pair of a steep triangle of A and a steep one of B can cross deeper
+// than it (the run measures the crossing depth of intersecting pairs only).
 struct CrossingBound {
   std::vector<char> steep_a;  // per A survivor in [begin, end), index i - begin
   std::vector<char> steep_b;  // per B survivor
