@@ -31,7 +31,8 @@ void settle(Pending& p, Verdict v, DecidedBy by, const PairOutcome* o, double cl
     p.cls = o != nullptr && certainly_penetrating(*o, p.threshold, p.mesh_band) ? ContactClass::Penetrating
                                                                                 : ContactClass::Touching;
   } else {
-    p.cls = apart_class(p.exact ? *p.exact : o != nullptr ? o->distance : p.d.lo, clearance);
+    // Intersecting triangles measure no distance (narrow_phase.h): the proven lower bound stands in.
+    p.cls = apart_class(p.exact ? *p.exact : o != nullptr && !o->intersecting ? o->distance : p.d.lo, clearance);
     p.dropped = !p.cls;
   }
 }

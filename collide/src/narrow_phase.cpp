@@ -339,19 +339,37 @@ struct TriangleRun {
   }
 
   // Until the run has an intersecting pair (and for every pair when all are listed): the exact
-  // intersection test, and the distance while none intersects.
+  // intersection test. The distance matters only if no pair intersects, and most pairs that reach
+  // this level do: the candidates passed by are measured only then (measure_deferred), in the order
+  // they were met, so the minimum, its witness and the tests made are those of measuring each one
+  // as it comes. A long wait is measured in chunks, which only spends tests an intersection later
+  // would have saved.
+  static constexpr std::size_t kMaxDeferred = 4096;
+  std::vector<std::array<std::uint32_t, 2>> deferred;  // survivor indices (i, j), visiting order
+
   [[gnu::noinline]] void first_phase(std::size_t i, std::size_t j) {
     const auto& tb = p.tri_b[j];
     if (triangles_intersect(a0, a1, a2, tb[0], tb[1], tb[2], stats)) {
       if (!out.intersecting) out.witness = {p.la[i], p.lb[j]};
       out.intersecting = true;
+      deferred.clear();
       if (all) out.triangle_pairs.push_back({p.la[i], p.lb[j]});
       note_crossing(crossing_depth(a0, a1, a2, tb[0], tb[1], tb[2]));
     } else if (!out.intersecting && want_distance) {
+      deferred.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)});
+      if (deferred.size() == kMaxDeferred) measure_deferred();
+    }
+  }
+
+  // The distances of the deferred candidates, in their order.
+  void measure_deferred() {
+    for (const auto& [i, j] : deferred) {
       // A box lower bound beyond what is already known cannot lower the minimum (slack: rounding).
       const double lower = box_distance(p.box_a[i], p.box_b[j]);
       if (lower <= std::min(out.distance, p.margin) + (p.margin - std::max(p.tau, options.clearance))) {
         ++counters.distance_tests;
+        load_a(i);
+        const auto& tb = p.tri_b[j];
         const double d = triangle_distance(a0, a1, a2, tb[0], tb[1], tb[2]);
         if (d < out.distance) {
           out.distance = d;
@@ -359,6 +377,7 @@ struct TriangleRun {
         }
       }
     }
+    deferred.clear();
   }
 
   // Candidate (A's survivor i, B's survivor j).
@@ -419,6 +438,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
   } else {
     tree_candidates(run);
   }
+  if (!out.intersecting && !out.cut) run.measure_deferred();
   counters.triangle_tests += run.stats.tests;
   counters.exact_fallbacks += run.stats.exact_fallbacks;
 }

@@ -49,6 +49,8 @@ struct PairOutcome {
   // exact faces: they are not measured beyond what the two flags need.
   double penetration = 0.0;
   bool crosses_threshold = false;  // some intersecting pair crosses deeper than PreparedPair::threshold
+  // The smallest triangle distance when no pair intersects (+inf when no candidate came within the
+  // margin). When one does, pairs met before it are not all measured: the value means nothing then.
   double distance = std::numeric_limits<double>::infinity();
   std::vector<std::array<std::uint32_t, 2>> triangle_pairs;
   // The triangle pair (indices in Sk's and Sl's meshes) that decided the outcome: the first
