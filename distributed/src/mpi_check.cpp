@@ -183,6 +183,38 @@ void add_stats(RankStats& into, const RankStats& s) {
   into.model_triangles = s.model_triangles;
 }
 
+std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm) {
+  MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  if (mine.size() > static_cast<std::size_t>(INT32_MAX)) {
+    std::fprintf(stderr, "cadclash check: rank %d: %zu bytes to share, more than one MPI message holds\n", rank,
+                 mine.size());
+    MPI_Abort(comm, 1);
+  }
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
+  check_mpi(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "MPI_Allgather", comm);
+  long long total = 0;
+  for (int r = 0; r < size; ++r) {
+    offsets[static_cast<std::size_t>(r)] = static_cast<int>(total);
+    total += counts[static_cast<std::size_t>(r)];
+  }
+  if (total > INT32_MAX) {
+    std::fprintf(stderr, "cadclash check: the ranks share %lld bytes, more than one MPI gather holds\n", total);
+    MPI_Abort(comm, 1);
+  }
+  std::string all(static_cast<std::size_t>(total), '\0');
+  check_mpi(MPI_Allgatherv(mine.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, comm),
+            "MPI_Allgatherv", comm);
+  std::vector<std::string> out;
+  for (int r = 0; r < size; ++r)
+    out.push_back(all.substr(static_cast<std::size_t>(offsets[static_cast<std::size_t>(r)]),
+                             static_cast<std::size_t>(counts[static_cast<std::size_t>(r)])));
+  return out;
+}
+
 bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& options, bool share_edges,
                       PartMeshing& pm, MPI_Comm comm) {
   assert(pm.mesher.mesh && pm.mesher.release);
@@ -192,7 +224,7 @@ bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& op
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const CheckPlan plan = boxes_scene.plan(options);  // boxes only, the same on every replica
-  const std::vector<int> owners = mesh_owners(model, plan, size);
+  const std::vector<int> owners = mesh_owners(model, plan, size, pm.home);
   std::vector<std::vector<PartId>> owned(static_cast<std::size_t>(size));
   for (PartId p = 0; p < owners.size(); ++p) owned[static_cast<std::size_t>(owners[p])].push_back(p);
   const std::vector<PartId>& mine = owned[static_cast<std::size_t>(rank)];
