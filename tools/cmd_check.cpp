@@ -487,7 +487,8 @@ int run_check_mpi(const CheckOptions& o, bool by_parts, const ReviewInputs& revi
     return kExitInputError;
   const int code = rows ? check_imported(o, imported, *rows, review, &mpi, by_parts ? &inputs : nullptr)
                         : kExitInputError;
-  mpi.note_files_read(by_parts ? inputs.files_read() : o.in.files.size(), o.in.files.size());
+  mpi.note_files_read(by_parts ? inputs.files_read() : o.in.files.size(), o.in.files.size(),
+                      by_parts ? inputs.read_seconds() : imported.seconds);
   if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
   return mpi.agree(code);
 }

@@ -49,7 +49,7 @@ struct MpiCheck::State {
   // built is not counted again, as in one process.
   std::optional<MergeHistory> history;
   std::optional<PartMeshing> parts;  // part meshing, when mesh_parts_where_needed set it up
-  std::vector<int> files_read;       // rank 0: per rank, the input files it read (note_files_read)
+  std::vector<double> files_read;    // rank 0: per rank, the input files it read and the seconds it took
   std::size_t files = 0;
   PartMeshing* part_meshing() { return parts ? &*parts : nullptr; }
   void add(const std::vector<RankStats>& r, double merge) {
@@ -126,11 +126,11 @@ void MpiCheck::mesh_every_part(Model& model) {
   state_->parts->mesher.mesh(all);  // a failure would have shown in mesh_parts_where_needed
 }
 
-void MpiCheck::note_files_read(std::size_t read_here, std::size_t files) {
-  const int mine = static_cast<int>(read_here);
-  state_->files_read.assign(static_cast<std::size_t>(size_), 0);
+void MpiCheck::note_files_read(std::size_t read_here, std::size_t files, double seconds) {
+  const double mine[2] = {static_cast<double>(read_here), seconds};
+  state_->files_read.assign(2 * static_cast<std::size_t>(size_), 0.0);
   state_->files = files;
-  MPI_Gather(&mine, 1, MPI_INT, state_->files_read.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 2, MPI_DOUBLE, state_->files_read.data(), 2, MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
@@ -162,8 +162,9 @@ void MpiCheck::print_ranks(std::ostream& os) const {
        << static_cast<double>(s.result_bytes) / 1024.0 << " KiB; model triangles held " << s.held_triangles;
     if (state_->parts)
       os << ", meshed here " << s.meshed_triangles << " of the model's " << s.model_triangles;
-    if (state_->files > 0 && static_cast<std::size_t>(s.rank) < state_->files_read.size())
-      os << "; files read here " << state_->files_read[static_cast<std::size_t>(s.rank)] << " of " << state_->files;
+    if (const auto at = 2 * static_cast<std::size_t>(s.rank); state_->files > 0 && at < state_->files_read.size())
+      os << "; files read here " << static_cast<std::size_t>(state_->files_read[at]) << " of " << state_->files
+         << " (" << std::fixed << std::setprecision(3) << state_->files_read[at + 1] << " s)";
     os << '\n' << std::defaultfloat;
     slowest = std::max(slowest, s.seconds);
     sum += s.seconds;

@@ -80,8 +80,9 @@ class MpiCheck {
   // With part meshing: every part not meshed here meshed now, the files not read here read first
   // (rank 0, before the HTML report).
   void mesh_every_part(Model& model);
-  // Collective: how many of the `files` input files each rank read, for print_ranks.
-  void note_files_read(std::size_t read_here, std::size_t files);
+  // Collective: how many of the `files` input files each rank read and in how many seconds, for
+  // print_ranks.
+  void note_files_read(std::size_t read_here, std::size_t files, double seconds);
   // Scene::check split over the ranks; the merged report on rank 0 (empty elsewhere).
   Report check(Scene& scene, Model& model, const CollideOptions& options);
   // replay_trajectory split over the ranks; the steps on rank 0.

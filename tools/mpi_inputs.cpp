@@ -56,6 +56,7 @@ ImportResult DistributedInputs::read(const InputOptions& in, MPI_Comm comm) {
     read_[0] = 1;
     show_read(rank_, size_, in.files[0], "the only file");
     ImportResult one = import_files(in.files, import_options(in));
+    read_seconds_ += one.seconds;
     share_edges_ = brep_parts_share_edges(one.model);
     first_part_ = {0, static_cast<PartId>(one.model.parts.size())};
     part_reader_.clear();  // parts no pair reaches: spread by surfaces (mesh_owners)
@@ -89,7 +90,9 @@ ImportResult DistributedInputs::read(const InputOptions& in, MPI_Comm comm) {
   std::string shared;  // per file read here: its index, its description's length, the description
   int edges = 0;
   if (!paths.empty()) {
+    const auto read_start = std::chrono::steady_clock::now();
     std::vector<ImportResult> got = import_each_file(paths, import_options(in));
+    read_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     for (std::size_t k = 0; k < mine.size(); ++k) {
       const std::string d = import_description(got[k]);
       put_u64(shared, mine[k]);
@@ -145,7 +148,9 @@ bool DistributedInputs::read_files_of(Model& model, std::span<const PartId> part
     paths.push_back(in_.files[f]);
     show_read(rank_, size_, in_.files[f], "its share reaches it");
   }
+  const auto start = std::chrono::steady_clock::now();
   std::vector<ImportResult> got = import_each_file(paths, import_options(in_));
+  read_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   bool same = true;
   for (std::size_t k = 0; k < files.size(); ++k) {
     const std::size_t f = files[k];

@@ -39,6 +39,8 @@ class DistributedInputs {
   bool parts_share_edges() const { return share_edges_; }
   std::size_t files_read() const;
   std::size_t files() const { return read_.size(); }
+  // Wall seconds this rank spent reading files (read and read_files_of).
+  double read_seconds() const { return read_seconds_; }
 
  private:
   InputOptions in_;
@@ -49,6 +51,7 @@ class DistributedInputs {
   std::vector<char> read_;           // per file: read here (its B-rep parts have their exact faces)
   std::vector<std::string> described_;  // per file not read here: its reader's description
   bool share_edges_ = false;
+  double read_seconds_ = 0.0;
 };
 #endif
 
