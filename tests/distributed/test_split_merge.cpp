@@ -378,12 +378,13 @@ TEST(SplitMerge, MeshOwnersFollowTheSplit) {
   EXPECT_EQ(mesh_owners(m, plan, 2, home), (std::vector<int>{0, 0, 1, 1, 1}));
 }
 
-TEST(SplitMerge, ReadersLargestFileFirstToTheLeastLoadedRank) {
-  // 100 and 60 to ranks 0 and 1, 50 to rank 1 (60 < 100), then 40 to rank 0 (100 < 110); equal
-  // sizes in file order; an empty file still counts.
-  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{50, 100, 40, 60}, 2), (std::vector<int>{1, 0, 0, 1}));
-  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{7, 7, 7}, 2), (std::vector<int>{0, 1, 0}));
-  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{0, 0, 5}, 3), (std::vector<int>{1, 2, 0}));
+TEST(SplitMerge, ReadersTakeContiguousRunsOfEqualBytes) {
+  // 250 bytes in all on 2 ranks: middles at 25, 100 (< 125: rank 0), 170, 220.
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{50, 100, 40, 60}, 2), (std::vector<int>{0, 0, 1, 1}));
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{7, 7, 7, 7}, 4), (std::vector<int>{0, 1, 2, 3}));
+  // Fewer files than ranks: spread out; an empty file still counts.
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{10, 10}, 4), (std::vector<int>{1, 3}));
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{0, 0, 5}, 3), (std::vector<int>{0, 0, 1}));
   EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{3, 9}, 1), (std::vector<int>{0, 0}));
 }
 

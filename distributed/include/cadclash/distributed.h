@@ -133,8 +133,11 @@ std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int rank
 // the exact faces (import.h, import_description); a rank reads another file only when its share of
 // the work reaches a part of it. The readers are chosen by file size, the work of reading.
 
-// Per file, its reader: the largest file first to the rank with the fewest bytes to read so far
-// (lowest rank on ties; equal sizes in file order). Precondition: ranks >= 1.
+// Per file, its reader: the files in the order given split into contiguous runs of about equal
+// bytes, as split_by_cost splits pairs (file f goes to the rank r with r·B/ranks <= bytes before f +
+// half of f's < (r+1)·B/ranks, B the total; an empty file counts 1 byte). Instances, and so the
+// plan's sorted pairs and their runs, come in file order: when most pairs lie within a file, a
+// rank's run falls mostly in the files it reads. Precondition: ranks >= 1.
 std::vector<int> assign_readers(std::span<const std::uint64_t> file_bytes, int ranks);
 
 // The facts of every surface of `parts` as `model` holds them now, in part then surface order.
