@@ -1,8 +1,9 @@
 // cadclash/distributed.h — one check (or trajectory) split over MPI processes, merged on rank 0 into
 // the report one process gives.
 //
-// How (collide.h, "One check split over processes"): every rank imports the same files and builds
-// the same Scene (replicated: assembly, B-rep, poses, surface boxes); every rank computes the plan
+// How (collide.h, "One check split over processes"): every rank holds the same model and builds
+// the same Scene (replicated: assembly, poses, surface boxes; the B-rep where its files were read,
+// below); every rank computes the plan
 // (broad phase and surface level: boxes only; the same pairs everywhere); rank 0 splits its pairs
 // into contiguous runs of equal estimated cost; each rank checks its run (check_part), tessellating
 // only what its pairs reach: with lazy tessellation the surfaces, face by face; with part meshing
