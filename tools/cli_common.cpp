@@ -72,8 +72,7 @@ void print_repair_summary(const MeshRepairReport& r, bool fill_holes, double sec
 
 }  // namespace
 
-ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report, SegmentReport* segment_report) {
-  ProgressLine line(show_progress(in.quiet), std::cerr);
+ImportOptions import_options(const InputOptions& in) {
   ImportOptions options;
   options.tessellation = effective_tessellation(in);
   options.lazy = in.lazy;
@@ -83,9 +82,20 @@ ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_repo
   options.tessellation.time_limit_seconds = in.import_time_limit;
   options.cache_dir = in.cache;
   options.parallel_files = in.parallel_files;
+  return options;
+}
+
+ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report, SegmentReport* segment_report) {
+  ProgressLine line(show_progress(in.quiet), std::cerr);
+  ImportOptions options = import_options(in);
   options.progress = line.callback();
   ImportResult result = import_files(in.files, options);
   line.clear();
+  return finish_inputs(in, std::move(result), repair_report, segment_report);
+}
+
+ImportResult finish_inputs(const InputOptions& in, ImportResult result, MeshRepairReport* repair_report,
+                           SegmentReport* segment_report) {
   print_diagnostics(result.diagnostics);
   if (in.repair) {
     MeshRepairOptions repair_options;

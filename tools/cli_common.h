@@ -51,6 +51,12 @@ TessellationOptions effective_tessellation(const InputOptions& in);
 // when given, receive what repair and segmentation did (left empty without --repair / --segment).
 ImportResult import_inputs(const InputOptions& in, MeshRepairReport* repair_report = nullptr,
                            SegmentReport* segment_report = nullptr);
+// The options the switches give the importer (no progress callback).
+ImportOptions import_options(const InputOptions& in);
+// What import_inputs does after import_files: `result`'s diagnostics printed, mesh parts repaired
+// and segmented when asked.
+ImportResult finish_inputs(const InputOptions& in, ImportResult result, MeshRepairReport* repair_report = nullptr,
+                           SegmentReport* segment_report = nullptr);
 
 // Prints diagnostics to stderr, one line each.
 void print_diagnostics(const std::vector<Diagnostic>& ds);

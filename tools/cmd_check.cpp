@@ -4,6 +4,7 @@
 #include "cmd_check_mpi.h"
 #include "html_report.h"
 #include "import_stages.h"
+#include "mpi_inputs.h"
 #include "progress_line.h"
 
 #include "cadclash/report.h"
@@ -255,7 +256,8 @@ struct Runner {
   std::function<std::vector<StepResult>(std::span<const TrajectoryRow>, const CollideOptions&, std::vector<Diagnostic>&,
                                         const std::string&)>
       replay;
-  std::function<void()> before_html;  // makes the model whole for the 3D view, when it is not
+  std::function<void()> before_html;    // makes the model whole for the 3D view, when it is not
+  std::function<void()> before_volume;  // gives every part its exact faces (--volume), when it may not have them
 };
 
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
@@ -274,7 +276,10 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run
     ro.pair_boxes = contact_boxes(m, poses, r);
   }
   report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, ro);
-  if (o.review.volume) measure_clashes(m, *report.review);
+  if (o.review.volume) {
+    if (run.before_volume) run.before_volume();
+    measure_clashes(m, *report.review);
+  }
   out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
   if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
   if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
@@ -368,8 +373,10 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
 }
 
 // The check of what was imported: in this process, or split over the ranks of `mpi` when given.
+// `inputs`, under mpirun with part meshing, reads the files a rank needs and has not read.
 int check_imported(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
-                   const ReviewInputs& review, [[maybe_unused]] MpiCheck* mpi) {
+                   const ReviewInputs& review, [[maybe_unused]] MpiCheck* mpi,
+                   [[maybe_unused]] DistributedInputs* inputs = nullptr) {
   Model& m = imported.model;
   if (m.instances.empty()) {
     std::cerr << "cadclash check: no instances to check\n";
@@ -397,6 +404,7 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
                   ProgressLine line(progress, std::cerr);
                   return replay_trajectory(scene, r, with_progress(c, line), ds, file);
                 },
+                {},
                 {}};
   bool primary = true;
 #if CADCLASH_HAS_MPI
@@ -406,15 +414,23 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
     runner.replay = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
                         const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
     runner.before_html = [&] { mpi->mesh_every_part(m); };
+    if (inputs != nullptr)
+      runner.before_volume = [&] {
+        std::vector<PartId> all(m.parts.size());
+        for (PartId p = 0; p < all.size(); ++p) all[p] = p;
+        if (mpi->rank() == 0) inputs->read_files_of(m, all);  // only rank 0 measures
+      };
   }
 #endif
   return finish_check(o, imported, rows, runner, scene, copt, primary, review);
 }
 
 #if CADCLASH_HAS_MPI
-// Part meshing (cmd_check_mpi.h) on what the import read without triangles, printing `messages` (what
-// it said); when part meshing cannot give the eager import's model, every rank imports eagerly.
-void mesh_parts_or_import(const CheckOptions& o, ImportResult& imported, const std::string& messages, MpiCheck& mpi) {
+// Part meshing (cmd_check_mpi.h) on what the ranks read without triangles, printing `messages` (what
+// the import said); when part meshing cannot give the eager import's model, every rank imports
+// eagerly. False (rank 0 says why) when the ranks' eager imports differ.
+bool mesh_parts_or_import(const CheckOptions& o, ImportResult& imported, const std::string& messages,
+                          const std::string& extra, DistributedInputs& inputs, MpiCheck& mpi) {
   std::optional<SceneSelection> sel;
   {
     std::ostringstream quiet;  // check_imported says why a selection fails
@@ -422,11 +438,59 @@ void mesh_parts_or_import(const CheckOptions& o, ImportResult& imported, const s
     sel = scene_selection(imported.model, o);
     std::cerr.rdbuf(err);
   }
-  if (sel && mpi.mesh_parts_where_needed(imported.model, *sel, collide_options(o))) {
+  if (sel && mpi.mesh_parts_where_needed(imported.model, *sel, collide_options(o), inputs)) {
     std::cerr << messages;
-    return;
+    return true;
   }
   imported = import_inputs(o.in);
+  inputs.read_everywhere();
+  return mpi.same_input_everywhere(imported.model, imported.diagnostics, extra);
+}
+
+// `cadclash check` as one rank of an MPI job. MPI starts before the files are read, although the
+// isolated CAD reader forks a child per file (import/src/isolated_run.cpp): part meshing reads files
+// after the plan, which needs MPI, and the import's descriptions are exchanged over it. Forking
+// after MPI_Init is safe with the transports Open MPI 4.1 uses on a node and between nodes without
+// RDMA (vader shared memory, tcp, self): the child never calls MPI, touches none of Open MPI's
+// memory or sockets and leaves with _exit, and Open MPI arms its fork warning (mpi_warn_on_fork,
+// opal_warn_fork) only in the openib BTL, whose registered (pinned) memory a forked child's
+// copy-on-write pages can corrupt (Open MPI FAQ, "OpenFabrics: fork"; in 4.1.4 only
+// mca_btl_openib.so calls opal_warn_fork). vader copies between processes by address (CMA,
+// process_vm_readv), which copy-on-write does not disturb. On InfiniBand (openib, or UCX) it is as
+// safe as the verbs stack's fork support (ibv_fork_init; Linux 5.12+ copies pinned pages at fork);
+// --no-isolation reads without forking there.
+int run_check_mpi(const CheckOptions& o, bool by_parts, const ReviewInputs& review) {
+  MpiCheck mpi;
+  DistributedInputs inputs;
+  // What the import says on stderr waits, under part meshing, until part meshing is known to stand.
+  std::ostringstream import_messages;
+  ImportResult imported;
+  if (by_parts) {
+    InputOptions lazy = o.in;
+    lazy.lazy = true;
+    std::streambuf* err = std::cerr.rdbuf(import_messages.rdbuf());
+    imported = finish_inputs(lazy, inputs.read(lazy, MPI_COMM_WORLD));
+    std::cerr.rdbuf(err);
+  } else {
+    imported = import_inputs(o.in);
+  }
+  std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
+  if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
+  // Every rank must hold the same input before any further collective, or the ranks would wait for
+  // each other.
+  const std::string trajectory = rows ? std::to_string(rows->size()) + " trajectory rows" : "unreadable trajectory";
+  if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) {
+    std::cerr << import_messages.str();
+    return kExitInputError;
+  }
+  if (by_parts && !mesh_parts_or_import(o, imported, import_messages.str(), trajectory, inputs, mpi))
+    return kExitInputError;
+  const int code = rows ? check_imported(o, imported, *rows, review, &mpi, by_parts ? &inputs : nullptr)
+                        : kExitInputError;
+  mpi.note_files_read(by_parts ? inputs.files_read() : o.in.files.size(), o.in.files.size(),
+                      by_parts ? inputs.read_seconds() : imported.seconds);
+  if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
+  return mpi.agree(code);
 }
 #endif
 
@@ -443,39 +507,14 @@ int run_check(const CheckOptions& o, const Launch& launch) {
   // Before the import: a bad baseline or approvals file should not cost a long import first.
   const std::optional<ReviewInputs> review = load_review_inputs(o.review, !o.path_csv.empty());
   if (!review) return kExitInputError;
-  // Under mpirun an eager check reads the B-rep without triangles and meshes whole parts where the
-  // ranks' shares need them (part meshing, cmd_check_mpi.h); what that import says on stderr waits
-  // until it is known to stand.
-  const bool by_parts = CADCLASH_HAS_MPI && launch.by_mpirun && !o.in.lazy && o.in.import_time_limit <= 0.0;
-  std::ostringstream import_messages;
-  ImportResult imported;
-  if (by_parts) {
-    InputOptions lazy = o.in;
-    lazy.lazy = true;
-    std::streambuf* err = std::cerr.rdbuf(import_messages.rdbuf());
-    imported = import_inputs(lazy);
-    std::cerr.rdbuf(err);
-  } else {
-    imported = import_inputs(o.in);
-  }
+#if CADCLASH_HAS_MPI
+  // Under mpirun an eager check reads the B-rep without triangles, each file on one rank, and meshes
+  // whole parts where the ranks' shares need them (part meshing, cmd_check_mpi.h, mpi_inputs.h).
+  if (launch.by_mpirun) return run_check_mpi(o, !o.in.lazy && o.in.import_time_limit <= 0.0, *review);
+#endif
+  ImportResult imported = import_inputs(o.in);
   std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
   if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
-#if CADCLASH_HAS_MPI
-  if (launch.by_mpirun) {
-    // MPI starts after the import: the isolated CAD readers fork, which MPI transports dislike. Every
-    // rank must have read the same input before any collective, or the ranks would wait for each other.
-    MpiCheck mpi;
-    const std::string trajectory = rows ? std::to_string(rows->size()) + " trajectory rows" : "unreadable trajectory";
-    if (!mpi.same_input_everywhere(imported.model, imported.diagnostics, trajectory)) {
-      std::cerr << import_messages.str();
-      return kExitInputError;
-    }
-    if (by_parts) mesh_parts_or_import(o, imported, import_messages.str(), mpi);
-    const int code = rows ? check_imported(o, imported, *rows, *review, &mpi) : kExitInputError;
-    if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
-    return mpi.agree(code);
-  }
-#endif
   if (!rows) return kExitInputError;
   return check_imported(o, imported, *rows, *review, nullptr);
 }

@@ -1,4 +1,5 @@
 #include "cmd_check_mpi.h"
+#include "mpi_inputs.h"
 
 #include "cadclash/distributed.h"
 #include "cadclash/tessellate.h"
@@ -48,6 +49,8 @@ struct MpiCheck::State {
   // built is not counted again, as in one process.
   std::optional<MergeHistory> history;
   std::optional<PartMeshing> parts;  // part meshing, when mesh_parts_where_needed set it up
+  std::vector<double> files_read;    // rank 0: per rank, the input files it read and the seconds it took
+  std::size_t files = 0;
   PartMeshing* part_meshing() { return parts ? &*parts : nullptr; }
   void add(const std::vector<RankStats>& r, double merge) {
     merge_seconds += merge;
@@ -91,9 +94,12 @@ bool MpiCheck::same_input_everywhere(const Model& model, const std::vector<Diagn
   return same;
 }
 
-bool MpiCheck::mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options) {
+bool MpiCheck::mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options,
+                                       DistributedInputs& inputs) {
   PartMeshing pm;
-  pm.mesher.mesh = [&model](std::span<const PartId> parts) {
+  pm.home = inputs.part_readers();
+  pm.mesher.mesh = [&model, &inputs](std::span<const PartId> parts) {
+    if (!inputs.read_files_of(model, parts)) return false;
     std::vector<Diagnostic> errors;
     bool complete = true;
     tessellate_parts(model, parts, errors, complete);
@@ -103,7 +109,7 @@ bool MpiCheck::mesh_parts_where_needed(Model& model, const SceneSelection& selec
   bool ok = false;
   {
     Scene boxes(model, selection);
-    ok = share_part_facts(boxes, model, options, brep_parts_share_edges(model), pm, MPI_COMM_WORLD);
+    ok = share_part_facts(boxes, model, options, inputs.parts_share_edges(), pm, MPI_COMM_WORLD);
   }
   if (ok) state_->parts = std::move(pm);
   return ok;
@@ -118,6 +124,13 @@ void MpiCheck::mesh_every_part(Model& model) {
   std::vector<PartId> all(model.parts.size());
   for (PartId p = 0; p < all.size(); ++p) all[p] = p;
   state_->parts->mesher.mesh(all);  // a failure would have shown in mesh_parts_where_needed
+}
+
+void MpiCheck::note_files_read(std::size_t read_here, std::size_t files, double seconds) {
+  const double mine[2] = {static_cast<double>(read_here), seconds};
+  state_->files_read.assign(2 * static_cast<std::size_t>(size_), 0.0);
+  state_->files = files;
+  MPI_Gather(mine, 2, MPI_DOUBLE, state_->files_read.data(), 2, MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
@@ -149,6 +162,9 @@ void MpiCheck::print_ranks(std::ostream& os) const {
        << static_cast<double>(s.result_bytes) / 1024.0 << " KiB; model triangles held " << s.held_triangles;
     if (state_->parts)
       os << ", meshed here " << s.meshed_triangles << " of the model's " << s.model_triangles;
+    if (const auto at = 2 * static_cast<std::size_t>(s.rank); state_->files > 0 && at < state_->files_read.size())
+      os << "; files read here " << static_cast<std::size_t>(state_->files_read[at]) << " of " << state_->files
+         << " (" << std::fixed << std::setprecision(3) << state_->files_read[at + 1] << " s)";
     os << '\n' << std::defaultfloat;
     slowest = std::max(slowest, s.seconds);
     sum += s.seconds;

@@ -49,6 +49,7 @@ class SilentRank {
 };
 
 class MpiCheck;
+class DistributedInputs;
 #if CADCLASH_HAS_MPI
 // One MPI session (MPI_Init_thread on construction, MPI_Finalize on destruction) and the distributed
 // forms of the queries. Every rank calls every method in the same order (collectives).
@@ -70,12 +71,18 @@ class MpiCheck {
   // check that asked for an eager import, and every rank now meshes (tessellate_parts) the parts it
   // owns and learns the other parts' facts; check() and replay() then mesh on each rank the parts its
   // share reaches. Collective. False on every rank when that cannot give the eager import's model (a
-  // face that does not mesh, parts sharing edges): import eagerly then.
-  bool mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options);
+  // face that does not mesh, parts sharing edges): import eagerly then. `inputs` read the files
+  // (DistributedInputs::read) and reads those of the parts a rank meshes that it has not read.
+  bool mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options,
+                               DistributedInputs& inputs);
   // With part meshing: the checking scene (built after mesh_parts_where_needed) told the facts.
   void note_parts(Scene& scene);
-  // With part meshing: every part not meshed here meshed now (rank 0, before the HTML report).
+  // With part meshing: every part not meshed here meshed now, the files not read here read first
+  // (rank 0, before the HTML report).
   void mesh_every_part(Model& model);
+  // Collective: how many of the `files` input files each rank read and in how many seconds, for
+  // print_ranks.
+  void note_files_read(std::size_t read_here, std::size_t files, double seconds);
   // Scene::check split over the ranks; the merged report on rank 0 (empty elsewhere).
   Report check(Scene& scene, Model& model, const CollideOptions& options);
   // replay_trajectory split over the ranks; the steps on rank 0.
@@ -84,7 +91,7 @@ class MpiCheck {
                                  const std::string& file);
   // Rank 0: one line per rank (instance pairs, estimated cost, triangles, seconds, peak memory at the
   // end of its part, bytes sent, triangles its model holds and, with part meshing, the triangles it
-  // meshed of the model's), rank 0's peak after merging and writing, and the load imbalance and merge
+  // meshed of the model's; the input files it read), rank 0's peak after merging and writing, and the load imbalance and merge
   // time, over the queries run so far.
   void print_ranks(std::ostream& os) const;
   // Rank 0's exit code, on every rank.

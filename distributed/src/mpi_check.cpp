@@ -6,11 +6,13 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstdio>
+#include <cstring>
 #include <new>
 
 namespace cadclash {
@@ -80,6 +82,22 @@ std::vector<std::uint32_t> my_part(const CheckPlan& plan, int rank, int size, MP
   return mine;
 }
 
+// Where each rank's part starts in a gather of `counts` bytes; ends the job when they pass what one
+// MPI gather holds (int offsets). Returns the total.
+std::size_t offsets_of(const std::vector<int>& counts, std::vector<int>& offsets, MPI_Comm comm) {
+  long long total = 0;
+  offsets.assign(counts.size(), 0);
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    offsets[r] = static_cast<int>(std::min<long long>(total, INT32_MAX));
+    total += counts[r];
+  }
+  if (total > INT32_MAX) {
+    std::fprintf(stderr, "cadclash check: the ranks' parts take %lld bytes, more than one MPI gather holds\n", total);
+    MPI_Abort(comm, 1);
+  }
+  return static_cast<std::size_t>(total);
+}
+
 // Every rank's bytes on rank 0 (empty elsewhere).
 std::vector<std::vector<std::uint8_t>> gather_bytes(const std::vector<std::uint8_t>& mine, int rank, int size,
                                                     MPI_Comm comm) {
@@ -93,18 +111,7 @@ std::vector<std::vector<std::uint8_t>> gather_bytes(const std::vector<std::uint8
   std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
   check_mpi(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm), "MPI_Gather", comm);
   std::vector<std::uint8_t> all;
-  if (rank == 0) {
-    long long total = 0;
-    for (int r = 0; r < size; ++r) {
-      offsets[static_cast<std::size_t>(r)] = static_cast<int>(total);
-      total += counts[static_cast<std::size_t>(r)];
-    }
-    if (total > INT32_MAX) {
-      std::fprintf(stderr, "cadclash check: the ranks' results take %lld bytes, more than one MPI gather holds\n", total);
-      MPI_Abort(comm, 1);
-    }
-    all.resize(static_cast<std::size_t>(total));
-  }
+  if (rank == 0) all.resize(offsets_of(counts, offsets, comm));
   check_mpi(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, 0, comm),
             "MPI_Gatherv", comm);
   std::vector<std::vector<std::uint8_t>> out;
@@ -183,6 +190,29 @@ void add_stats(RankStats& into, const RankStats& s) {
   into.model_triangles = s.model_triangles;
 }
 
+std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm) {
+  MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  if (mine.size() > static_cast<std::size_t>(INT32_MAX)) {
+    std::fprintf(stderr, "cadclash check: rank %d: %zu bytes to share, more than one MPI message holds\n", rank,
+                 mine.size());
+    MPI_Abort(comm, 1);
+  }
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
+  check_mpi(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "MPI_Allgather", comm);
+  std::string all(offsets_of(counts, offsets, comm), '\0');
+  check_mpi(MPI_Allgatherv(mine.data(), count, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, comm),
+            "MPI_Allgatherv", comm);
+  std::vector<std::string> out;
+  for (int r = 0; r < size; ++r)
+    out.push_back(all.substr(static_cast<std::size_t>(offsets[static_cast<std::size_t>(r)]),
+                             static_cast<std::size_t>(counts[static_cast<std::size_t>(r)])));
+  return out;
+}
+
 bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& options, bool share_edges,
                       PartMeshing& pm, MPI_Comm comm) {
   assert(pm.mesher.mesh && pm.mesher.release);
@@ -192,7 +222,7 @@ bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& op
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const CheckPlan plan = boxes_scene.plan(options);  // boxes only, the same on every replica
-  const std::vector<int> owners = mesh_owners(model, plan, size);
+  const std::vector<int> owners = mesh_owners(model, plan, size, pm.home);
   std::vector<std::vector<PartId>> owned(static_cast<std::size_t>(size));
   for (PartId p = 0; p < owners.size(); ++p) owned[static_cast<std::size_t>(owners[p])].push_back(p);
   const std::vector<PartId>& mine = owned[static_cast<std::size_t>(rank)];
@@ -216,26 +246,15 @@ bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& op
                             f.has_triangles ? 1.0 : 0.0};
     mine_v.insert(mine_v.end(), v, v + kPer);
   }
-  const int count = static_cast<int>(mine_v.size());
-  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
-  check_mpi(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm), "MPI_Allgather", comm);
-  long long total = 0;
+  // Doubles as their bytes: the ranks run one build on one kind of host.
+  const std::vector<std::string> all = allgather_bytes(
+      std::string(reinterpret_cast<const char*>(mine_v.data()), mine_v.size() * sizeof(double)), comm);
   for (int r = 0; r < size; ++r) {
-    offsets[static_cast<std::size_t>(r)] = static_cast<int>(total);
-    total += counts[static_cast<std::size_t>(r)];
-  }
-  if (total > INT32_MAX) {
-    std::fprintf(stderr, "cadclash check: the surfaces' facts take more than one MPI message holds\n");
-    MPI_Abort(comm, 1);
-  }
-  std::vector<double> all(static_cast<std::size_t>(total));
-  check_mpi(MPI_Allgatherv(mine_v.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
-                           comm),
-            "MPI_Allgatherv", comm);
-  for (int r = 0; r < size; ++r) {
+    const std::string& bytes = all[static_cast<std::size_t>(r)];
+    std::vector<double> x(bytes.size() / sizeof(double));
+    std::memcpy(x.data(), bytes.data(), x.size() * sizeof(double));
     std::vector<SurfaceFacts> facts;
-    const double* x = all.data() + offsets[static_cast<std::size_t>(r)];
-    for (int i = 0; i + kPer <= counts[static_cast<std::size_t>(r)]; i += kPer) {
+    for (std::size_t i = 0; i + kPer <= x.size(); i += kPer) {
       SurfaceFacts f;
       f.box = Aabb(Vec3(x[i], x[i + 1], x[i + 2]), Vec3(x[i + 3], x[i + 4], x[i + 5]));
       f.deflection = x[i + 6];

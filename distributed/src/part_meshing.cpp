@@ -20,8 +20,9 @@ std::vector<PartId> parts_of_pairs(const Model& model, const CheckPlan& plan, st
   return out;
 }
 
-std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int ranks) {
+std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int ranks, std::span<const int> home) {
   assert(ranks >= 1);
+  assert(home.empty() || home.size() == model.parts.size());
   std::vector<int> owner(model.parts.size(), -1);
   std::vector<std::uint64_t> surfaces(static_cast<std::size_t>(ranks), 0);
   const std::vector<std::vector<std::uint32_t>> runs = split_by_cost(plan, ranks);
@@ -33,6 +34,11 @@ std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int rank
       }
   for (PartId p = 0; p < owner.size(); ++p) {
     if (owner[p] >= 0) continue;
+    if (!home.empty()) {
+      assert(home[p] >= 0 && home[p] < ranks);
+      owner[p] = home[p];
+      continue;
+    }
     const auto least = std::min_element(surfaces.begin(), surfaces.end());
     owner[p] = static_cast<int>(least - surfaces.begin());
     *least += model.parts[p].surface_count;

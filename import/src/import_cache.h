@@ -23,8 +23,10 @@ std::optional<std::string> cache_entry_name(const std::string& path, const Impor
 
 // One file's result as an entry's contents, and back. std::nullopt when the model holds a part whose
 // source cannot be stored (neither none nor a BrepSource). load_import returns false and `why` when
-// the contents are not whole.
-std::optional<std::string> save_import(const ImportResult& r);
-bool load_import(std::string_view bytes, ImportResult& r, std::string& why);
+// the contents are not whole. Without `exact_faces` a B-rep part is stored as its default deflection
+// only (import_description), which load_import accepts only with `stand_ins`: the part then gets a
+// source that knows that deflection and meshes nothing.
+std::optional<std::string> save_import(const ImportResult& r, bool exact_faces = true);
+bool load_import(std::string_view bytes, ImportResult& r, std::string& why, bool stand_ins = false);
 
 }  // namespace cadclash::detail

@@ -128,10 +128,12 @@ ImportResult read_any(const std::string& path, const ImportOptions& options) {
 
 }  // namespace
 
-ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options) {
-  if (paths.size() == 1) return import_file(paths.front(), options);
-  const auto start = std::chrono::steady_clock::now();
+std::vector<ImportResult> import_each_file(std::span<const std::string> paths, const ImportOptions& options) {
   std::vector<ImportResult> each(paths.size());
+  if (paths.size() == 1) {
+    each.front() = import_file(paths.front(), options);
+    return each;
+  }
   std::vector<std::exception_ptr> failed(paths.size());
   int threads = options.parallel_files > 0 ? options.parallel_files : omp_get_max_threads();
 #if CADCLASH_ASAN_RUNTIME
@@ -173,6 +175,12 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
   }
   for (const std::exception_ptr& e : failed)
     if (e) std::rethrow_exception(e);
+  return each;
+}
+
+ImportResult merge_file_imports(std::span<const std::string> paths, std::vector<ImportResult> each) {
+  assert(each.size() == paths.size());
+  if (paths.size() == 1) return std::move(each.front());
   ImportResult all;
   for (std::size_t i = 0; i < paths.size(); ++i) {
     ImportResult& one = each[i];
@@ -182,7 +190,15 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
     all.diagnostics.insert(all.diagnostics.end(), one.diagnostics.begin(), one.diagnostics.end());
     all.complete = all.complete && one.complete;
     all.files.insert(all.files.end(), one.files.begin(), one.files.end());
+    all.seconds = std::max(all.seconds, one.seconds);
   }
+  return all;
+}
+
+ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options) {
+  if (paths.size() == 1) return import_file(paths.front(), options);
+  const auto start = std::chrono::steady_clock::now();
+  ImportResult all = merge_file_imports(paths, import_each_file(paths, options));
   all.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return all;
 }

@@ -5,6 +5,22 @@
 namespace cadclash::detail {
 namespace {
 
+// A B-rep part whose file this process has not read (import_from_description): it knows the
+// deflection its faces will be meshed at, which is all a plan asks of an unmeshed face.
+class StandInSource final : public SurfaceSource {
+ public:
+  explicit StandInSource(double deflection) : deflection_(deflection) {}
+  bool triangulate(std::uint32_t local_index, double, TriangleMesh&, double&, Diagnostic& error) override {
+    error = {Severity::Error, {}, 0, -1,
+             "face " + std::to_string(local_index) + ": its file was not read in this process"};
+    return false;
+  }
+  double default_deflection() const override { return deflection_; }
+
+ private:
+  double deflection_;
+};
+
 void put_vec(ByteWriter& w, const Vec3& v) {
   for (int k = 0; k < 3; ++k) w.f64(v[k]);
 }
@@ -91,7 +107,7 @@ bool get_surface(ByteReader& r, Surface& s) {
 
 }  // namespace
 
-std::optional<std::string> save_import(const ImportResult& result) {
+std::optional<std::string> save_import(const ImportResult& result, bool exact_faces) {
   ByteWriter w;
   write_diagnostics(w, result.diagnostics);
   w.u64(result.complete ? 1 : 0);
@@ -108,6 +124,11 @@ std::optional<std::string> save_import(const ImportResult& result) {
     }
     const auto* brep = dynamic_cast<const BrepSource*>(part.source.get());
     if (!brep) return std::nullopt;
+    if (!exact_faces) {
+      w.u64(2);
+      w.f64(brep->default_deflection());
+      continue;
+    }
     w.u64(1);
     w.str(save_brep_source(*brep));
   }
@@ -123,7 +144,7 @@ std::optional<std::string> save_import(const ImportResult& result) {
   return std::move(w.out);
 }
 
-bool load_import(std::string_view bytes, ImportResult& result, std::string& why) {
+bool load_import(std::string_view bytes, ImportResult& result, std::string& why, bool stand_ins) {
   ByteReader r{bytes};
   why = "its contents are cut short or inconsistent";
   result.diagnostics = read_diagnostics(r);
@@ -135,7 +156,13 @@ bool load_import(std::string_view bytes, ImportResult& result, std::string& why)
     part.source_file = r.str();
     part.first_surface = static_cast<SurfaceId>(r.u64());
     part.surface_count = static_cast<std::uint32_t>(r.u64());
-    if (r.u64() == 0 || !r.ok) continue;
+    const std::uint64_t kind = r.u64();
+    if (kind == 0 || !r.ok) continue;
+    if (kind == 2 && stand_ins) {
+      part.source = std::make_shared<StandInSource>(r.f64());
+      continue;
+    }
+    if (kind != 1) return false;
     std::string source_why;
     const std::string stored = r.str();
     if (!r.ok) return false;

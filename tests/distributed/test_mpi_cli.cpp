@@ -3,6 +3,7 @@
 // per-rank lines are printed; a rank that crashes is named with its unfinished instance pairs.
 // Without --lazy the ranks mesh whole parts where their shares need them (part meshing): still one
 // eagerly importing process's reports, with fewer triangles meshed per rank than the model holds.
+// Several files are each read on one rank, and on another only when its share reaches them.
 #include "../test_temp.h"
 #include "cadclash/export.h"
 #include "cadclash/import.h"
@@ -68,8 +69,9 @@ Outcome run(int ranks, const std::string& args, const std::string& env = "") {
 }
 
 // Runs the check in one process and on 1, 2 and 4 ranks (`rank_args` added there: other thread
-// counts); every output file and stdout must match.
-void expect_identical(const std::string& args, bool html, const std::string& rank_args = "") {
+// counts); every output file and stdout must match. Every rank line must hold `rank_says` when given.
+void expect_identical(const std::string& args, bool html, const std::string& rank_args = "",
+                      const std::string& rank_says = "") {
   auto files = [&](const std::string& tag) {
     return " --no-timings --json '" + scratch(tag + ".json") + "'" + (html ? " --html '" + scratch(tag + ".html") + "'" : "");
   };
@@ -87,8 +89,11 @@ void expect_identical(const std::string& args, bool html, const std::string& ran
       EXPECT_TRUE(slurp(scratch(tag + ".html")) == slurp(scratch("one.html"))) << ranks << " ranks: HTML differs";
     }
     for (int k = 0; k < ranks; ++k) {  // one line per rank on stderr
-      EXPECT_NE(r.err.find("rank " + std::to_string(k) + " of " + std::to_string(ranks) + ": "), std::string::npos)
-          << r.err;
+      const std::size_t line = r.err.find("rank " + std::to_string(k) + " of " + std::to_string(ranks) + ": ");
+      EXPECT_NE(line, std::string::npos) << r.err;
+      if (line != std::string::npos && !rank_says.empty()) {
+        EXPECT_NE(r.err.substr(line, r.err.find('\n', line) - line).find(rank_says), std::string::npos) << r.err;
+      }
     }
     EXPECT_NE(r.err.find("load imbalance"), std::string::npos) << r.err;
   }
@@ -226,13 +231,36 @@ TEST(MpiCli, RanksMeshOnlyThePartsTheirShareReaches) {
   }
 }
 
+// Rank r's line on stderr ("rank r of N: ..."); empty when missing.
+std::string rank_line(const std::string& err, int r, int ranks) {
+  const std::size_t at = err.find("rank " + std::to_string(r) + " of " + std::to_string(ranks) + ": ");
+  return at == std::string::npos ? std::string() : err.substr(at, err.find('\n', at) - at);
+}
+
+// What CADCLASH_TEST_SHOW_READS=1 makes rank r say when it reads `file` (`why`: "its reader" or "its
+// share reaches it").
+std::string read_line(int r, int ranks, const std::string& file, const std::string& why) {
+  return "cadclash check: rank " + std::to_string(r) + " of " + std::to_string(ranks) + " reads '" + file + "' (" +
+         why + ")\n";
+}
+
+// `text` without the lines CADCLASH_TEST_SHOW_READS adds.
+std::string without_read_lines(const std::string& text) {
+  std::istringstream in(text);
+  std::string out, line;
+  while (std::getline(in, line))
+    if (!(line.rfind("cadclash check: rank ", 0) == 0 && line.find(" reads '") != std::string::npos)) out += line + '\n';
+  return out;
+}
+
 // Two files, two boards and one board 1000 mm away, on two ranks, the pairs selected within the
 // boards (each file also holds an unused part at its origin, which write_board_step leaves as a free
-// shape: it would pair across the files). Rank 0's run lies within the first file (it holds about
-// 2/3 of the pairs), so rank 0 keeps nothing of the second file, though it reads it: it holds no more
-// triangles than the first file has. Rank 1 holds the second file's board and what its pairs reach
-// of the first.
-TEST(MpiCli, RankMeshesNothingOfAFileItsPairsDoNotReach) {
+// shape: it would pair across the files). The larger first file is read by rank 0, the second by
+// rank 1. Rank 0's run lies within the first file (it holds about 2/3 of the pairs), so rank 0
+// neither reads the second file nor keeps anything of it: it holds no more triangles than the first
+// file has. Rank 1 holds the second file's board and what its pairs reach of the first, which it
+// reads for them.
+TEST(MpiCli, RankReadsAndMeshesNothingOfAFileItsPairsDoNotReach) {
   REQUIRE_AS1();
   const std::string first = board_step(2, false), second = board_step(1, false, 1000);
   const Outcome alone = run(1, "check '" + first + "' --tolerance 0.01 --no-timings --threads 1");
@@ -246,7 +274,7 @@ TEST(MpiCli, RankMeshesNothingOfAFileItsPairsDoNotReach) {
                            " --tolerance 0.01 --no-timings --threads 1 --json ";
   const Outcome single = run(0, args + "'" + scratch("files_one.json") + "'");
   ASSERT_EQ(single.code, 0) << single.err;
-  const Outcome two = run(2, args + "'" + scratch("files_np2.json") + "'");
+  const Outcome two = run(2, args + "'" + scratch("files_np2.json") + "'", "CADCLASH_TEST_SHOW_READS=1");
   ASSERT_EQ(two.code, 0) << two.err;
   EXPECT_TRUE(slurp(scratch("files_np2.json")) == slurp(scratch("files_one.json")));
   EXPECT_TRUE(two.out == single.out);
@@ -257,6 +285,52 @@ TEST(MpiCli, RankMeshesNothingOfAFileItsPairsDoNotReach) {
   EXPECT_LE(ranks[0][0], in_first) << "rank 0 holds parts of the second file:\n" << two.err;
   EXPECT_GT(ranks[1][0], 0u) << two.err;
   EXPECT_LT(ranks[1][0], model) << two.err;
+  // Each file read once by its reader; rank 0 never reads the second, rank 1 the first for its pairs.
+  EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
+  EXPECT_NE(rank_line(two.err, 1, 2).find("; files read here 2 of 2"), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(0, 2, first, "its reader")), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(1, 2, second, "its reader")), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(1, 2, first, "its share reaches it")), std::string::npos) << two.err;
+  EXPECT_EQ(two.err.find("rank 0 of 2 reads '" + second + "'"), std::string::npos) << two.err;
+}
+
+// The same two files, every pair: on 1, 2 and 4 ranks the JSON, the table and the HTML (rank 0
+// reads and meshes what it did not need before writing it) are one process's; every rank line says
+// how many files the rank read.
+TEST(MpiCli, FilesReadWhereNeededSameReportHtmlAndTable) {
+  REQUIRE_AS1();
+  const std::string first = board_step(2, false), second = board_step(1, false, 1000);
+  expect_identical("check '" + first + "' '" + second + "' --tolerance 0.01", true, " --threads 1",
+                   "; files read here ");
+}
+
+// A truncated STEP file beside the boards, read on rank 1 only (the smaller file; the pairs are
+// selected within the first file's boards, so no rank's share reaches it and its unused parts are
+// meshed on its reader): its diagnostics (file and line, STEP #ids, the face kept unhealed) come out
+// once, exactly as one process prints and writes them, exit code 1.
+TEST(MpiCli, BadFileReadOnOneRankReportedAsInOneProcess) {
+  REQUIRE_AS1();
+  const std::string first = board_step(2, false);
+  const std::string bad = scratch("truncated_copy.step");
+  std::filesystem::copy_file(std::string(CADCLASH_DATA_DIR) + "/cad/truncated.step", bad,
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string boards = "/" + std::filesystem::path(first).filename().string() + "/board";
+  const std::string args = "check '" + first + "' '" + bad + "' --select-a " + boards + " --select-b " + boards +
+                           " --tolerance 0.01 --no-timings --threads 1 --json ";
+  const Outcome one = run(0, args + "'" + scratch("trunc_one.json") + "'");
+  ASSERT_EQ(one.code, 1) << one.err;
+  const std::string json = slurp(scratch("trunc_one.json"));
+  ASSERT_NE(one.err.find(bad + ":383: error: STEP file is truncated"), std::string::npos) << one.err;
+  ASSERT_NE(json.find("#325"), std::string::npos) << json;
+  const Outcome two = run(2, args + "'" + scratch("trunc_np2.json") + "'", "CADCLASH_TEST_SHOW_READS=1");
+  EXPECT_EQ(two.code, 1) << two.err;
+  EXPECT_TRUE(slurp(scratch("trunc_np2.json")) == json) << slurp(scratch("trunc_np2.json"));
+  EXPECT_TRUE(two.out == one.out);
+  const std::string err = without_read_lines(two.err);
+  EXPECT_EQ(err.substr(0, one.err.size()), one.err);  // the import's messages once, in one process's order
+  EXPECT_NE(two.err.find(read_line(1, 2, bad, "its reader")), std::string::npos) << two.err;
+  EXPECT_EQ(two.err.find("rank 0 of 2 reads '" + bad + "'"), std::string::npos) << two.err;
+  EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
 }
 
 // With --lazy every rank reads and keeps the B-rep and tessellates face by face: no part meshing.

@@ -373,6 +373,19 @@ TEST(SplitMerge, MeshOwnersFollowTheSplit) {
   // Three ranks, a pair each: part 4 to rank 1, the first of those owning one surface.
   EXPECT_EQ(mesh_owners(m, plan, 3), (std::vector<int>{0, 0, 1, 2, 1}));
   EXPECT_EQ(mesh_owners(m, plan, 1), (std::vector<int>{0, 0, 0, 0, 0}));
+  // With homes (the readers of the parts' files), a part no pair reaches goes home.
+  const std::vector<int> home{1, 1, 1, 0, 1};
+  EXPECT_EQ(mesh_owners(m, plan, 2, home), (std::vector<int>{0, 0, 1, 1, 1}));
+}
+
+TEST(SplitMerge, ReadersTakeContiguousRunsOfEqualBytes) {
+  // 250 bytes in all on 2 ranks: middles at 25, 100 (< 125: rank 0), 170, 220.
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{50, 100, 40, 60}, 2), (std::vector<int>{0, 0, 1, 1}));
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{7, 7, 7, 7}, 4), (std::vector<int>{0, 1, 2, 3}));
+  // Fewer files than ranks: spread out; an empty file still counts.
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{10, 10}, 4), (std::vector<int>{1, 3}));
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{0, 0, 5}, 3), (std::vector<int>{0, 0, 1}));
+  EXPECT_EQ(assign_readers(std::vector<std::uint64_t>{3, 9}, 1), (std::vector<int>{0, 0}));
 }
 
 TEST(SplitMerge, SplitIsContiguousCompleteAndBalanced) {

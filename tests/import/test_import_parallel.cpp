@@ -56,6 +56,53 @@ TEST(ImportParallel, SameSceneForAnyNumberOfFilesAtOnce) {
   }
 }
 
+// import_files in two steps (import_each_file, merge_file_imports), and each file's result through its
+// description (what another MPI rank receives): the same scene, B-rep parts with stand-in sources
+// that know their deflection and mesh nothing.
+TEST(ImportParallel, EachFileDescribedAndMergedGivesTheSameScene) {
+  const std::vector<std::string> files{kData + "cad/truncated.step", kData + "collide/box_a.obj",
+                                       kData + "cad/heal_unshared_vertices.brep", kData + "no-such-file.step"};
+  ImportOptions options;
+  options.lazy = true;
+  const ImportResult whole = import_files(files, options);
+  std::vector<ImportResult> each = import_each_file(files, options);
+  std::vector<ImportResult> described(files.size());
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::string why;
+    const std::string bytes = import_description(each[i]);
+    ASSERT_TRUE(import_from_description(bytes, described[i], why)) << files[i] << ": " << why;
+    EXPECT_EQ(described[i].files.size(), 1u);
+    EXPECT_EQ(described[i].files[0].path, files[i]);
+    ImportResult cut;
+    EXPECT_FALSE(import_from_description(bytes.substr(0, bytes.size() - 1), cut, why));
+  }
+  const ImportResult merged = merge_file_imports(files, std::move(each));
+  const ImportResult from_descriptions = merge_file_imports(files, std::move(described));
+  EXPECT_TRUE(same_bytes(everything(merged), everything(whole)));
+  EXPECT_EQ(messages(from_descriptions), messages(whole));
+  ASSERT_EQ(from_descriptions.model.parts.size(), whole.model.parts.size());
+  std::size_t stand_ins = 0;
+  for (PartId p = 0; p < whole.model.parts.size(); ++p) {
+    const auto& brep = whole.model.parts[p].source;
+    const auto& stand_in = from_descriptions.model.parts[p].source;
+    ASSERT_EQ(brep == nullptr, stand_in == nullptr) << p;
+    if (!brep) continue;
+    ++stand_ins;
+    EXPECT_EQ(stand_in->default_deflection(), brep->default_deflection());
+    TriangleMesh mesh;
+    double achieved = 0.0;
+    Diagnostic error;
+    EXPECT_FALSE(stand_in->triangulate(0, 0.0, mesh, achieved, error));
+  }
+  EXPECT_GT(stand_ins, 0u);
+  // Apart from the sources, the scene is the one import_files gives (surfaces, instances, poses).
+  ImportResult plain = from_descriptions;
+  for (Part& part : plain.model.parts) part.source.reset();
+  ImportResult plain_whole = whole;
+  for (Part& part : plain_whole.model.parts) part.source.reset();
+  EXPECT_TRUE(same_bytes(*detail::save_import(plain), *detail::save_import(plain_whole)));
+}
+
 // Without the isolated reader, OCCT's translators run in this process: they take turns.
 TEST(ImportParallel, UnisolatedReadersTakeTurns) {
   const std::vector<std::string> files{kData + "cad/valid_two_solids.step", kData + "cad/dangling_ref.step",

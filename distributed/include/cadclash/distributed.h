@@ -1,8 +1,9 @@
 // cadclash/distributed.h — one check (or trajectory) split over MPI processes, merged on rank 0 into
 // the report one process gives.
 //
-// How (collide.h, "One check split over processes"): every rank imports the same files and builds
-// the same Scene (replicated: assembly, B-rep, poses, surface boxes); every rank computes the plan
+// How (collide.h, "One check split over processes"): every rank holds the same model and builds
+// the same Scene (replicated: assembly, poses, surface boxes; the B-rep where its files were read,
+// below); every rank computes the plan
 // (broad phase and surface level: boxes only; the same pairs everywhere); rank 0 splits its pairs
 // into contiguous runs of equal estimated cost; each rank checks its run (check_part), tessellating
 // only what its pairs reach: with lazy tessellation the surfaces, face by face; with part meshing
@@ -112,15 +113,33 @@ struct PartMeshing {
   std::vector<char> facts_only;     // per part: meshed here for its facts, not reached by a share yet
   std::uint64_t meshed_triangles = 0;  // triangles this replica meshed so far (released ones included)
   std::uint64_t model_triangles = 0;   // triangles of every B-rep surface of the model (from the facts)
+  // Per part, the rank that meshes it when no pair reaches it (the rank that read its file, which
+  // holds its exact faces); empty: the rank with the fewest surfaces owned (mesh_owners).
+  std::vector<int> home;
 };
 
 // The parts of the instances of plan.pairs[k], k in `pairs`: ascending, each once.
 std::vector<PartId> parts_of_pairs(const Model& model, const CheckPlan& plan, std::span<const std::uint32_t> pairs);
 
 // Per part, the rank that meshes it first: the first rank, in split_by_cost(plan, ranks), whose run
-// reaches the part; a part no pair reaches goes to the rank with the fewest surfaces owned so far
-// (lowest rank on ties). The same on every replica of the same plan. Precondition: ranks >= 1.
-std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int ranks);
+// reaches the part; a part no pair reaches goes to home[part] when `home` is given, else to the rank
+// with the fewest surfaces owned so far (lowest rank on ties). The same on every replica of the same
+// plan. Preconditions: ranks >= 1; `home` empty or one rank in [0, ranks) per part.
+std::vector<int> mesh_owners(const Model& model, const CheckPlan& plan, int ranks, std::span<const int> home = {});
+
+// ---------------------------------------------------------------------------------------------
+// Files read where they are needed (no MPI)
+// ---------------------------------------------------------------------------------------------
+// Under mpirun each input file is read by one rank, its reader, which shares what it read without
+// the exact faces (import.h, import_description); a rank reads another file only when its share of
+// the work reaches a part of it. The readers are chosen by file size, the work of reading.
+
+// Per file, its reader: the files in the order given split into contiguous runs of about equal
+// bytes, as split_by_cost splits pairs (file f goes to the rank r with r·B/ranks <= bytes before f +
+// half of f's < (r+1)·B/ranks, B the total; an empty file counts 1 byte). Instances, and so the
+// plan's sorted pairs and their runs, come in file order: when most pairs lie within a file, a
+// rank's run falls mostly in the files it reads. Precondition: ranks >= 1.
+std::vector<int> assign_readers(std::span<const std::uint64_t> file_bytes, int ranks);
 
 // The facts of every surface of `parts` as `model` holds them now, in part then surface order.
 std::vector<SurfaceFacts> surface_facts(const Model& model, std::span<const PartId> parts);
@@ -192,6 +211,10 @@ struct DistributedCheck {
 // With `parts` (part meshing: `model` imported without triangles, share_part_facts done, `scene`
 // built afterwards and told note_surface_facts), each rank first meshes the parts its run reaches
 // (share_parts); the merged report is then the one of one process that imported eagerly.
+// Every rank's bytes on every rank, in rank order (MPI_Allgatherv). Collective. A rank's bytes
+// beyond one MPI message (2^31 - 1) end the job (MPI_Abort) with a message naming it.
+std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm);
+
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& options,
                                    MergeHistory& history, MPI_Comm comm, PartMeshing* parts = nullptr);
 

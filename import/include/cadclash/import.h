@@ -135,4 +135,22 @@ ImportResult import_file(const std::string& path, const ImportOptions& options =
 // are merged in the order given, so the result is the same however many are read at once.
 ImportResult import_files(std::span<const std::string> paths, const ImportOptions& options = {});
 
+// import_files in two steps, for processes that read some of the files each (distributed checks):
+// import_each_file reads every file on its own (import_file, options.parallel_files at a time),
+// results in the order given; merge_file_imports makes of one result per path (in that order) the
+// scene import_files gives (seconds: the results' largest). Precondition: each.size() == paths.size().
+std::vector<ImportResult> import_each_file(std::span<const std::string> paths, const ImportOptions& options = {});
+ImportResult merge_file_imports(std::span<const std::string> paths, std::vector<ImportResult> each);
+
+// One file's ImportResult (import_file's) for a process that plans a check with it but reads the
+// file only if it needs the exact faces: the bytes of an import cache entry with each B-rep part's
+// exact faces left out (its default deflection kept), then the file's FileImport. Everything else
+// comes back as read: diagnostics, complete, parts, surfaces (names, STEP #ids, boxes, facts, a mesh
+// file's triangles), instances and poses. Precondition: the B-rep parts' sources are BrepSources.
+std::string import_description(const ImportResult& one_file);
+// The bytes back. Each B-rep part gets a stand-in SurfaceSource: default_deflection() as read,
+// triangulate() fails (nothing else answers); replace it by reading the file. False and `why` when
+// the bytes are not a whole description.
+bool import_from_description(std::string_view bytes, ImportResult& out, std::string& why);
+
 }  // namespace cadclash
