@@ -181,7 +181,8 @@ std::optional<Core> fitted_axis(const std::vector<std::array<Vec3, 3>>& ta) {
 
 CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& core_a,
                              const std::vector<std::uint32_t>& la, std::size_t begin, std::size_t end,
-                             const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack) {
+                             const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack,
+                             bool curved) {
   std::vector<std::array<Vec3, 3>> ta(end - begin);
   for (std::size_t i = begin; i < end; ++i) {
     const auto& t = mesh_a.triangles[la[i]];
@@ -202,7 +203,7 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
     return na * nb;
   };
   auto consider = [&](const std::optional<Core>& c) {
-    if (!c) return false;
+    if (!c || (!curved && c->kind != Core::Plane)) return false;
     std::optional<CrossingBound> b = bound_for(*c, ta, tri_b, level, slack);
     if (b && (!best || steep_pairs(*b) < steep_pairs(*best))) best = std::move(b);
     return best && !best->any;
@@ -211,6 +212,7 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
   switch (core_a.shape) {
     case SurfaceShape::Cylinder:
     case SurfaceShape::Sphere: {
+      if (!curved) break;
       Core c;
       c.kind = core_a.shape == SurfaceShape::Cylinder ? Core::Line : Core::Point;
       c.origin = core_a.origin;
@@ -219,10 +221,10 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
       break;
     }
     case SurfaceShape::Plane: done = consider(plane_core(ta)); break;
-    default: done = consider(fitted_axis(ta)) || consider(plane_core(ta));
+    default: done = (curved && consider(fitted_axis(ta))) || consider(plane_core(ta));
   }
   // Then B's: the plane a pin stands on, the axis of a pin through a plate's hole.
-  if (!done && !consider(plane_core(tri_b))) consider(fitted_axis(tri_b));
+  if (!done && !consider(plane_core(tri_b)) && curved) consider(fitted_axis(tri_b));
   return best ? *best : fallback;
 }
 

@@ -34,8 +34,12 @@ struct CrossingBound {
 
 // `slack` bounds the rounding of a height of these coordinates (PreparedPair::slack).
 // `core_a` is A's analytic surface in A's frame (only a hint: the bound is the triangles' own).
+// `curved`: also try lines and points as cores. Which cores are tried changes only how many pairs
+// the run still visits, never its outcome: at a level of the order of the rounding (a plane pair's
+// T) only a plane can hold both faces' triangles in so thin a shell, so the run asks for planes.
 CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& core_a,
                              const std::vector<std::uint32_t>& la, std::size_t begin, std::size_t end,
-                             const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack);
+                             const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack,
+                             bool curved = true);
 
 }  // namespace cadclash::detail

@@ -277,7 +277,7 @@ struct TriangleRun {
   void update_bound() {
     const double l = level();
     if (bounded && bound_level == l) return;
-    bound = crossing_bound(sa.mesh, sa.analytic, p.la, begin, end, p.tri_b, l, p.slack);
+    bound = crossing_bound(sa.mesh, sa.analytic, p.la, begin, end, p.tri_b, l, p.slack, /*curved=*/l >= p.tau);
     bounded = true;
     bound_level = l;
     if (!bound.any) done = true;
