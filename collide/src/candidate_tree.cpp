@@ -71,6 +71,17 @@ void CandidateTree::build(const std::vector<Aabb>& boxes) {
   }
 }
 
+namespace {
+
+// Nodes of the tree build() makes over n items: a leaf up to kLeafItems, else halves n / 2, n - n / 2.
+std::size_t node_count(std::size_t n) { return n <= kLeafItems ? 1 : 1 + node_count(n / 2) + node_count(n - n / 2); }
+
+}  // namespace
+
+std::size_t CandidateTree::bytes_for(std::size_t items) {
+  return items == 0 ? 0 : node_count(items) * sizeof(Node) + items * sizeof(Item);
+}
+
 void CandidateTree::query(const FlatBox& a, double margin, std::vector<std::uint32_t>& out,
                           std::uint64_t& tests) const {
   if (nodes_.empty()) return;

@@ -40,6 +40,8 @@ class CandidateTree {
   void query(const FlatBox& a, double margin, std::vector<std::uint32_t>& out, std::uint64_t& tests) const;
 
   std::size_t bytes() const { return nodes_.size() * sizeof(Node) + items_.size() * sizeof(Item); }
+  // What bytes() is once built over `items` boxes (the node count depends on the count alone).
+  static std::size_t bytes_for(std::size_t items);
 
  private:
   struct Node {

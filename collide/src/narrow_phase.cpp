@@ -5,6 +5,7 @@
 #include "cadclash/geometry.h"
 
 #include <array>
+#include <bit>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -154,7 +155,7 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
 
 void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
                         const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, double tau,
-                        PreparedPair& out, CollideCounters& counters) {
+                        PreparedPair& out, CollideCounters& counters, bool defer_tree) {
   out = PreparedPair{};
   out.tau = tau;
   out.threshold = tau;
@@ -204,13 +205,15 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
   out.slack = kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
   out.margin = search + out.slack;
   if (options.use_oaabb && options.triangle_level != TriangleLevel::Flat &&
-      (options.triangle_level == TriangleLevel::Bvh || out.la.size() * out.lb.size() > options.flat_limit))
-    out.tree_b.build(out.box_b);
+      (options.triangle_level == TriangleLevel::Bvh || out.la.size() * out.lb.size() > options.flat_limit)) {
+    if (defer_tree) out.tree_deferred = true;
+    else out.tree_b.build(out.box_b);
+  }
 }
 
 std::size_t prepared_bytes(const PreparedPair& p) {
   return (p.la.size() + p.lb.size()) * sizeof(std::uint32_t) + (p.box_a.size() + p.box_b.size()) * sizeof(Aabb) +
-         p.tri_b.size() * sizeof(p.tri_b[0]) + p.tree_b.bytes();
+         p.tri_b.size() * sizeof(p.tri_b[0]) + (p.tree_deferred ? CandidateTree::bytes_for(p.lb.size()) : p.tree_b.bytes());
 }
 
 namespace {
@@ -401,18 +404,34 @@ struct TriangleRun {
 // A's survivors [begin, end) in order, each with its candidates from B's tree, visited in (a, b)
 // order as the flat loops visit them, so both give the same answer. Once only deeper crossings can
 // change the outcome, a triangle of A that cannot take part in one is passed over unqueried.
+// Without a prepared tree the first of A's triangles scan B's boxes (the same candidates in the
+// same order) until the scans have cost about what building the tree costs; most runs of a contact
+// settle by then (the first intersecting pair, then the crossing bound).
 void tree_candidates(TriangleRun& run) {
   const PreparedPair& p = run.p;
-  CandidateTree own;  // a pair prepared for the flat loops has none
-  if (p.tree_b.empty()) own.build(p.box_b);
-  const CandidateTree& tree = p.tree_b.empty() ? own : p.tree_b;
+  CandidateTree own;
+  const bool prepared = !p.tree_b.empty();
+  const std::size_t nb = p.lb.size();
+  std::uint64_t scan_budget = prepared ? 0 : nb * (4 + std::bit_width(nb));
   std::vector<std::uint32_t> js;
   std::uint64_t box_tests = 0;
   for (std::size_t i = run.begin; i < run.end && !run.done; ++i) {
     if (run.penetration_only() && !run.may_cross(i)) continue;
     js.clear();
-    tree.query(flat_box(p.box_a[i]), p.margin, js, box_tests);
-    if (js.size() > 1) std::sort(js.begin(), js.end());
+    if (scan_budget >= nb) {
+      scan_budget -= nb;
+      box_tests += nb;
+      const FlatBox a = flat_box(p.box_a[i]);
+      for (std::uint32_t j = 0; j < nb; ++j)
+        if (candidate_within(a, flat_box(p.box_b[j]), p.margin)) js.push_back(j);
+    } else {
+      if (!prepared && own.empty()) {
+        own.build(p.box_b);
+        scan_budget = 0;
+      }
+      (prepared ? p.tree_b : own).query(flat_box(p.box_a[i]), p.margin, js, box_tests);
+      if (js.size() > 1) std::sort(js.begin(), js.end());
+    }
     for (std::size_t k = 0; k < js.size() && !run.done; ++k) run.test(i, js[k]);
   }
   run.counters.aabb_tests += box_tests;

@@ -27,6 +27,9 @@ struct PreparedPair {
   std::vector<Aabb> box_a, box_b;              // their boxes in A's frame, parallel to la / lb
   std::vector<std::array<Vec3, 3>> tri_b;      // Sl's survivors mapped into A's frame
   CandidateTree tree_b;  // over box_b, when the triangle level will not use the flat loops
+  // The run makes tree_b's candidates itself, scanning B's boxes until a tree pays (run_pair): a
+  // run that settles within a few of A's triangles never builds one. Charged as if built.
+  bool tree_deferred = false;
 };
 
 // The touching bound of fast mode (and of the paper's narrow phase): tolerance + both surfaces'
@@ -70,9 +73,10 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
 
 // prepare_pair with the touching bound given: `tau` is the depth past which a crossing ends the run
 // and, with options.clearance, the search reach (certified decisions search T + both bands + r).
+// `defer_tree`: leave the tree to the one run_pair over the whole pair (PreparedPair::tree_deferred).
 void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
                         const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, double tau,
-                        PreparedPair& out, CollideCounters& counters);
+                        PreparedPair& out, CollideCounters& counters, bool defer_tree = false);
 
 // Tests A's survivors la[begin, end) against all of B's, in ascending (triangle a, triangle b) order.
 // Polls `deadline` (when given) every 256 triangle tests and stops with out.cut set once it expired.

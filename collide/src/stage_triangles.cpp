@@ -57,12 +57,13 @@ class PairsThrough {
   std::vector<std::atomic<std::uint32_t>> left_;
 };
 
-void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes) {
+// `one_run`: one run_pair covers the whole pair (Version 1), so it may make its own candidates.
+void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes, bool one_run) {
   const Task& t = q.tasks[k];
   if (!usable(s.model, t)) return;
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
-                     task_tau(s, q, t), q.prepared[k], q.task_counters[k]);
+                     task_tau(s, q, t), q.prepared[k], q.task_counters[k], one_run);
   // Certified: the decision's crossing step asks whether the triangles cross deeper than T, and
   // only where one face is a plane (decide_crossing.cpp); elsewhere the run need not find out.
   const Surface& a = s.model.surfaces[t.sa];
@@ -82,7 +83,7 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
     if (q.deadline.expired()) {
       q.task_cut[ku] = 1;
     } else {
-      prepare(s, q, ku, bytes);
+      prepare(s, q, ku, bytes, /*one_run=*/true);
       run_pair(s.model.surfaces[q.tasks[ku].sa], q.prepared[ku], 0, q.prepared[ku].la.size(), q.o, q.outcomes[ku],
                q.task_counters[ku], &q.deadline);
       q.prepared[ku] = PreparedPair{};  // free the survivors as we go
@@ -99,7 +100,7 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     if (q.deadline.expired()) q.task_cut[static_cast<std::size_t>(k)] = 1;
-    else prepare(s, q, static_cast<std::size_t>(k), bytes);
+    else prepare(s, q, static_cast<std::size_t>(k), bytes, /*one_run=*/false);
   }
   for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
   q.apply_memory_budget();
