@@ -184,17 +184,50 @@ struct Foot {
   double magnitude = 0.0;
 };
 
+// Gauss-Newton on (S(u, v) - p)·S_u = (S(u, v) - p)·S_v = 0 from `start`, inside the surface's
+// parameter range: the points asked are vertices of a touching face, a deflection or less from this
+// surface, where it converges in a few steps, each one first-derivative evaluation. nullopt when it
+// does not settle (a singular point, a far point, a step leaving the range), for OCCT's solver.
+std::optional<gp_Pnt2d> gauss_newton_foot(const BRepAdaptor_Surface& surface, const gp_Pnt2d& start, const gp_Pnt& p,
+                                          double magnitude) {
+  const double u0 = surface.FirstUParameter(), u1 = surface.LastUParameter();
+  const double v0 = surface.FirstVParameter(), v1 = surface.LastVParameter();
+  double u = start.X(), v = start.Y();
+  // A 3D step this small is far below the evaluation's own rounding (kEvaluationRounding · magnitude);
+  // where it stops changes no proof: the point used is S(u, v), a point of the surface wherever it is.
+  const double settled = 1e-2 * kEvaluationRounding * magnitude;
+  for (int step = 0; step < 8; ++step) {
+    gp_Pnt s;
+    gp_Vec du, dv;
+    surface.D1(u, v, s, du, dv);
+    const gp_Vec r(s, p);
+    const double a = du.Dot(du), b = du.Dot(dv), c = dv.Dot(dv);
+    const double det = a * c - b * b;
+    if (!(det > 1e-12 * a * c)) return std::nullopt;  // degenerate parametrisation here
+    const double su = (c * du.Dot(r) - b * dv.Dot(r)) / det, sv = (a * dv.Dot(r) - b * du.Dot(r)) / det;
+    const double nu = u + su, nv = v + sv;
+    if (!(nu >= u0 && nu <= u1 && nv >= v0 && nv <= v1)) return std::nullopt;
+    u = nu, v = nv;
+    if ((su * du + sv * dv).Magnitude() <= settled) return gp_Pnt2d(u, v);
+  }
+  return std::nullopt;
+}
+
 std::optional<Foot> newton_foot(const BRepAdaptor_Surface& surface, const TopoDS_Face& face, const Aabb& face_box,
                                 const gp_Pnt& p) {
   const std::optional<gp_Pnt2d> start = nearest_node_parameters(face, p);
   if (!start) return std::nullopt;
+  Foot f;
+  // Every evaluated point and the control points stay within the face box's reach of the origin.
+  f.magnitude = gp_Vec(p.XYZ()).Magnitude() + box_norm(face_box);
+  if (const std::optional<gp_Pnt2d> quick = gauss_newton_foot(surface, *start, p, f.magnitude)) {
+    f.u = quick->X(), f.v = quick->Y();
+    return f;
+  }
   Extrema_GenLocateExtPS foot(surface);
   foot.Perform(p, start->X(), start->Y());
   if (!foot.IsDone()) return std::nullopt;
-  Foot f;
   foot.Point().Parameter(f.u, f.v);
-  // Every evaluated point and the control points stay within the face box's reach of the origin.
-  f.magnitude = gp_Vec(p.XYZ()).Magnitude() + box_norm(face_box);
   return f;
 }
 

@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,46 @@ TEST(SurfacePoint, FootAndNormalOnTheSurfaceAndBoundsOnTheEdges) {
   ASSERT_TRUE(occt.IsDone());
   EXPECT_GE(*rim, occt.Value() - 1e-12) << "an upper bound is never below the distance";
   EXPECT_NEAR(*rim, std::sqrt(2.0), 1e-9);
+}
+
+// surface_point on B-spline faces (as1's faces of revolution are stored so): the foot of points
+// near a NURBS cylinder and a NURBS torus is the exact one, from its own Gauss-Newton steps or
+// OCCT's solver, at every angle round the seam and for points inside, outside and on the surface.
+TEST(SurfacePoint, FootOnBsplineFacesIsTheExactFoot) {
+  const TopoDS_Shape cylinder = BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeCylinder(3, 8).Shape()).Shape();
+  const TopoDS_Shape torus = BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeTorus(10, 2).Shape()).Shape();
+  const Model m = build({cylinder, torus}, 0.05);
+  for (PartId part : {PartId{0}, PartId{1}}) {
+    const auto* src = dynamic_cast<const BrepSource*>(m.parts[part].source.get());
+    ASSERT_NE(src, nullptr);
+    const std::uint32_t first = m.parts[part].first_surface;
+    std::uint32_t face = kInvalidId;  // the cylinder's side; the torus's only face
+    for (std::uint32_t i = 0; i < src->face_count(); ++i)
+      if (part == 1 || m.surfaces[first + i].aabb.sizes().z() > 7.0) face = i;
+    ASSERT_NE(face, kInvalidId);
+    int checked = 0;
+    for (int k = 0; k < 24; ++k) {
+      const double a = 2.0 * std::numbers::pi * (k + 0.37) / 24.0;
+      for (double off : {-0.01, 0.0, 0.004, 0.05}) {
+        Vec3 q, foot;
+        if (part == 0) {
+          q = Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k);
+          foot = Vec3(3 * std::cos(a), 3 * std::sin(a), q.z());
+        } else {
+          const double b = 0.7 + 0.2 * k;  // round the tube
+          const Vec3 ring(10 * std::cos(a), 10 * std::sin(a), 0.0);
+          const Vec3 out = std::cos(b) * Vec3(std::cos(a), std::sin(a), 0.0) + std::sin(b) * Vec3::UnitZ();
+          q = ring + (2 + off) * out;
+          foot = ring + 2 * out;
+        }
+        const auto sp = src->surface_point(face, q);
+        ASSERT_TRUE(sp.has_value()) << "part " << part << " k " << k << " off " << off;
+        EXPECT_NEAR((sp->point - foot).norm(), 0.0, 1e-9) << "part " << part << " k " << k << " off " << off;
+        ++checked;
+      }
+    }
+    EXPECT_EQ(checked, 96);
+  }
 }
 
 struct Outcome {
