@@ -175,7 +175,8 @@ struct RankStats {
   std::uint64_t instance_pairs = 0;  // assigned to it
   std::uint64_t cost = 0;            // their estimated cost (PlannedPair::cost)
   std::uint64_t triangles = 0;       // triangles its scene holds afterwards (model_memory.triangle_count)
-  double seconds = 0.0;              // wall time of its check_part() calls (and the reading and share_parts() before them)
+  double seconds = 0.0;              // wall time of its check_part() calls and what precedes them
+                                     // (reading files, share_parts())
   double cpu_seconds = 0.0;          // CPU time of the process (all its threads) during them
   double plan_seconds = 0.0;         // wall time of its plan() calls (every rank plans every pair)
   std::uint64_t result_bytes = 0;    // bytes of its results sent to rank 0
@@ -203,6 +204,10 @@ struct DistributedCheck {
   double merge_seconds = 0.0;    // rank 0: reading the parts and merging them
 };
 
+// Every rank's bytes on every rank, in rank order (MPI_Allgatherv). Collective. A rank's bytes
+// beyond one MPI message (2^31 - 1) end the job (MPI_Abort) with a message naming it.
+std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm);
+
 // Scene::check(options) over the ranks of `comm`: the plan on every rank, rank 0's split (its cost
 // estimates count the triangles it holds) broadcast, a part per rank, the parts merged on rank 0. `history` (MergeHistory(surface count,
 // scene.memory()) before the first query) is used on rank 0 only. Preconditions: every rank's
@@ -220,10 +225,6 @@ struct DistributedCheck {
 // (share_parts); the merged report is then the one of one process that imported eagerly.
 // With `read`, each rank first reads what its run reaches (parts_of_pairs); when it fails the job
 // ends (MPI_Abort) with a message naming the rank.
-// Every rank's bytes on every rank, in rank order (MPI_Allgatherv). Collective. A rank's bytes
-// beyond one MPI message (2^31 - 1) end the job (MPI_Abort) with a message naming it.
-std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm);
-
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& options,
                                    MergeHistory& history, MPI_Comm comm, PartMeshing* parts = nullptr,
                                    const PartReader& read = {});
