@@ -7,14 +7,16 @@
 # to the one process's. Prints per run the wall time, every rank's line (files read and the seconds
 # it took, with a build that reads files where needed) and its peak memory with its isolated readers
 # (/usr/bin/time around each rank), and the one process's import time; writes out/mpi-files/<tag>/.
-#   bash scripts/mpi_files.sh [BUILD_DIR [CADCLASH [TAG]]]
+#   bash scripts/mpi_files.sh [BUILD_DIR [CADCLASH [TAG [CHECK_OPTION...]]]]
 # (a build with -DCADCLASH_WITH_MPI=ON -DCADCLASH_BUILD_TESTS=ON; CADCLASH: another cadclash binary
-# to measure, e.g. one built before files were read where needed; TAG names its results)
+# to measure, e.g. one built before files were read where needed; TAG names its results;
+# CHECK_OPTIONs are added to every check, e.g. --lazy)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
 exe=${2:-$build/tools/cadclash}
 tag=${3:-current}
+extra=("${@:4}")
 out=$root/out/mpi-files
 mkdir -p "$out/$tag"
 files=()
@@ -30,7 +32,7 @@ done
 if [ "$(id -u)" = 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 export OMPI_MCA_btl_vader_single_copy_mechanism=none
 echo "machine: $(uptime)"
-check=("$exe" check "${files[@]}" --select-a "${select[@]}" --select-b "${select[@]}" --threads 1)
+check=("$exe" check "${files[@]}" --select-a "${select[@]}" --select-b "${select[@]}" --threads 1 "${extra[@]}")
 /usr/bin/time -f '%e s, peak memory %M KiB' -o "$out/$tag/one.time" "${check[@]}" --json "$out/$tag/one.json" \
   >"$out/$tag/one.out" 2>"$out/$tag/one.err"
 echo "$tag one process: $(cat "$out/$tag/one.time"); $(grep -i 'import' "$out/$tag/one.out" | tail -1)"

@@ -6,6 +6,7 @@
 
 #include "cadclash/interference.h"
 
+#include <algorithm>
 #include <ctime>
 #include <fstream>
 #include <iomanip>
@@ -22,6 +23,17 @@ std::string fmt_mm(double v) {
   std::ostringstream s;
   s << std::setprecision(4) << v;
   return s.str();
+}
+
+std::map<std::string, InstanceId> instances_by_path(const Model& m) {
+  std::map<std::string, InstanceId> out;
+  for (InstanceId i = 0; i < m.instances.size(); ++i) out.emplace(m.instances[i].path, i);
+  return out;
+}
+
+// Whether --volume measures the clash: a current one whose solids overlap.
+bool measured(const ReportClash& c) {
+  return current_clash(c) && (c.worst == ContactClass::Penetrating || c.worst == ContactClass::Containment);
 }
 
 }  // namespace
@@ -114,15 +126,23 @@ std::optional<ReviewInputs> load_review_inputs(const ReviewCliOptions& o, bool t
 }
 
 void measure_clashes(const Model& m, ClashReview& r) {
-  std::map<std::string, InstanceId> by_path;
-  for (InstanceId i = 0; i < m.instances.size(); ++i) by_path.emplace(m.instances[i].path, i);
+  const std::map<std::string, InstanceId> by_path = instances_by_path(m);
   for (ReportClash& c : r.clashes) {
-    if (!current_clash(c) ||
-        (c.worst != ContactClass::Penetrating && c.worst != ContactClass::Containment))
-      continue;
+    if (!measured(c)) continue;
     const InterferenceResult v = measure_interference(m, by_path.at(c.instance_a), by_path.at(c.instance_b));
     c.interference = ClashInterference{v.measured, v.note, v.volume, v.depth, {v.centroid.x(), v.centroid.y(), v.centroid.z()}};
   }
+}
+
+std::vector<PartId> parts_to_measure(const Model& m, const ClashReview& r) {
+  const std::map<std::string, InstanceId> by_path = instances_by_path(m);
+  std::vector<PartId> out;
+  for (const ReportClash& c : r.clashes)
+    if (measured(c))
+      for (const std::string* path : {&c.instance_a, &c.instance_b}) out.push_back(m.instances[by_path.at(*path)].part);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 std::vector<const ReportClash*> clash_of_pairs(const ClashReview& r, std::size_t pairs) {

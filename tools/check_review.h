@@ -48,6 +48,8 @@ std::string utc_today();
 // With --volume: the Boolean common of each current penetrating or containment clash's two solids
 // (cadclash/interference.h) into its `interference`.
 void measure_clashes(const Model& m, ClashReview& r);
+// The parts whose solids measure_clashes(m, r) intersects: ascending, each once.
+std::vector<PartId> parts_to_measure(const Model& m, const ClashReview& r);
 
 // For each pair index of the query, its clash in `r` (nullptr for none).
 std::vector<const ReportClash*> clash_of_pairs(const ClashReview& r, std::size_t pairs);

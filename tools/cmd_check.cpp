@@ -248,6 +248,7 @@ struct CheckOutcome {
   std::string stopped_by;               // first budget that ran out; empty when every query finished
   std::vector<Diagnostic> diagnostics;  // the queries' own
   Report shown;                         // what --html shows: the query, or a trajectory's last step
+  bool unreadable = false;              // an input file could not be read again for --volume
 };
 
 // How the queries run: in this process, or split over the ranks of an MPI job (cmd_check_mpi.h).
@@ -256,8 +257,11 @@ struct Runner {
   std::function<std::vector<StepResult>(std::span<const TrajectoryRow>, const CollideOptions&, std::vector<Diagnostic>&,
                                         const std::string&)>
       replay;
-  std::function<void()> before_html;    // makes the model whole for the 3D view, when it is not
-  std::function<void()> before_volume;  // gives every part its exact faces (--volume), when it may not have them
+  // Each makes the model ready, when it may not be, and returns false (after saying why on stderr) when
+  // it cannot: every part whole for the 3D view; the parts of the clashes --volume measures given
+  // their exact faces.
+  std::function<bool()> before_html;
+  std::function<bool(const ClashReview&)> before_volume;
 };
 
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
@@ -277,7 +281,7 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run
   }
   report.review = review_query(*report.query, review.baseline ? &*review.baseline : nullptr, review.approvals, ro);
   if (o.review.volume) {
-    if (run.before_volume) run.before_volume();
+    if (run.before_volume && !run.before_volume(*report.review)) out.unreadable = true;
     measure_clashes(m, *report.review);
   }
   out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
@@ -364,16 +368,16 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
       return kExitInputError;
     }
   }
-  if (primary && !o.html.empty() && runner.before_html) runner.before_html();
+  if (primary && !o.html.empty() && runner.before_html && !runner.before_html()) return kExitInputError;
   if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
     return kExitInputError;
-  if (input_error) return kExitInputError;
+  if (input_error || run.unreadable) return kExitInputError;
   if (o.fail_on_collision && run.collision) return kExitCollision;  // a definite finding, partial report or not
   return run.stopped_by.empty() ? kExitOk : kExitBudget;
 }
 
 // The check of what was imported: in this process, or split over the ranks of `mpi` when given.
-// `inputs`, under mpirun with part meshing, reads the files a rank needs and has not read.
+// `inputs`, under mpirun with files read where needed, reads the files a rank needs and has not read.
 int check_imported(const CheckOptions& o, ImportResult& imported, const std::vector<TrajectoryRow>& rows,
                    const ReviewInputs& review, [[maybe_unused]] MpiCheck* mpi,
                    [[maybe_unused]] DistributedInputs* inputs = nullptr) {
@@ -413,13 +417,22 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
     runner.check = [&](const CollideOptions& c) { return mpi->check(scene, m, c); };
     runner.replay = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
                         const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
-    runner.before_html = [&] { mpi->mesh_every_part(m); };
-    if (inputs != nullptr)
-      runner.before_volume = [&] {
+    runner.before_html = [&] {
+      mpi->mesh_every_part(m);
+      return true;
+    };
+    if (inputs != nullptr) {
+      mpi->read_where_needed(m, *inputs);
+      runner.before_html = [&] {  // the page shows every part (HTML: rank 0 only)
         std::vector<PartId> all(m.parts.size());
         for (PartId p = 0; p < all.size(); ++p) all[p] = p;
-        if (mpi->rank() == 0) inputs->read_files_of(m, all);  // only rank 0 measures
+        const bool read = inputs->read_files_of(m, all);
+        mpi->mesh_every_part(m);
+        return read;
       };
+      // Only rank 0's review holds clashes: the others read nothing here.
+      runner.before_volume = [&](const ClashReview& r) { return inputs->read_files_of(m, parts_to_measure(m, r)); };
+    }
   }
 #endif
   return finish_check(o, imported, rows, runner, scene, copt, primary, review);
@@ -459,18 +472,26 @@ bool mesh_parts_or_import(const CheckOptions& o, ImportResult& imported, const s
 // process_vm_readv), which copy-on-write does not disturb. On InfiniBand (openib, or UCX) it is as
 // safe as the verbs stack's fork support (ibv_fork_init; Linux 5.12+ copies pinned pages at fork);
 // --no-isolation reads without forking there.
-int run_check_mpi(const CheckOptions& o, bool by_parts, const ReviewInputs& review) {
+int run_check_mpi(const CheckOptions& o, const ReviewInputs& review) {
+  // Files are read where needed unless --import-time-limit may cut a read short: what a read
+  // finishes within the limit depends on the machine's speed and load (import_cache.cpp does not
+  // even cache such a result), so a rank reading a file again for its share could get another
+  // scene than the file's reader described. Without the limit, an eager check meshes whole parts
+  // where needed (part meshing; under the limit it could not: the limit covers the import's
+  // meshing, not meshing after it) and --lazy tessellates face by face in the check.
+  const bool where_needed = o.in.import_time_limit <= 0.0;
+  const bool by_parts = where_needed && !o.in.lazy;
   MpiCheck mpi;
   DistributedInputs inputs;
   // What the import says on stderr waits, under part meshing, until part meshing is known to stand.
   std::ostringstream import_messages;
   ImportResult imported;
-  if (by_parts) {
+  if (where_needed) {
     InputOptions lazy = o.in;
     lazy.lazy = true;
-    std::streambuf* err = std::cerr.rdbuf(import_messages.rdbuf());
+    std::streambuf* err = by_parts ? std::cerr.rdbuf(import_messages.rdbuf()) : nullptr;
     imported = finish_inputs(lazy, inputs.read(lazy, MPI_COMM_WORLD));
-    std::cerr.rdbuf(err);
+    if (by_parts) std::cerr.rdbuf(err);
   } else {
     imported = import_inputs(o.in);
   }
@@ -485,10 +506,10 @@ int run_check_mpi(const CheckOptions& o, bool by_parts, const ReviewInputs& revi
   }
   if (by_parts && !mesh_parts_or_import(o, imported, import_messages.str(), trajectory, inputs, mpi))
     return kExitInputError;
-  const int code = rows ? check_imported(o, imported, *rows, review, &mpi, by_parts ? &inputs : nullptr)
+  const int code = rows ? check_imported(o, imported, *rows, review, &mpi, where_needed ? &inputs : nullptr)
                         : kExitInputError;
-  mpi.note_files_read(by_parts ? inputs.files_read() : o.in.files.size(), o.in.files.size(),
-                      by_parts ? inputs.read_seconds() : imported.seconds);
+  mpi.note_files_read(where_needed ? inputs.files_read() : o.in.files.size(), o.in.files.size(),
+                      where_needed ? inputs.read_seconds() : imported.seconds);
   if (mpi.rank() == 0 && !o.in.quiet) mpi.print_ranks(std::cerr);
   return mpi.agree(code);
 }
@@ -508,9 +529,9 @@ int run_check(const CheckOptions& o, const Launch& launch) {
   const std::optional<ReviewInputs> review = load_review_inputs(o.review, !o.path_csv.empty());
   if (!review) return kExitInputError;
 #if CADCLASH_HAS_MPI
-  // Under mpirun an eager check reads the B-rep without triangles, each file on one rank, and meshes
-  // whole parts where the ranks' shares need them (part meshing, cmd_check_mpi.h, mpi_inputs.h).
-  if (launch.by_mpirun) return run_check_mpi(o, !o.in.lazy && o.in.import_time_limit <= 0.0, *review);
+  // Under mpirun each file is read (without triangles) on one rank and again where the ranks' shares
+  // need it (mpi_inputs.h); an eager check meshes whole parts there (part meshing, cmd_check_mpi.h).
+  if (launch.by_mpirun) return run_check_mpi(o, *review);
 #endif
   ImportResult imported = import_inputs(o.in);
   std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};

@@ -49,6 +49,7 @@ struct MpiCheck::State {
   // built is not counted again, as in one process.
   std::optional<MergeHistory> history;
   std::optional<PartMeshing> parts;  // part meshing, when mesh_parts_where_needed set it up
+  PartReader read;                   // files read where needed, when read_where_needed set it up
   std::vector<double> files_read;    // rank 0: per rank, the input files it read and the seconds it took
   std::size_t files = 0;
   PartMeshing* part_meshing() { return parts ? &*parts : nullptr; }
@@ -115,6 +116,10 @@ bool MpiCheck::mesh_parts_where_needed(Model& model, const SceneSelection& selec
   return ok;
 }
 
+void MpiCheck::read_where_needed(Model& model, DistributedInputs& inputs) {
+  state_->read = [&model, &inputs](std::span<const PartId> parts) { return inputs.read_files_of(model, parts); };
+}
+
 void MpiCheck::note_parts(Scene& scene) {
   if (state_->parts) note_surface_facts(scene, *state_->parts);
 }
@@ -136,7 +141,7 @@ void MpiCheck::note_files_read(std::size_t read_here, std::size_t files, double 
 Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options) {
   if (!state_->history) state_->history.emplace(model.surfaces.size(), scene.memory());
   DistributedCheck c =
-      check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD, state_->part_meshing());
+      check_distributed(scene, model, options, *state_->history, MPI_COMM_WORLD, state_->part_meshing(), state_->read);
   state_->add(c.ranks, c.merge_seconds);
   return std::move(c.report);
 }
@@ -145,7 +150,8 @@ std::vector<StepResult> MpiCheck::replay(Scene& scene, Model& model, std::span<c
                                          const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
                                          const std::string& file) {
   DistributedReplay r =
-      replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD, state_->part_meshing());
+      replay_distributed(scene, model, rows, options, diagnostics, file, MPI_COMM_WORLD, state_->part_meshing(),
+                         state_->read);
   state_->add(r.ranks, r.merge_seconds);
   return std::move(r.steps);
 }

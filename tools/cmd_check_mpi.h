@@ -75,6 +75,10 @@ class MpiCheck {
   // (DistributedInputs::read) and reads those of the parts a rank meshes that it has not read.
   bool mesh_parts_where_needed(Model& model, const SceneSelection& selection, const CollideOptions& options,
                                DistributedInputs& inputs);
+  // Files read where needed (DistributedInputs::read gave `model`): before check() and replay() check
+  // a rank's share, the files of the parts it reaches and has not read are read (a lazy check
+  // tessellates their faces, a certified one asks them for exact distances).
+  void read_where_needed(Model& model, DistributedInputs& inputs);
   // With part meshing: the checking scene (built after mesh_parts_where_needed) told the facts.
   void note_parts(Scene& scene);
   // With part meshing: every part not meshed here meshed now, the files not read here read first

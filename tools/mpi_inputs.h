@@ -1,7 +1,8 @@
-// `cadclash check` under mpirun with part meshing: each input file read by one rank (its reader),
-// the others told what it holds without the exact faces, and a file read again on a rank only when
-// that rank's share of the work reaches one of its parts (cadclash/distributed.h, "Files read where
-// they are needed"). Exists with CADCLASH_WITH_MPI only.
+// `cadclash check` under mpirun (part meshing or --lazy; not with --import-time-limit): each input
+// file read by one rank (its reader), the others told what it holds without the exact faces, and a
+// file read again on a rank only when that rank's share of the work reaches one of its parts, or
+// on rank 0 when --volume measures a clash of its parts or --html shows them
+// (cadclash/distributed.h, "Files read where they are needed"). Exists with CADCLASH_WITH_MPI only.
 #pragma once
 
 #include "cli_common.h"

@@ -268,7 +268,7 @@ bool share_part_facts(Scene& boxes_scene, Model& model, const CollideOptions& op
 }
 
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& o, MergeHistory& history,
-                                   MPI_Comm comm, PartMeshing* parts) {
+                                   MPI_Comm comm, PartMeshing* parts, const PartReader& read) {
   assert(o.memory_budget_bytes == 0);
   MPI_Comm_set_errhandler(comm, MPI_ERRORS_RETURN);
   int rank = 0, size = 1;
@@ -280,6 +280,10 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
   const std::vector<std::uint32_t> mine = my_part(plan, rank, size, comm);
   const auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = process_cpu_seconds();
+  if (read && !read(parts_of_pairs(model, plan, mine))) {
+    std::fprintf(stderr, "cadclash check: rank %d: the files its instance pairs reach could not be read\n", rank);
+    MPI_Abort(comm, 1);
+  }
   if (parts != nullptr && !share_parts(model, plan, mine, *parts)) {
     // share_part_facts meshed every part once without a failure: the same meshing cannot fail now.
     std::fprintf(stderr, "cadclash check: rank %d: a part that meshed on its owner failed to mesh here\n", rank);
@@ -330,7 +334,8 @@ DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOpti
 
 DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                      const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
-                                     const std::string& file, MPI_Comm comm, PartMeshing* parts) {
+                                     const std::string& file, MPI_Comm comm, PartMeshing* parts,
+                                     const PartReader& read) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   DistributedReplay out;
@@ -355,7 +360,7 @@ DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const
       step_options.time_budget_seconds = left;
     }
     k = apply_trajectory_step(scene, rows, k, diagnostics, file);
-    DistributedCheck c = check_distributed(scene, model, step_options, history, comm, parts);
+    DistributedCheck c = check_distributed(scene, model, step_options, history, comm, parts, read);
     if (rank == 0) {
       last_cut_by_time = !c.report.complete && c.report.stopped_by.find("time") != std::string::npos;
       out.merge_seconds += c.merge_seconds;

@@ -3,7 +3,8 @@
 // per-rank lines are printed; a rank that crashes is named with its unfinished instance pairs.
 // Without --lazy the ranks mesh whole parts where their shares need them (part meshing): still one
 // eagerly importing process's reports, with fewer triangles meshed per rank than the model holds.
-// Several files are each read on one rank, and on another only when its share reaches them.
+// Several files are each read on one rank, and on another only when its share reaches them (with
+// --lazy too); rank 0 reads for --volume only the files of the clashes it measures.
 #include "../test_temp.h"
 #include "cadclash/export.h"
 #include "cadclash/import.h"
@@ -70,8 +71,9 @@ Outcome run(int ranks, const std::string& args, const std::string& env = "") {
 
 // Runs the check in one process and on 1, 2 and 4 ranks (`rank_args` added there: other thread
 // counts); every output file and stdout must match. Every rank line must hold `rank_says` when given.
+// `rank_errs`, when given, receives the stderr of the 1, 2 and 4 rank runs.
 void expect_identical(const std::string& args, bool html, const std::string& rank_args = "",
-                      const std::string& rank_says = "") {
+                      const std::string& rank_says = "", std::vector<std::string>* rank_errs = nullptr) {
   auto files = [&](const std::string& tag) {
     return " --no-timings --json '" + scratch(tag + ".json") + "'" + (html ? " --html '" + scratch(tag + ".html") + "'" : "");
   };
@@ -83,6 +85,7 @@ void expect_identical(const std::string& args, bool html, const std::string& ran
     const std::string tag = "np" + std::to_string(ranks);
     const Outcome r = run(ranks, args + rank_args + files(tag));
     ASSERT_EQ(r.code, 0) << ranks << " ranks:\n" << r.err;
+    if (rank_errs != nullptr) rank_errs->push_back(r.err);
     EXPECT_TRUE(slurp(scratch(tag + ".json")) == json) << ranks << " ranks: the JSON reports differ";
     EXPECT_TRUE(r.out == one.out) << ranks << " ranks: the tables differ\n" << r.out << "\nvs\n" << one.out;
     if (html) {
@@ -253,45 +256,71 @@ std::string without_read_lines(const std::string& text) {
   return out;
 }
 
-// Two files, two boards and one board 1000 mm away, on two ranks, the pairs selected within the
-// boards (each file also holds an unused part at its origin, which write_board_step leaves as a free
-// shape: it would pair across the files). The larger first file is read by rank 0, the second by
-// rank 1. Rank 0's run lies within the first file (it holds about 2/3 of the pairs), so rank 0
-// neither reads the second file nor keeps anything of it: it holds no more triangles than the first
-// file has. Rank 1 holds the second file's board and what its pairs reach of the first, which it
-// reads for them.
+// Two files, two boards and one board 1000 mm away, the pairs selected within the boards (each file
+// also holds an unused part at its origin, which write_board_step leaves as a free shape: it would
+// pair across the files); `extra` added to the check's arguments.
+struct BoardFiles {
+  std::string first, second;
+  std::string args;  // the check of both files, up to its --json
+};
+BoardFiles board_files(const std::string& extra) {
+  BoardFiles f{board_step(2, false), board_step(1, false, 1000), ""};
+  const std::string boards = "/" + std::filesystem::path(f.first).filename().string() + "/board /" +
+                             std::filesystem::path(f.second).filename().string() + "/board";
+  f.args = "check '" + f.first + "' '" + f.second + "' --select-a " + boards + " --select-b " + boards +
+           " --tolerance 0.01 --no-timings --threads 1" + extra + " --json ";
+  return f;
+}
+
+// `f` checked in one process and on two ranks (CADCLASH_TEST_SHOW_READS=1; their stderr into `err`):
+// the same JSON and table. The larger first file is read by rank 0, the second by rank 1. Rank 0's
+// run lies within the first file (it holds about 2/3 of the pairs), so rank 0 never reads the
+// second file; rank 1 reads the first for its pairs.
+void expect_read_where_needed(const BoardFiles& f, const std::string& tag, std::string& err) {
+  const Outcome single = run(0, f.args + "'" + scratch(tag + "_one.json") + "'");
+  ASSERT_EQ(single.code, 0) << single.err;
+  const Outcome two = run(2, f.args + "'" + scratch(tag + "_np2.json") + "'", "CADCLASH_TEST_SHOW_READS=1");
+  err = two.err;
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_TRUE(slurp(scratch(tag + "_np2.json")) == slurp(scratch(tag + "_one.json")));
+  EXPECT_TRUE(two.out == single.out);
+  EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
+  EXPECT_NE(rank_line(two.err, 1, 2).find("; files read here 2 of 2"), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(0, 2, f.first, "its reader")), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(1, 2, f.second, "its reader")), std::string::npos) << two.err;
+  EXPECT_NE(two.err.find(read_line(1, 2, f.first, "its share reaches it")), std::string::npos) << two.err;
+  EXPECT_EQ(two.err.find("rank 0 of 2 reads '" + f.second + "'"), std::string::npos) << two.err;
+}
+
+// Part meshing: rank 0 neither reads the second file nor keeps anything of it: it holds no more
+// triangles than the first file has. Rank 1 holds the second file's board and what its pairs reach
+// of the first.
 TEST(MpiCli, RankReadsAndMeshesNothingOfAFileItsPairsDoNotReach) {
   REQUIRE_AS1();
-  const std::string first = board_step(2, false), second = board_step(1, false, 1000);
-  const Outcome alone = run(1, "check '" + first + "' --tolerance 0.01 --no-timings --threads 1");
+  const BoardFiles f = board_files("");
+  const Outcome alone = run(1, "check '" + f.first + "' --tolerance 0.01 --no-timings --threads 1");
   ASSERT_EQ(alone.code, 0) << alone.err;
   const auto first_only = meshed_per_rank(alone.err, 1);
   ASSERT_EQ(first_only.size(), 1u);
   const std::uint64_t in_first = first_only[0][2];
-  const std::string boards = "/" + std::filesystem::path(first).filename().string() + "/board /" +
-                             std::filesystem::path(second).filename().string() + "/board";
-  const std::string args = "check '" + first + "' '" + second + "' --select-a " + boards + " --select-b " + boards +
-                           " --tolerance 0.01 --no-timings --threads 1 --json ";
-  const Outcome single = run(0, args + "'" + scratch("files_one.json") + "'");
-  ASSERT_EQ(single.code, 0) << single.err;
-  const Outcome two = run(2, args + "'" + scratch("files_np2.json") + "'", "CADCLASH_TEST_SHOW_READS=1");
-  ASSERT_EQ(two.code, 0) << two.err;
-  EXPECT_TRUE(slurp(scratch("files_np2.json")) == slurp(scratch("files_one.json")));
-  EXPECT_TRUE(two.out == single.out);
-  const auto ranks = meshed_per_rank(two.err, 2);
+  std::string err;
+  expect_read_where_needed(f, "files", err);
+  const auto ranks = meshed_per_rank(err, 2);
   ASSERT_EQ(ranks.size(), 2u);
   const std::uint64_t model = ranks[0][2];
   ASSERT_GT(model, in_first);
-  EXPECT_LE(ranks[0][0], in_first) << "rank 0 holds parts of the second file:\n" << two.err;
-  EXPECT_GT(ranks[1][0], 0u) << two.err;
-  EXPECT_LT(ranks[1][0], model) << two.err;
-  // Each file read once by its reader; rank 0 never reads the second, rank 1 the first for its pairs.
-  EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
-  EXPECT_NE(rank_line(two.err, 1, 2).find("; files read here 2 of 2"), std::string::npos) << two.err;
-  EXPECT_NE(two.err.find(read_line(0, 2, first, "its reader")), std::string::npos) << two.err;
-  EXPECT_NE(two.err.find(read_line(1, 2, second, "its reader")), std::string::npos) << two.err;
-  EXPECT_NE(two.err.find(read_line(1, 2, first, "its share reaches it")), std::string::npos) << two.err;
-  EXPECT_EQ(two.err.find("rank 0 of 2 reads '" + second + "'"), std::string::npos) << two.err;
+  EXPECT_LE(ranks[0][0], in_first) << "rank 0 holds parts of the second file:\n" << err;
+  EXPECT_GT(ranks[1][0], 0u) << err;
+  EXPECT_LT(ranks[1][0], model) << err;
+}
+
+// --lazy: the ranks tessellate faces, not parts, inside the check; a rank reads a file before its
+// run starts when the run reaches a part of it, and else never.
+TEST(MpiCli, LazyRankReadsNothingOfAFileItsPairsDoNotReach) {
+  REQUIRE_AS1();
+  std::string err;
+  expect_read_where_needed(board_files(" --lazy"), "lazy_files", err);
+  EXPECT_EQ(err.find("meshed here"), std::string::npos) << err;
 }
 
 // The same two files, every pair: on 1, 2 and 4 ranks the JSON, the table and the HTML (rank 0
@@ -302,6 +331,53 @@ TEST(MpiCli, FilesReadWhereNeededSameReportHtmlAndTable) {
   const std::string first = board_step(2, false), second = board_step(1, false, 1000);
   expect_identical("check '" + first + "' '" + second + "' --tolerance 0.01", true, " --threads 1",
                    "; files read here ");
+}
+
+// --lazy: the same; on four ranks the last rank's run lies within the second file, which it
+// reads as its reader, and it never reads the first.
+TEST(MpiCli, FilesReadWhereNeededLazySameReportHtmlAndTable) {
+  REQUIRE_AS1();
+  const std::string first = board_step(2, false), second = board_step(1, false, 1000);
+  std::vector<std::string> errs;
+  expect_identical("check '" + first + "' '" + second + "' --lazy --tolerance 0.01", true, " --threads 1",
+                   "; files read here ", &errs);
+  ASSERT_EQ(errs.size(), 3u);
+  EXPECT_NE(rank_line(errs[2], 3, 4).find("; files read here 1 of 2"), std::string::npos) << errs[2];
+}
+
+// as1 with its plate pushed 0.05 mm up into the two L-brackets (two penetrating clashes, whose
+// volume --volume measures) beside a board file, the pairs selected within as1. On two ranks the
+// board file is read by rank 1 only: rank 0 reads as1, its file, and measures the clashes from it,
+// without reading the board's file. Reports as one process's, with and without --lazy.
+TEST(MpiCli, VolumeReadsOnlyTheFilesOfMeasuredClashes) {
+  REQUIRE_AS1();
+  const std::string pushed = scratch("as1_plate_up.stp");
+  const std::string rewrite = std::string("'") + STEP_REWRITE_EXE + "' '" + as1_path() + "' '" + pushed +
+                              "' PLATE 0 0 0.05 >/dev/null 2>&1";
+  ASSERT_EQ(std::system(rewrite.c_str()), 0) << rewrite;
+  const std::string board = board_step(1, false, 1000);
+  for (const char* lazy : {"", " --lazy"}) {
+    SCOPED_TRACE(lazy);
+    const std::string args = "check '" + pushed + "' '" + board +
+                             "' --select-a /as1_plate_up.stp --select-b /as1_plate_up.stp --volume --no-timings "
+                             "--threads 1" + std::string(lazy) + " --json ";
+    const Outcome one = run(0, args + "'" + scratch("volume_one.json") + "'");
+    ASSERT_EQ(one.code, 0) << one.err;
+    const std::string json = slurp(scratch("volume_one.json"));
+    std::size_t measured = 0;
+    for (std::size_t at = json.find("\"measured\": true"); at != std::string::npos;
+         at = json.find("\"measured\": true", at + 1))
+      ++measured;
+    ASSERT_EQ(measured, 2u) << json;
+    const Outcome two = run(2, args + "'" + scratch("volume_np2.json") + "'", "CADCLASH_TEST_SHOW_READS=1");
+    ASSERT_EQ(two.code, 0) << two.err;
+    EXPECT_TRUE(slurp(scratch("volume_np2.json")) == json);
+    EXPECT_TRUE(two.out == one.out);
+    EXPECT_NE(two.err.find(read_line(0, 2, pushed, "its reader")), std::string::npos) << two.err;
+    EXPECT_NE(two.err.find(read_line(1, 2, board, "its reader")), std::string::npos) << two.err;
+    EXPECT_EQ(two.err.find("rank 0 of 2 reads '" + board + "'"), std::string::npos) << two.err;
+    EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
+  }
 }
 
 // A truncated STEP file beside the boards, read on rank 1 only (the smaller file; the pairs are
@@ -333,7 +409,7 @@ TEST(MpiCli, BadFileReadOnOneRankReportedAsInOneProcess) {
   EXPECT_NE(rank_line(two.err, 0, 2).find("; files read here 1 of 2"), std::string::npos) << two.err;
 }
 
-// With --lazy every rank reads and keeps the B-rep and tessellates face by face: no part meshing.
+// With --lazy the ranks tessellate face by face: no part meshing.
 TEST(MpiCli, LazyRanksSayNothingOfPartMeshing) {
   REQUIRE_AS1();
   const Outcome r = run(2, "check '" + as1_path() + "' --lazy --no-timings");

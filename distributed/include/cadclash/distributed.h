@@ -162,13 +162,21 @@ bool share_parts(Model& model, const CheckPlan& plan, std::span<const std::uint3
 // Triangles of the surfaces that have them in `model`.
 std::uint64_t held_triangles(const Model& model);
 
+// Gives a replica the exact faces of `parts` before it checks pairs that reach them: reads the files
+// holding them when the import left those parts with stand-in sources (import.h,
+// import_from_description), which mesh nothing. A lazy check tessellates faces, and a certified one
+// asks them for exact distances, inside Scene::check_part, so they must be read before it starts.
+// Returns false when they could not be read as the plan's replica describes them.
+using PartReader = std::function<bool(std::span<const PartId>)>;
+
 // One rank's share of a query (or of a whole trajectory: summed over its steps).
 struct RankStats {
   int rank = 0;
   std::uint64_t instance_pairs = 0;  // assigned to it
   std::uint64_t cost = 0;            // their estimated cost (PlannedPair::cost)
   std::uint64_t triangles = 0;       // triangles its scene holds afterwards (model_memory.triangle_count)
-  double seconds = 0.0;              // wall time of its check_part() calls (and share_parts() before them)
+  double seconds = 0.0;              // wall time of its check_part() calls and what precedes them
+                                     // (reading files, share_parts())
   double cpu_seconds = 0.0;          // CPU time of the process (all its threads) during them
   double plan_seconds = 0.0;         // wall time of its plan() calls (every rank plans every pair)
   std::uint64_t result_bytes = 0;    // bytes of its results sent to rank 0
@@ -196,6 +204,10 @@ struct DistributedCheck {
   double merge_seconds = 0.0;    // rank 0: reading the parts and merging them
 };
 
+// Every rank's bytes on every rank, in rank order (MPI_Allgatherv). Collective. A rank's bytes
+// beyond one MPI message (2^31 - 1) end the job (MPI_Abort) with a message naming it.
+std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm);
+
 // Scene::check(options) over the ranks of `comm`: the plan on every rank, rank 0's split (its cost
 // estimates count the triangles it holds) broadcast, a part per rank, the parts merged on rank 0. `history` (MergeHistory(surface count,
 // scene.memory()) before the first query) is used on rank 0 only. Preconditions: every rank's
@@ -211,12 +223,11 @@ struct DistributedCheck {
 // With `parts` (part meshing: `model` imported without triangles, share_part_facts done, `scene`
 // built afterwards and told note_surface_facts), each rank first meshes the parts its run reaches
 // (share_parts); the merged report is then the one of one process that imported eagerly.
-// Every rank's bytes on every rank, in rank order (MPI_Allgatherv). Collective. A rank's bytes
-// beyond one MPI message (2^31 - 1) end the job (MPI_Abort) with a message naming it.
-std::vector<std::string> allgather_bytes(const std::string& mine, MPI_Comm comm);
-
+// With `read`, each rank first reads what its run reaches (parts_of_pairs); when it fails the job
+// ends (MPI_Abort) with a message naming the rank.
 DistributedCheck check_distributed(Scene& scene, Model& model, const CollideOptions& options,
-                                   MergeHistory& history, MPI_Comm comm, PartMeshing* parts = nullptr);
+                                   MergeHistory& history, MPI_Comm comm, PartMeshing* parts = nullptr,
+                                   const PartReader& read = {});
 
 // Part meshing's first step, collective: every rank plans `boxes_scene` (a Scene over `model`, a
 // lazy import: nothing meshed; the selection of the real check), meshes the parts mesh_owners gives
@@ -238,7 +249,8 @@ struct DistributedReplay {
 };
 DistributedReplay replay_distributed(Scene& scene, Model& model, std::span<const TrajectoryRow> rows,
                                      const CollideOptions& options, std::vector<Diagnostic>& diagnostics,
-                                     const std::string& file, MPI_Comm comm, PartMeshing* parts = nullptr);
+                                     const std::string& file, MPI_Comm comm, PartMeshing* parts = nullptr,
+                                     const PartReader& read = {});
 #endif
 
 }  // namespace cadclash
