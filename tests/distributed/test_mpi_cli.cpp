@@ -127,6 +127,22 @@ TEST(MpiCli, As1PartMeshingSameReportHtmlAndTable) {
   expect_identical("check '" + as1_path() + "' --tolerance 0.01 --clearance 1", true);
 }
 
+// Eight ranks (the largest count; more ranks than as1 has parts to mesh, oversubscribed on
+// any small machine): the default check, eager and lazy, one thread each, is one process's.
+TEST(MpiCli, As1EightRanksSameReportAndTable) {
+  REQUIRE_AS1();
+  for (const std::string mode : {"", " --lazy"}) {
+    const std::string args = "check '" + as1_path() + "'" + mode + " --no-timings --json '";
+    const Outcome one = run(0, args + scratch("one8.json") + "'");
+    ASSERT_EQ(one.code, 0) << one.err;
+    const Outcome eight = run(8, args + scratch("np8.json") + "' --threads 1");
+    ASSERT_EQ(eight.code, 0) << eight.err;
+    EXPECT_TRUE(slurp(scratch("np8.json")) == slurp(scratch("one8.json"))) << "mode '" << mode << "': the JSON differs";
+    EXPECT_TRUE(eight.out == one.out) << "mode '" << mode << "': the tables differ";
+    for (int k = 0; k < 8; ++k) EXPECT_NE(eight.err.find("rank " + std::to_string(k) + " of 8: "), std::string::npos) << eight.err;
+  }
+}
+
 // The rod of as1 moved over eight steps (CSV written from the imported poses), at a coarse deflection.
 std::string as1_trajectory_csv() {
   const ImportResult as1 = import_file(as1_path());
