@@ -82,6 +82,21 @@ double over_curved(const Share& y, double lo_x, double hi_x, double slack) {
 // The steep sets for one core, or nullopt when the shell is too thick for it to say anything.
 std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::array<Vec3, 3>>& ta,
                                        const std::vector<std::array<Vec3, 3>>& tb, double level, double slack) {
+  if (core.kind == Core::Plane) {
+    // The shell of a plane is its vertices' heights, as share() computes them: a shell too thick
+    // for the level (the common case for a plane that is not a contact's) is known without the
+    // triangles' normals.
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (int side = 0; side < 2; ++side)
+      for (const auto& t : side == 0 ? ta : tb)
+        for (const Vec3& v : t) {
+          const double h = core.dir.dot(v) - core.offset;
+          lo[side] = std::min(lo[side], h), hi[side] = std::max(hi[side], h);
+        }
+    const double d = std::min(std::max(0.0, hi[0] - lo[1]), std::max(0.0, hi[1] - lo[0])) + 2.0 * slack;
+    if (!(d / (level - slack) * (1.0 + 1e-9) < 1.0)) return std::nullopt;
+  }
   std::vector<Share> sa(ta.size()), sb(tb.size());
   double lo_a = std::numeric_limits<double>::infinity(), hi_a = -lo_a, lo_b = lo_a, hi_b = -lo_a;
   for (std::size_t i = 0; i < ta.size(); ++i) {
