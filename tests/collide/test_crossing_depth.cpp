@@ -225,18 +225,24 @@ detail::PairOutcome reference_outcome(const Surface& sa, const detail::PreparedP
   return o;
 }
 
+// The scene's pair prepared for the flat loops (no candidate tree).
+detail::PreparedPair prepare_flat(const PairScene& sc, const CollideOptions& o) {
+  const detail::SurfaceBvh bvh_a = detail::build_surface_bvh(sc.a.mesh);
+  const detail::SurfaceBvh bvh_b = detail::build_surface_bvh(sc.b.mesh);
+  detail::PreparedPair p;
+  CollideCounters c;
+  detail::prepare_pair(sc.a, bvh_a, sc.b, bvh_b, sc.pose_b, sc.pose_b.inverse(), o, p, c);
+  return p;
+}
+
 TEST(EarlyExit, SkippedPairsNeverChangeTheOutcome) {
   std::uint64_t skipped = 0, runs = 0, stopped = 0;
   for (const PairScene& sc : scenes()) {
     SCOPED_TRACE(sc.name);
-    const detail::SurfaceBvh bvh_a = detail::build_surface_bvh(sc.a.mesh);
-    const detail::SurfaceBvh bvh_b = detail::build_surface_bvh(sc.b.mesh);
     CollideOptions all;
     all.mode = CollideMode::AllTrianglePairs;
     all.triangle_level = TriangleLevel::Flat;
-    detail::PreparedPair p;
-    CollideCounters c;
-    detail::prepare_pair(sc.a, bvh_a, sc.b, bvh_b, sc.pose_b, sc.pose_b.inverse(), all, p, c);
+    const detail::PreparedPair p = prepare_flat(sc, all);
     ASSERT_FALSE(p.la.empty());
     detail::PairOutcome every;
     CollideCounters c_all;
@@ -318,13 +324,9 @@ TEST(CrossingBound, EveryDeeperCrossingIsBetweenSteepTriangles) {
   std::size_t certified = 0, checked = 0;
   for (const PairScene& sc : scenes()) {
     SCOPED_TRACE(sc.name);
-    const detail::SurfaceBvh bvh_a = detail::build_surface_bvh(sc.a.mesh);
-    const detail::SurfaceBvh bvh_b = detail::build_surface_bvh(sc.b.mesh);
     CollideOptions o;
     o.triangle_level = TriangleLevel::Flat;
-    detail::PreparedPair p;
-    CollideCounters c;
-    detail::prepare_pair(sc.a, bvh_a, sc.b, bvh_b, sc.pose_b, sc.pose_b.inverse(), o, p, c);
+    const detail::PreparedPair p = prepare_flat(sc, o);
     ASSERT_FALSE(p.la.empty());
     std::vector<double> depth(p.la.size() * p.lb.size());  // intersecting pairs; 0 for the others
     double deepest = 0.0;

@@ -26,6 +26,14 @@ std::string as1_path() { return std::string(CADCLASH_DATA_DIR) + "/external/as1-
 #define REQUIRE_AS1() \
   if (!std::filesystem::exists(as1_path())) GTEST_SKIP() << "needs data/external/as1-tu-203.stp (scripts/setup.sh)"
 
+// A rank's part as rank 0 receives it: through bytes, appended to `parts` when they read back.
+void through_bytes(const PartialCheck& part, std::vector<PartialCheck>& parts) {
+  std::string error;
+  std::optional<PartialCheck> back = partial_check_from_bytes(partial_check_bytes(part), error);
+  EXPECT_TRUE(back.has_value()) << error;
+  if (back) parts.push_back(std::move(*back));
+}
+
 // The id of as1's rod (the trajectories here move it), or kInvalidId.
 InstanceId rod_of(const Model& m) {
   for (InstanceId i = 0; i < m.instances.size(); ++i)
@@ -91,12 +99,7 @@ class Split {
     const auto split = split_by_cost(plans[0], static_cast<int>(scenes_.size()));
     std::vector<PartialCheck> parts;
     for (std::size_t r = 0; r < scenes_.size(); ++r) {
-      // Through bytes, as the ranks send them.
-      const std::vector<std::uint8_t> bytes = partial_check_bytes(scenes_[r]->check_part(o, plans[r], split[r]));
-      std::string error;
-      std::optional<PartialCheck> back = partial_check_from_bytes(bytes, error);
-      EXPECT_TRUE(back.has_value()) << error;
-      if (back) parts.push_back(std::move(*back));
+      through_bytes(scenes_[r]->check_part(o, plans[r], split[r]), parts);
     }
     MergedCheck m = merge_parts(plans[0], parts, *models_[0], history_);
     for (std::size_t r = 0; r < scenes_.size(); ++r)
@@ -277,11 +280,7 @@ class PartSplit {
       EXPECT_EQ(plans[r].pairs.size(), plans[0].pairs.size());
       EXPECT_TRUE(share_parts(*models_[r], plans[r], split[r], pm_[r]));
       for (PartId p : parts_of_pairs(*models_[r], plans[r], split[r])) EXPECT_TRUE(pm_[r].held[p]) << p;
-      const std::vector<std::uint8_t> bytes = partial_check_bytes(scenes_[r]->check_part(o, plans[r], split[r]));
-      std::string error;
-      std::optional<PartialCheck> back = partial_check_from_bytes(bytes, error);
-      EXPECT_TRUE(back.has_value()) << error;
-      if (back) parts.push_back(std::move(*back));
+      through_bytes(scenes_[r]->check_part(o, plans[r], split[r]), parts);
     }
     MergedCheck m = merge_parts(plans[0], parts, *models_[0], history_);
     EXPECT_TRUE(m.new_deflections.empty());  // every reached surface was meshed before its check
