@@ -34,6 +34,10 @@ class CandidateTree {
   // farther than the margin holds no candidate (subtraction rounds monotonically).
   void build(const std::vector<Aabb>& boxes);
   bool empty() const { return nodes_.empty(); }
+  void clear() {
+    nodes_.clear();
+    items_.clear();
+  }
 
   // Appends every item j with candidate_within(a, item_box(j), margin), in no particular order;
   // adds the node and item box tests made to `tests`.

@@ -156,7 +156,15 @@ void prepare_pair(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb,
 void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surface& sb, const SurfaceBvh& bvh_b,
                         const Pose& t_ab, const Pose& t_ba, const CollideOptions& options, double tau,
                         PreparedPair& out, CollideCounters& counters, bool defer_tree) {
-  out = PreparedPair{};
+  // Cleared, not replaced: a caller preparing pair after pair keeps the lists' capacity.
+  out.la.clear();
+  out.lb.clear();
+  out.box_a.clear();
+  out.box_b.clear();
+  out.tri_b.clear();
+  out.tree_b.clear();
+  out.tree_deferred = false;
+  out.margin = out.slack = 0.0;
   out.tau = tau;
   out.threshold = tau;
   const double search = std::max(out.tau, options.clearance);

@@ -58,37 +58,44 @@ class PairsThrough {
 };
 
 // `one_run`: one run_pair covers the whole pair (Version 1), so it may make its own candidates.
-void prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes, bool one_run) {
+// Into `out` (q.prepared[k], or Version 1's per-thread scratch); false when the task is not usable.
+bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes, bool one_run,
+             PreparedPair& out) {
   const Task& t = q.tasks[k];
-  if (!usable(s.model, t)) return;
+  if (!usable(s.model, t)) return false;
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
-                     task_tau(s, q, t), q.prepared[k], q.task_counters[k], one_run);
+                     task_tau(s, q, t), out, q.task_counters[k], one_run);
   // Certified: the decision's crossing step asks whether the triangles cross deeper than T, and
   // only where one face is a plane (decide_crossing.cpp); elsewhere the run need not find out.
   const Surface& a = s.model.surfaces[t.sa];
   const Surface& b = s.model.surfaces[t.sb];
   if (q.o.decision != DecisionMode::Fast &&
       (a.analytic.shape == SurfaceShape::Plane || b.analytic.shape == SurfaceShape::Plane))
-    q.prepared[k].threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
-  bytes[k] = prepared_bytes(q.prepared[k]);
+    out.threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
+  bytes[k] = prepared_bytes(out);
+  return true;
 }
 
 void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
   PairsThrough through(q, ntasks, [&](std::size_t k) { return q.tasks[k].pair; });
-#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    if (q.deadline.expired()) {
-      q.task_cut[ku] = 1;
-    } else {
-      prepare(s, q, ku, bytes, /*one_run=*/true);
-      run_pair(s.model.surfaces[q.tasks[ku].sa], q.prepared[ku], 0, q.prepared[ku].la.size(), q.o, q.outcomes[ku],
-               q.task_counters[ku], &q.deadline);
-      q.prepared[ku] = PreparedPair{};  // free the survivors as we go
+#pragma omp parallel num_threads(q.threads) if (n >= kMinParallel)
+  {
+    // One pair at a time per thread: its survivor lists reuse the thread's buffers, freed with them
+    // when the stage ends.
+    PreparedPair scratch;
+#pragma omp for schedule(runtime)
+    for (std::ptrdiff_t k = 0; k < n; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      if (q.deadline.expired()) {
+        q.task_cut[ku] = 1;
+      } else if (prepare(s, q, ku, bytes, /*one_run=*/true, scratch)) {
+        run_pair(s.model.surfaces[q.tasks[ku].sa], scratch, 0, scratch.la.size(), q.o, q.outcomes[ku],
+                 q.task_counters[ku], &q.deadline);
+      }
+      through.item_done(q.tasks[ku].pair);
     }
-    through.item_done(q.tasks[ku].pair);
   }
   through.finish();
 }
@@ -100,7 +107,7 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     if (q.deadline.expired()) q.task_cut[static_cast<std::size_t>(k)] = 1;
-    else prepare(s, q, static_cast<std::size_t>(k), bytes, /*one_run=*/false);
+    else prepare(s, q, static_cast<std::size_t>(k), bytes, /*one_run=*/false, q.prepared[static_cast<std::size_t>(k)]);
   }
   for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
   q.apply_memory_budget();
