@@ -98,7 +98,7 @@ struct QueryState {
   std::vector<double> old_deflection;  // parallel to `tessellated`
 
   // Triangle level, per task.
-  std::vector<PreparedPair> prepared;
+  std::vector<PreparedPair> prepared;  // Version 2 only (Version 1 prepares into per-thread buffers)
   std::vector<PairOutcome> outcomes;
   std::vector<CollideCounters> task_counters;
   std::vector<char> task_cut;

@@ -145,7 +145,7 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
 
 void triangle_level_stage(SceneData& s, QueryState& q) {
   const std::size_t ntasks = q.first_task[q.cutoff];
-  q.prepared.assign(q.tasks.size(), PreparedPair{});
+  q.prepared.assign(q.o.version == ParallelVersion::V1 ? 0 : q.tasks.size(), PreparedPair{});  // V1: per thread
   q.outcomes.assign(q.tasks.size(), PairOutcome{});
   q.task_counters.assign(q.tasks.size(), CollideCounters{});
   q.task_cut.assign(q.tasks.size(), 0);
