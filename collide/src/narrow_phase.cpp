@@ -433,10 +433,7 @@ void tree_candidates(TriangleRun& run) {
       for (std::uint32_t j = 0; j < nb; ++j)
         if (candidate_within(a, flat_box(p.box_b[j]), p.margin)) js.push_back(j);
     } else {
-      if (!prepared && own.empty()) {
-        own.build(p.box_b);
-        scan_budget = 0;
-      }
+      if (!prepared && own.empty()) own.build(p.box_b);  // the scan budget is spent: it never grows back
       (prepared ? p.tree_b : own).query(flat_box(p.box_a[i]), p.margin, js, box_tests);
       if (js.size() > 1) std::sort(js.begin(), js.end());
     }
