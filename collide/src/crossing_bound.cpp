@@ -54,6 +54,10 @@ Share share(const Core& core, const std::array<Vec3, 3>& t) {
     if (out > 0.0 || in > 0.0) {
       s.lo = std::max(out, in);
       s.c = s.lo / s.hi;
+      // A triangle nearly across the core's direction (a plate's face around a pin: its normal along
+      // the axis) has u·ρ near 0 while r is not: its true minimum, which the other side's inward
+      // bound (over_curved) needs, is the core's distance to it. c stays u·ρ's.
+      if (s.c < 0.5) s.lo = std::max(s.lo, point_triangle_distance(Vec3::Zero(), r0, r1, r2));
       return s;
     }
   }
