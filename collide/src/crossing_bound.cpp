@@ -101,15 +101,17 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
     const double d = std::min(std::max(0.0, hi[0] - lo[1]), std::max(0.0, hi[1] - lo[0])) + 2.0 * slack;
     if (!(d / (level - slack) * (1.0 + 1e-9) < 1.0)) return std::nullopt;
   }
-  std::vector<Share> sa(ta.size()), sb(tb.size());
+  std::vector<Share> sa, sb;  // appended: a resized list would be filled first
+  sa.reserve(ta.size());
+  sb.reserve(tb.size());
   double lo_a = std::numeric_limits<double>::infinity(), hi_a = -lo_a, lo_b = lo_a, hi_b = -lo_a;
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    sa[i] = share(core, ta[i]);
-    lo_a = std::min(lo_a, sa[i].lo), hi_a = std::max(hi_a, sa[i].hi);
+  for (const auto& t : ta) {
+    const Share& s = sa.emplace_back(share(core, t));
+    lo_a = std::min(lo_a, s.lo), hi_a = std::max(hi_a, s.hi);
   }
-  for (std::size_t j = 0; j < tb.size(); ++j) {
-    sb[j] = share(core, tb[j]);
-    lo_b = std::min(lo_b, sb[j].lo), hi_b = std::max(hi_b, sb[j].hi);
+  for (const auto& t : tb) {
+    const Share& s = sb.emplace_back(share(core, t));
+    lo_b = std::min(lo_b, s.lo), hi_b = std::max(hi_b, s.hi);
   }
   // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: per triangle
   // (over_curved). The shell's ends and the foot points carry the rounding of r (slack each), the
@@ -202,10 +204,11 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
                              const std::vector<std::uint32_t>& la, std::size_t begin, std::size_t end,
                              const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack,
                              bool curved) {
-  std::vector<std::array<Vec3, 3>> ta(end - begin);
+  std::vector<std::array<Vec3, 3>> ta;
+  ta.reserve(end - begin);
   for (std::size_t i = begin; i < end; ++i) {
     const auto& t = mesh_a.triangles[la[i]];
-    ta[i - begin] = {mesh_a.vertices[t[0]], mesh_a.vertices[t[1]], mesh_a.vertices[t[2]]};
+    ta.push_back({mesh_a.vertices[t[0]], mesh_a.vertices[t[1]], mesh_a.vertices[t[2]]});
   }
   CrossingBound fallback;
   fallback.steep_a.assign(ta.size(), 1);

@@ -119,12 +119,6 @@ double straddle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& p0, 
   return may_straddle(v0, v1, v2, p0, n) ? clipped_straddle(v0, v1, v2, p0, p1, p2, n) : 0.0;
 }
 
-double max_magnitude(const std::vector<Aabb>& boxes) {
-  double m = 0.0;
-  for (const Aabb& b : boxes) m = std::max(m, box_magnitude(b));
-  return m;
-}
-
 }  // namespace
 
 double crossing_depth(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
@@ -195,22 +189,29 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
   }
   counters.triangles_a += out.la.size();
   counters.triangles_b += out.lb.size();
-  out.box_a.resize(out.la.size());
-  for (std::size_t i = 0; i < out.la.size(); ++i) out.box_a[i] = triangle_box(sa.mesh, out.la[i]);
-  out.tri_b.resize(out.lb.size());
-  out.box_b.resize(out.lb.size());
-  for (std::size_t j = 0; j < out.lb.size(); ++j) {
-    const auto& t = sb.mesh.triangles[out.lb[j]];
+  // Appended, not resized: a resized list of arrays is zero-filled before it is written. The slack
+  // needs the largest coordinate of any box: the union's (exact: min and max round nothing).
+  Aabb all_a, all_b;
+  out.box_a.reserve(out.la.size());
+  for (std::uint32_t t : out.la) {
+    out.box_a.push_back(triangle_box(sa.mesh, t));
+    all_a.extend(out.box_a.back());
+  }
+  out.tri_b.reserve(out.lb.size());
+  out.box_b.reserve(out.lb.size());
+  for (std::uint32_t t : out.lb) {
+    const auto& v = sb.mesh.triangles[t];
+    const std::array<Vec3, 3>& m =
+        out.tri_b.emplace_back(std::array<Vec3, 3>{t_ab * sb.mesh.vertices[v[0]], t_ab * sb.mesh.vertices[v[1]],
+                                                   t_ab * sb.mesh.vertices[v[2]]});
     Aabb b;
-    for (int k = 0; k < 3; ++k) {
-      out.tri_b[j][k] = t_ab * sb.mesh.vertices[t[k]];
-      b.extend(out.tri_b[j][k]);
-    }
-    out.box_b[j] = b;
+    for (const Vec3& x : m) b.extend(x);
+    out.box_b.push_back(b);
+    all_b.extend(b);
   }
   // Slack so that rounding in box arithmetic never turns "within the margin" into "beyond it", nor a
   // height over a plane (at most a few ulps of these magnitudes) a crossing bound below its depth.
-  out.slack = kRelativePad * (1.0 + std::max(max_magnitude(out.box_a), max_magnitude(out.box_b)));
+  out.slack = kRelativePad * (1.0 + std::max(box_magnitude(all_a), box_magnitude(all_b)));
   out.margin = search + out.slack;
   if (options.use_oaabb && options.triangle_level != TriangleLevel::Flat &&
       (options.triangle_level == TriangleLevel::Bvh || out.la.size() * out.lb.size() > options.flat_limit)) {
