@@ -31,18 +31,11 @@ struct Share {
   double lo = 0.0, hi = 0.0, c = 0.0;
 };
 
+// A line or point core's share (a plane's is its vertices' heights and plane_c, in bound_for).
 Share share(const Core& core, const std::array<Vec3, 3>& t) {
   Share s;
   const Vec3 n = normal_of(t[0], t[1], t[2]);
   const double len = n.norm();
-  if (core.kind == Core::Plane) {
-    const double h0 = core.dir.dot(t[0]) - core.offset, h1 = core.dir.dot(t[1]) - core.offset,
-                 h2 = core.dir.dot(t[2]) - core.offset;
-    s.lo = std::min({h0, h1, h2});
-    s.hi = std::max({h0, h1, h2});
-    s.c = len > 0.0 ? std::abs(n.dot(core.dir)) / len : 0.0;
-    return s;
-  }
   const Vec3 r0 = core.rho(t[0]), r1 = core.rho(t[1]), r2 = core.rho(t[2]);
   s.hi = std::max({r0.norm(), r1.norm(), r2.norm()});
   if (len > 0.0 && s.hi > 0.0) {
@@ -83,13 +76,34 @@ double over_curved(const Share& y, double lo_x, double hi_x, double slack) {
   return std::min(outward, inward);
 }
 
-// The steep sets for one core, or nullopt when the shell is too thick for it to say anything.
+// c of a triangle for a plane core, as share() computes it.
+double plane_c(const Core& core, const std::array<Vec3, 3>& t) {
+  const Vec3 n = normal_of(t[0], t[1], t[2]);
+  const double len = n.norm();
+  return len > 0.0 ? std::abs(n.dot(core.dir)) / len : 0.0;
+}
+
+// The steep sets for one core, or nullopt when the shell is too thick for it to say anything. Once
+// one side has no steep triangle no pair can cross deeper: the other side's flags are not worked
+// out (left steep, which says nothing more).
 std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::array<Vec3, 3>>& ta,
                                        const std::vector<std::array<Vec3, 3>>& tb, double level, double slack) {
+  // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: per triangle
+  // (over_curved). The shell's ends and the foot points carry the rounding of r (slack each), the
+  // depth its own.
+  const double room = level - slack;
+  const double grow = 1.0 + 1e-9;
+  CrossingBound b;
+  b.steep_a.resize(ta.size());
+  bool any_a = false, any_b = false;
+  auto certified = [&] {
+    b.steep_b.assign(tb.size(), 1);
+    b.any = false;
+    return b;
+  };
   if (core.kind == Core::Plane) {
-    // The shell of a plane is its vertices' heights, as share() computes them: a shell too thick
-    // for the level (the common case for a plane that is not a contact's) is known without the
-    // triangles' normals.
+    // The shell of a plane is its vertices' heights (r of share()): a shell too thick for the level
+    // (the common case for a plane that is not a contact's) is known without the triangles' normals.
     double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     double hi[2] = {-lo[0], -lo[1]};
     for (int side = 0; side < 2; ++side)
@@ -99,7 +113,14 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
           lo[side] = std::min(lo[side], h), hi[side] = std::max(hi[side], h);
         }
     const double d = std::min(std::max(0.0, hi[0] - lo[1]), std::max(0.0, hi[1] - lo[0])) + 2.0 * slack;
-    if (!(d / (level - slack) * (1.0 + 1e-9) < 1.0)) return std::nullopt;
+    const double kappa = d / room * grow;  // a triangle is steep below this
+    if (!(kappa < 1.0)) return std::nullopt;
+    for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(plane_c(core, ta[i]) >= kappa)) != 0;
+    if (!any_a) return certified();
+    b.steep_b.resize(tb.size());
+    for (std::size_t j = 0; j < tb.size(); ++j) any_b |= (b.steep_b[j] = !(plane_c(core, tb[j]) >= kappa)) != 0;
+    b.any = any_a && any_b;
+    return b;
   }
   std::vector<Share> sa, sb;  // appended: a resized list would be filled first
   sa.reserve(ta.size());
@@ -113,32 +134,17 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
     const Share& s = sb.emplace_back(share(core, t));
     lo_b = std::min(lo_b, s.lo), hi_b = std::max(hi_b, s.hi);
   }
-  // Plane: depth <= D / max(c_X, c_Y), D = min(hi_a - lo_b, hi_b - lo_a). Curved: per triangle
-  // (over_curved). The shell's ends and the foot points carry the rounding of r (slack each), the
-  // depth its own.
-  const double room = level - slack;
-  const double grow = 1.0 + 1e-9;
-  CrossingBound b;
-  b.steep_a.resize(ta.size());
+  // x of A is steep when B's triangles may straddle it deeper than the level, and y of B when A's
+  // may straddle it: a pair is deeper only if both are.
+  for (std::size_t i = 0; i < ta.size(); ++i)
+    any_a |= (b.steep_a[i] = !(over_curved(sa[i], lo_b, hi_b, slack) * grow <= room)) != 0;
+  if (!any_a) return certified();
   b.steep_b.resize(tb.size());
-  bool any_a = false, any_b = false;
-  if (core.kind == Core::Plane) {
-    const double d_ab = std::max(0.0, hi_a - lo_b) + 2.0 * slack, d_ba = std::max(0.0, hi_b - lo_a) + 2.0 * slack;
-    const double kappa = std::min(d_ab, d_ba) / room * grow;  // a triangle is steep below this
-    if (!(kappa < 1.0)) return std::nullopt;
-    for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(sa[i].c >= kappa)) != 0;
-    for (std::size_t j = 0; j < tb.size(); ++j) any_b |= (b.steep_b[j] = !(sb[j].c >= kappa)) != 0;
-  } else {
-    // x of A is steep when B's triangles may straddle it deeper than the level, and y of B when A's
-    // may straddle it: a pair is deeper only if both are.
-    for (std::size_t i = 0; i < ta.size(); ++i)
-      any_a |= (b.steep_a[i] = !(over_curved(sa[i], lo_b, hi_b, slack) * grow <= room)) != 0;
-    for (std::size_t j = 0; j < tb.size(); ++j)
-      any_b |= (b.steep_b[j] = !(over_curved(sb[j], lo_a, hi_a, slack) * grow <= room)) != 0;
-    if (any_a && any_b && std::all_of(b.steep_a.begin(), b.steep_a.end(), [](char c) { return c != 0; }) &&
-        std::all_of(b.steep_b.begin(), b.steep_b.end(), [](char c) { return c != 0; }))
-      return std::nullopt;
-  }
+  for (std::size_t j = 0; j < tb.size(); ++j)
+    any_b |= (b.steep_b[j] = !(over_curved(sb[j], lo_a, hi_a, slack) * grow <= room)) != 0;
+  if (any_a && any_b && std::all_of(b.steep_a.begin(), b.steep_a.end(), [](char c) { return c != 0; }) &&
+      std::all_of(b.steep_b.begin(), b.steep_b.end(), [](char c) { return c != 0; }))
+    return std::nullopt;
   b.any = any_a && any_b;
   return b;
 }
