@@ -168,33 +168,28 @@ std::optional<Core> plane_core(const std::vector<std::array<Vec3, 3>>& ta) {
 // their normals avoid, through the point nearest to their normal lines. Any line is a valid core;
 // a good one only makes the shell thin.
 std::optional<Core> fitted_axis(const std::vector<std::array<Vec3, 3>>& ta) {
+  // One pass: with n = len·u, Σ n nᵀ / len = Σ len·u uᵀ, so the point's normal equations
+  // Σ len·(I - u uᵀ)·x = Σ len·(I - u uᵀ)·centroid come from the same sums as the direction's.
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-  Vec3 mean = Vec3::Zero();
+  Vec3 mean = Vec3::Zero(), along = Vec3::Zero();
   double weight = 0.0;
   for (const auto& t : ta) {
     const Vec3 n = normal_of(t[0], t[1], t[2]);
     const double len = n.norm();
     if (!(len > 0.0)) continue;
-    m += n * n.transpose() / len;
-    mean += len * (t[0] + t[1] + t[2]) / 3.0;
+    const Vec3 c = (t[0] + t[1] + t[2]) / 3.0;
+    m += n * (n.transpose() / len);
+    mean += len * c;
+    along += n * (n.dot(c) / len);
     weight += len;
   }
   if (!(weight > 0.0)) return std::nullopt;
-  mean /= weight;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
   if (eig.info() != Eigen::Success || !(eig.eigenvalues()(1) > 1e-3 * eig.eigenvalues()(2))) return std::nullopt;
   const Vec3 d = eig.eigenvectors().col(0).normalized();
-  Eigen::Matrix3d lhs = weight * d * d.transpose();
-  Vec3 rhs = weight * d * d.dot(mean);
-  for (const auto& t : ta) {
-    const Vec3 n = normal_of(t[0], t[1], t[2]);
-    const double len = n.norm();
-    if (!(len > 0.0)) continue;
-    const Vec3 u = n / len;
-    const Eigen::Matrix3d proj = Eigen::Matrix3d::Identity() - u * u.transpose();
-    lhs += len * proj;
-    rhs += len * proj * ((t[0] + t[1] + t[2]) / 3.0);
-  }
+  // weight·d dᵀ pins the point along the axis (at the weighted centroid's height).
+  const Eigen::Matrix3d lhs = weight * d * d.transpose() + weight * Eigen::Matrix3d::Identity() - m;
+  const Vec3 rhs = weight * d * d.dot(mean / weight) + mean - along;
   const Vec3 origin = lhs.ldlt().solve(rhs);
   if (!origin.allFinite()) return std::nullopt;
   Core core;
