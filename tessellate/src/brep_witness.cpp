@@ -11,6 +11,7 @@
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <Bnd_Box.hxx>
 #include <BRep_Tool.hxx>
+#include <ElSLib.hxx>
 #include <Extrema_GenLocateExtPS.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_BezierSurface.hxx>
@@ -284,7 +285,23 @@ std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& 
 std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
                                                               const gp_Pnt& p) {
   const BRepAdaptor_Surface surface(face, Standard_False);
-  const std::optional<Foot> f = newton_foot(surface, face, face_box, p);
+  // A plane's, cylinder's or sphere's foot point in closed form (ElSLib: the orthogonal projection,
+  // as parameters of the face's own placed surface); other surfaces by Newton from the nearest node.
+  // Either way the point used is S(u, v), a point of the surface.
+  std::optional<Foot> f;
+  switch (surface.GetType()) {
+    case GeomAbs_Plane:
+    case GeomAbs_Cylinder:
+    case GeomAbs_Sphere: {
+      f.emplace();
+      f->magnitude = gp_Vec(p.XYZ()).Magnitude() + box_norm(face_box);
+      if (surface.GetType() == GeomAbs_Plane) ElSLib::Parameters(surface.Plane(), p, f->u, f->v);
+      else if (surface.GetType() == GeomAbs_Cylinder) ElSLib::Parameters(surface.Cylinder(), p, f->u, f->v);
+      else ElSLib::Parameters(surface.Sphere(), p, f->u, f->v);
+      break;
+    }
+    default: f = newton_foot(surface, face, face_box, p);
+  }
   if (!f) return std::nullopt;
   gp_Pnt s;
   gp_Vec du, dv;

@@ -17,7 +17,9 @@
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
+#include <TopLoc_Location.hxx>
 #include <TopoDS_Shape.hxx>
+#include <gp_Trsf.hxx>
 
 #include <gtest/gtest.h>
 
@@ -117,6 +119,62 @@ TEST(SurfacePoint, FootOnBsplineFacesIsTheExactFoot) {
         const auto sp = src->surface_point(face, q);
         ASSERT_TRUE(sp.has_value()) << "part " << part << " k " << k << " off " << off;
         EXPECT_NEAR((sp->point - foot).norm(), 0.0, 1e-9) << "part " << part << " k " << k << " off " << off;
+        ++checked;
+      }
+    }
+    EXPECT_EQ(checked, 96);
+  }
+}
+
+// surface_point on planes, cylinders and spheres (their foot in closed form): the exact foot, on
+// faces whose shape carries a placement (a location turned and moved off the origin), at every angle
+// round the seam, for points inside, outside and on the surface.
+TEST(SurfacePoint, FootOnPlacedElementaryFacesIsTheExactFoot) {
+  gp_Trsf turn;
+  turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(1, 2, 3)), 0.7);
+  gp_Trsf shift;
+  shift.SetTranslation(gp_Vec(120.0, -40.0, 65.0));
+  const gp_Trsf place = shift * turn;
+  const TopLoc_Location at(place);
+  const Model m = build({BRepPrimAPI_MakeCylinder(3, 8).Shape().Moved(at), BRepPrimAPI_MakeSphere(4).Shape().Moved(at),
+                         BRepPrimAPI_MakeBox(5, 6, 7).Shape().Moved(at)},
+                        0.05);
+  auto placed = [&](const Vec3& v) {
+    const gp_Pnt q = gp_Pnt(v.x(), v.y(), v.z()).Transformed(place);
+    return Vec3(q.X(), q.Y(), q.Z());
+  };
+  for (PartId part : {PartId{0}, PartId{1}, PartId{2}}) {
+    const auto* src = dynamic_cast<const BrepSource*>(m.parts[part].source.get());
+    ASSERT_NE(src, nullptr);
+    // The cylinder's side, the sphere's face, the box's face z = 7 (in the shapes' own frames): the
+    // face whose foot of one point is that point's foot on it.
+    const Vec3 q0 = part == 0 ? Vec3(3.5, 0, 4) : part == 1 ? Vec3(0, 0.3, 4.5) : Vec3(2, 3, 7.5);
+    const Vec3 foot0 = part == 0 ? Vec3(3, 0, 4) : part == 1 ? Vec3(q0 * (4 / q0.norm())) : Vec3(2, 3, 7);
+    std::uint32_t face = kInvalidId;
+    for (std::uint32_t i = 0; i < src->face_count(); ++i)
+      if (const auto sp = src->surface_point(i, placed(q0)); sp && (sp->point - placed(foot0)).norm() < 1e-6) face = i;
+    ASSERT_NE(face, kInvalidId) << "part " << part;
+    int checked = 0;
+    for (int k = 0; k < 24; ++k) {
+      const double a = 2.0 * std::numbers::pi * (k + 0.37) / 24.0;
+      for (double off : {-0.01, 0.0, 0.004, 0.05}) {
+        Vec3 q, foot;
+        if (part == 0) {
+          q = Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k);
+          foot = Vec3(3 * std::cos(a), 3 * std::sin(a), q.z());
+        } else if (part == 1) {
+          const double b = -1.2 + 0.1 * k;
+          const Vec3 out(std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b));
+          q = (4 + off) * out;
+          foot = 4 * out;
+        } else {
+          q = Vec3(0.2 * k, 0.25 * k, 7 + off);
+          foot = Vec3(q.x(), q.y(), 7);
+        }
+        const auto sp = src->surface_point(face, placed(q));
+        ASSERT_TRUE(sp.has_value()) << "part " << part << " k " << k << " off " << off;
+        EXPECT_NEAR((sp->point - placed(foot)).norm(), 0.0, 1e-9) << "part " << part << " k " << k << " off " << off;
+        EXPECT_GT(sp->rounding, 0.0);
         ++checked;
       }
     }
