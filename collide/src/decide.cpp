@@ -3,6 +3,7 @@
 #include "cadclash/geometry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -289,18 +290,28 @@ std::optional<double> analytic_witness(const AnalyticSurface& an_b, const Triang
     double g;
     Vec3 foot;
   };
-  std::vector<Candidate> cs;
+  if (region.isEmpty()) return std::nullopt;
+  // The nearest kMaxAnalyticTrials, in vertex order among equals (a stable sort's first ones). A
+  // vertex is mapped only when it lies in the region taken back to A's frame, padded far beyond the
+  // rounding of either mapping: those outside map outside `region` too.
+  const Aabb region_a = pad_box(transform_box(region, to_b.inverse()),
+                                kRelativePad * (box_magnitude(region) + to_b.translation().cwiseAbs().maxCoeff()));
+  std::array<Candidate, kMaxAnalyticTrials> best;
+  std::size_t kept = 0;
   for (const Vec3& va : mesh_a.vertices) {
+    if (!region_a.contains(va)) continue;
     const Vec3 v = to_b * va;
     if (!region.contains(v)) continue;
     const std::optional<Vec3> f = foot_point(an_b, v);
     if (!f) continue;
     const double g = (v - *f).norm();
-    if (g <= limit) cs.push_back({g, *f});
+    if (!(g <= limit) || (kept == best.size() && !(g < best[kept - 1].g))) continue;
+    std::size_t i = kept < best.size() ? kept++ : kept - 1;
+    for (; i > 0 && g < best[i - 1].g; --i) best[i] = best[i - 1];
+    best[i] = {g, *f};
   }
-  std::stable_sort(cs.begin(), cs.end(), [](const Candidate& x, const Candidate& y) { return x.g < y.g; });
-  if (cs.size() > kMaxAnalyticTrials) cs.resize(kMaxAnalyticTrials);
-  for (const Candidate& c : cs) {
+  for (std::size_t k = 0; k < kept; ++k) {
+    const Candidate& c = best[k];
     if (!(point_mesh_distance(bvh_b, mesh_b, c.foot, delta_b + slack) <= delta_b + slack)) continue;
     if (!near_outline(outline_b, c.foot, 2.0 * delta_b + slack)) return c.g;
   }

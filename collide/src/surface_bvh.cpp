@@ -3,6 +3,7 @@
 #include "cadclash/geometry.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -146,10 +147,39 @@ SurfaceBvh build_surface_bvh(const TriangleMesh& mesh) {
   return build_box_bvh(boxes);
 }
 
+namespace {
+
+// Sorts out[start, end) (distinct indices below n): a bitmap over the indices when the run is long
+// against n (marking and reading n / 64 words beats k log k comparisons), else std::sort.
+void sort_indices(std::vector<std::uint32_t>& out, std::size_t start, std::uint32_t n) {
+  const std::size_t k = out.size() - start;
+  const std::size_t words = (std::size_t{n} + 63) / 64;
+  if (k < 64 || words > 4 * k) {
+    std::sort(out.begin() + static_cast<std::ptrdiff_t>(start), out.end());
+    return;
+  }
+  thread_local std::vector<std::uint64_t> bits;
+  bits.assign(words, 0);
+  for (std::size_t i = start; i < out.size(); ++i) bits[out[i] >> 6] |= std::uint64_t{1} << (out[i] & 63u);
+  out.resize(start);
+  for (std::size_t w = 0; w < words; ++w)
+    for (std::uint64_t b = bits[w]; b != 0; b &= b - 1)
+      out.push_back(static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(std::countr_zero(b))));
+}
+
+}  // namespace
+
 void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aabb& query,
                        std::vector<std::uint32_t>& out, std::uint64_t& box_tests) {
   if (bvh.empty() || query.isEmpty()) return;
   const std::size_t start = out.size();
+  if (bvh.node_count == 0) {  // no tree: the scan meets the items in ascending order
+    for (std::uint32_t t = 0; t < bvh.items; ++t) {
+      ++box_tests;
+      if (boxes_overlap(triangle_box(mesh, t), query)) out.push_back(t);
+    }
+    return;
+  }
   const GridBox grid = grid_box(bvh, query);
   walk_bvh(
       bvh,
@@ -162,7 +192,7 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
         if (boxes_overlap(triangle_box(mesh, t), query)) out.push_back(t);
         return false;
       });
-  std::sort(out.begin() + static_cast<std::ptrdiff_t>(start), out.end());
+  sort_indices(out, start, bvh.items);
 }
 
 double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {

@@ -289,5 +289,56 @@ TEST(NearOutline, AgreesWithAScanOverEverySegment) {
   EXPECT_FALSE(detail::near_outline(detail::Outline{}, Vec3::Zero(), 1e9));
 }
 
+// analytic_witness: of the vertices of A (mapped into B's frame, inside the region) within the limit
+// of B's plane, the nearest four are tried, nearest first and in vertex order among equals; the first
+// whose foot lies inside B (on its triangles, clear of their outline by twice B's deflection) gives
+// the answer. A's frame is turned and moved 1e6 away from B's.
+TEST(AnalyticWitness, NearestFourVerticesInVertexOrderFirstFootInsideWins) {
+  Surface b;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j) b.mesh.vertices.push_back(Vec3(i, j, 0.0));
+  for (std::uint32_t i = 0; i < 10; ++i)
+    for (std::uint32_t j = 0; j < 10; ++j) {
+      const std::uint32_t v = i * 11 + j;
+      b.mesh.triangles.push_back({v, v + 11, v + 12});
+      b.mesh.triangles.push_back({v, v + 12, v + 1});
+    }
+  AnalyticSurface plane;
+  plane.shape = SurfaceShape::Plane;
+  plane.origin = Vec3::Zero();
+  plane.axis = Vec3::UnitZ();
+  const detail::SurfaceBvh bvh = detail::build_surface_bvh(b.mesh);
+  const detail::Outline outline = detail::make_outline(b.mesh);
+  const double delta = 0.001;
+  Pose to_b = Pose::Identity();
+  to_b.rotate(Eigen::AngleAxisd(0.8, Vec3(1, -2, 0.5).normalized()));
+  to_b.pretranslate(Vec3(-1e6, 2e6, 5e5));
+  const Pose to_a = to_b.inverse();
+  const Aabb region(Vec3(-1, -1, -1), Vec3(11, 11, 1));
+  // Points given in B's frame; A holds them mapped back. Near the edge x = 0: a foot on the outline.
+  auto witness = [&](const std::vector<Vec3>& in_b, bool moved = true) {
+    TriangleMesh a;
+    for (const Vec3& p : in_b) a.vertices.push_back(moved ? to_a * p : p);
+    return detail::analytic_witness(plane, b.mesh, bvh, outline, delta, a, moved ? to_b : Pose::Identity(), region,
+                                    1.0, 1e-9);
+  };
+  // The interior vertex at 0.1 beats the farther one; the nearer vertex on the edge does not count.
+  std::optional<double> g = witness({{5, 5, 0.3}, {0.0005, 5, 0.05}, {3, 3, -0.1}, {20, 5, 0.01}});
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(*g, 0.1, 1e-8);
+  // Four nearer vertices on the edge use up the trials: the interior one is never tried.
+  EXPECT_FALSE(witness({{0.0005, 1, 0.01}, {0.0005, 2, 0.02}, {0.0005, 3, 0.03}, {0.0005, 4, 0.04}, {5, 5, 0.05}}));
+  // Exact ties (no mapping) keep vertex order: of two vertices at 0.04, the one listed first is tried.
+  const Vec3 e1(0.0005, 1, 0.01), e2(0.0005, 2, 0.02), e3(0.0005, 3, 0.03), e4(0.0005, 4, 0.04), in(5, 5, 0.04);
+  g = witness({e1, e2, e3, in, e4}, false);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(*g, 0.04);
+  EXPECT_FALSE(witness({e1, e2, e3, e4, in}, false));
+  EXPECT_FALSE(witness({e4, in, e1, e2, e3}, false));
+  EXPECT_TRUE(witness({in, e4, e1, e2, e3}, false));
+  // Outside the region or beyond the limit: no candidate.
+  EXPECT_FALSE(witness({{5, 5, 1.5}, {12, 5, 0.01}}));
+}
+
 }  // namespace
 }  // namespace cadclash

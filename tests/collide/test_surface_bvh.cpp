@@ -118,6 +118,47 @@ TEST(SurfaceBvh, DecodedNodeBoxesContainTheirItemsAndQueriesAreExact) {
   }
 }
 
+// query_surface_bvh: the triangles whose exact box meets the query, ascending, after what `out`
+// held already; for queries meeting a few triangles and most of them (the ascending order is made
+// two ways), and for a surface too small for a tree.
+TEST(SurfaceBvh, TriangleQueriesReturnTheMeetingTrianglesAscending) {
+  for (const std::size_t n : {std::size_t{SurfaceBvh::kFlatLimit}, std::size_t{5000}, std::size_t{70000}}) {
+    SCOPED_TRACE(n);
+    std::mt19937 gen(static_cast<std::uint32_t>(n));
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    TriangleMesh mesh;
+    for (std::size_t t = 0; t < n; ++t) {
+      const Vec3 c(100 * u(gen), 100 * u(gen), 100 * u(gen));
+      const auto v = static_cast<std::uint32_t>(mesh.vertices.size());
+      for (int k = 0; k < 3; ++k) mesh.vertices.push_back(c + Vec3(u(gen), u(gen), u(gen)));
+      mesh.triangles.push_back({v, v + 1, v + 2});
+    }
+    const SurfaceBvh bvh = detail::build_surface_bvh(mesh);
+    EXPECT_EQ(bvh.node_count == 0, n <= SurfaceBvh::kFlatLimit);
+    std::size_t large = 0;
+    for (const double side : {0.5, 3.0, 20.0, 60.0, 120.0}) {
+      for (int q = 0; q < 10; ++q) {
+        const Vec3 lo(100 * u(gen) - side / 2, 100 * u(gen) - side / 2, 100 * u(gen) - side / 2);
+        const Aabb query(lo, lo + Vec3::Constant(side));
+        std::vector<std::uint32_t> expected{7, 3};  // what the caller held: kept in front, unsorted
+        for (std::uint32_t t = 0; t < n; ++t) {
+          const auto& tri = mesh.triangles[t];
+          Aabb b(mesh.vertices[tri[0]]);
+          b.extend(mesh.vertices[tri[1]]).extend(mesh.vertices[tri[2]]);
+          if (boxes_overlap(b, query)) expected.push_back(t);
+        }
+        large += expected.size() > n / 4;
+        std::vector<std::uint32_t> got{7, 3};
+        std::uint64_t tests = 0;
+        detail::query_surface_bvh(bvh, mesh, query, got, tests);
+        ASSERT_EQ(got, expected) << "side " << side << " query " << q;
+        EXPECT_GT(tests, 0u);
+      }
+    }
+    EXPECT_GT(large, 0u);  // some queries meet most triangles
+  }
+}
+
 // The tree's bytes are what the layout promises: 16 per node and 2 per item (4 past 65536 items).
 TEST(SurfaceBvh, BytesPerItem) {
   const std::vector<Aabb> small = random_boxes(1000, Vec3::Zero(), 10.0, 0.1, -1, 3);
