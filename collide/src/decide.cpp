@@ -237,10 +237,11 @@ bool near_outline(const Outline& outline, const Vec3& p, double margin) {
   const Aabb& root = tree.root;
   const double mag = std::max({p.cwiseAbs().maxCoeff(), root.min().cwiseAbs().maxCoeff(), root.max().cwiseAbs().maxCoeff()});
   const double prune = margin + 0x1p-40 * mag;
+  const double prune2 = prune * prune;  // squaring rounds far below that slack
   const double m2 = margin * margin;
   bool near = false;
   walk_bvh(
-      tree, [&](const SurfaceBvh::Node& node) { return tree.node_box(node).exteriorDistance(p) <= prune; },
+      tree, [&](const SurfaceBvh::Node& node) { return tree.node_box(node).squaredExteriorDistance(p) <= prune2; },
       [&](std::uint32_t i) {
         const auto& [a, b] = outline.segments[i];
         near = (closest_on_segment(p, a, b) - p).squaredNorm() <= m2;

@@ -207,20 +207,27 @@ double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, cons
     return best;
   }
   // Nearer child first: the best so far shrinks sooner and prunes more. The minimum is the same in
-  // any order.
-  std::uint32_t stack[64];
+  // any order. Each node's squared distance is worked out once, when it is pushed (its square root
+  // is exteriorDistance's value).
+  struct Entry {
+    std::uint32_t node;
+    double d2;
+  };
+  Entry stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, bvh.node_box(bvh.nodes[0]).squaredExteriorDistance(p)};
   while (top > 0) {
-    const SurfaceBvh::Node& node = bvh.nodes[stack[--top]];
-    if (bvh.node_box(node).exteriorDistance(p) > std::min(best, reach)) continue;
+    const Entry e = stack[--top];
+    if (std::sqrt(e.d2) > std::min(best, reach)) continue;
+    const SurfaceBvh::Node& node = bvh.nodes[e.node];
     if (const std::uint32_t count = node.count(); count > 0) {
       for (std::uint32_t i = node.first(); i < node.first() + count; ++i) visit(bvh.item(i));
     } else {
-      const bool left_nearer = bvh.node_box(bvh.nodes[node.first()]).squaredExteriorDistance(p) <=
-                               bvh.node_box(bvh.nodes[node.first() + 1]).squaredExteriorDistance(p);
-      stack[top++] = left_nearer ? node.first() + 1 : node.first();
-      stack[top++] = left_nearer ? node.first() : node.first() + 1;
+      const Entry left{node.first(), bvh.node_box(bvh.nodes[node.first()]).squaredExteriorDistance(p)};
+      const Entry right{node.first() + 1, bvh.node_box(bvh.nodes[node.first() + 1]).squaredExteriorDistance(p)};
+      const bool left_nearer = left.d2 <= right.d2;
+      stack[top++] = left_nearer ? right : left;
+      stack[top++] = left_nearer ? left : right;
     }
   }
   return best;
