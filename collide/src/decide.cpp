@@ -233,21 +233,42 @@ bool near_outline(const Outline& outline, const Vec3& p, double margin) {
   if (tree.empty() || !(margin >= 0.0)) return false;
   // Both distances are a few roundings of the coordinates' magnitude M off (well within the slack
   // the callers add to their margins); 2^-40 M covers them, so pruning never changes the answer
-  // (the nodes' grid boxes, rounded outward, only prune less).
+  // (the nodes' grid boxes, rounded outward, only prune less; squaring rounds far below that).
   const Aabb& root = tree.root;
   const double mag = std::max({p.cwiseAbs().maxCoeff(), root.min().cwiseAbs().maxCoeff(), root.max().cwiseAbs().maxCoeff()});
   const double prune = margin + 0x1p-40 * mag;
-  const double prune2 = prune * prune;  // squaring rounds far below that slack
+  const double prune2 = prune * prune;
   const double m2 = margin * margin;
-  bool near = false;
-  walk_bvh(
-      tree, [&](const SurfaceBvh::Node& node) { return tree.node_box(node).squaredExteriorDistance(p) <= prune2; },
-      [&](std::uint32_t i) {
-        const auto& [a, b] = outline.segments[i];
-        near = (closest_on_segment(p, a, b) - p).squaredNorm() <= m2;
-        return near;
-      });
-  return near;
+  auto near_segment = [&](std::uint32_t i) {
+    const auto& [a, b] = outline.segments[i];
+    return (closest_on_segment(p, a, b) - p).squaredNorm() <= m2;
+  };
+  if (tree.node_count == 0) {
+    for (std::uint32_t i = 0; i < tree.items; ++i)
+      if (near_segment(i)) return true;
+    return false;
+  }
+  // Nearer child first: most points asked lie by the outline (a foot on a face's edge), and the
+  // first near segment answers; any order gives the same answer.
+  std::uint32_t stack[64];
+  int top = 0;
+  if (tree.node_box(tree.nodes[0]).squaredExteriorDistance(p) > prune2) return false;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SurfaceBvh::Node& node = tree.nodes[stack[--top]];
+    if (const std::uint32_t count = node.count(); count > 0) {
+      for (std::uint32_t i = node.first(); i < node.first() + count; ++i)
+        if (near_segment(tree.item(i))) return true;
+      continue;
+    }
+    const double dl = tree.node_box(tree.nodes[node.first()]).squaredExteriorDistance(p);
+    const double dr = tree.node_box(tree.nodes[node.first() + 1]).squaredExteriorDistance(p);
+    const bool left_nearer = dl <= dr;
+    const double d_far = left_nearer ? dr : dl, d_near = left_nearer ? dl : dr;
+    if (d_far <= prune2) stack[top++] = left_nearer ? node.first() + 1 : node.first();
+    if (d_near <= prune2) stack[top++] = left_nearer ? node.first() : node.first() + 1;
+  }
+  return false;
 }
 
 namespace {
