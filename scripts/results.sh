@@ -13,7 +13,8 @@ cd "$root"
 
 # Configured as scripts/build.sh does, but only the programs this page runs are built: a whole tree
 # takes longer than the benchmarks.
-echo "results: building $build (bench_accuracy, bench_compare, bench_scale_path, test_triangle_predicates)"
+echo "results: building $build (bench_accuracy, bench_compare, bench_scale_path, test_triangle_predicates," \
+  "bench_triangle_predicates)"
 generator=()
 if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
@@ -22,7 +23,8 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
 else
   cmake -S "$root" -B "$build" -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_TESTS=ON >/dev/null
 fi
-cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates bench_scale_path
+cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates bench_scale_path \
+  bench_triangle_predicates
 compare_built=no
 if cmake --build "$build" --target help | grep -q '^bench_compare:'; then
   if cmake --build "$build" -j "$(nproc)" --target bench_compare; then compare_built=yes
@@ -75,6 +77,25 @@ echo "results: numerical extremes (triangle test against the exact oracle)"
   echo "|---|---|---|---|---|---|---|"
   grep '^\[ family   \] |' "$out/extremes.log" | sed 's/^\[ family   \] //'
 } >"$out/extremes.md"
+
+echo "results: triangle predicate speed (bench_triangle_predicates)"
+# Time per test of the staged predicate (filters, then CGAL only where they cannot decide) against
+# CGAL's exact test on every pair, on the same 4,096 pairs per set.
+"$build/bench/bench_triangle_predicates" --benchmark_filter='^(intersect|intersect_exact_only)/' \
+  --benchmark_min_time=0.2 --benchmark_format=json >"$out/predicates.json"
+python3 - "$out/predicates.json" >"$out/predicates.md" <<'PY'
+import json, sys
+rows = {}
+for b in json.load(open(sys.argv[1]))["benchmarks"]:
+    kind, name = b["name"].split("/", 1)
+    rows.setdefault(name, {})[kind] = b
+print("| pair set (4,096 pairs) | staged: ns per test | exact fallbacks | CGAL exact on every pair: ns per test | speed-up |")
+print("|---|---:|---:|---:|---:|")
+for name, r in rows.items():
+    s, e = r["intersect"], r["intersect_exact_only"]
+    ns_s, ns_e = 1e9 * s["per_pair"], 1e9 * e["per_pair"]
+    print(f"| {name} | {ns_s:.1f} | {100 * s.get('fallback', 0.0):.2f}% | {ns_e:.1f} | {ns_e / ns_s:.1f}x |")
+PY
 elapsed=$(( $(date +%s) - start ))
 
 # Plots next to the page; links in the embedded tables point there.
@@ -105,6 +126,7 @@ while IFS= read -r line || [ -n "$line" ]; do
       ;;
     @ACCURACY@) relink "$out/accuracy.md" ;;
     @EXTREMES@) cat "$out/extremes.md" ;;
+    @PREDICATES@) cat "$out/predicates.md" ;;
     @SCALE@) cat "$out/scale.md" ;;
     *) printf '%s\n' "$line" ;;
   esac
