@@ -175,8 +175,12 @@ constexpr std::size_t kMaxWitnessTrials = 8;
 
 // Trial order: nearest first, but among the nearest a vertex whose foot lies well inside the other
 // face's outline first. A foot near the outline is the exact face classifier's slow case, and the
-// contact there is often along the edge, where the edge's own curve answers anyway.
-void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
+// contact there is often along the edge, where the edge's own curve answers anyway. At most
+// kMaxWitnessTrials of the 4·kMaxWitnessTrials nearest. The outline is asked in that nearest-first
+// order only until the trials are found: the vertices inside come first, so each can be tried as
+// it is met; the first success (the common case) ends the search. True when `prove` succeeded.
+template <class Prove>
+bool try_in_order(std::vector<Candidate>& cs, FaceView a, FaceView b, Prove prove) {
   const std::size_t keep = std::min<std::size_t>(cs.size(), 4 * kMaxWitnessTrials);
   auto nearer = [](const Candidate& x, const Candidate& y) { return x.near < y.near; };
   std::partial_sort(cs.begin(), cs.begin() + static_cast<std::ptrdiff_t>(keep), cs.end(), nearer);
@@ -185,8 +189,21 @@ void order_trials(std::vector<Candidate>& cs, FaceView a, FaceView b) {
     const FaceView& other = c.of_a ? b : a;
     return other.outline != nullptr && !near_outline(*other.outline, c.point, 2.0 * other.surface.deflection + c.near);
   };
-  std::stable_partition(cs.begin(), cs.end(), inside);
-  if (cs.size() > kMaxWitnessTrials) cs.resize(kMaxWitnessTrials);
+  std::size_t trials = 0;
+  std::vector<std::size_t> outside;  // by the outline: tried after every inside one, nearest first
+  for (std::size_t k = 0; k < cs.size() && trials < kMaxWitnessTrials; ++k) {
+    if (!inside(cs[k])) {
+      outside.push_back(k);
+      continue;
+    }
+    ++trials;
+    if (prove(cs[k])) return true;
+  }
+  for (std::size_t k : outside) {
+    if (trials++ >= kMaxWitnessTrials) break;
+    if (prove(cs[k])) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -260,16 +277,12 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
       const Vec3 w = t.t_ab * b.mesh.vertices[v];
       if (const double d = point_mesh_distance(fa.bvh, a.mesh, w, limit_b); d <= limit_b) cs.push_back({d, false, w});
     }
-    order_trials(cs, fa, fb);
-    for (const Candidate& cand : cs)
-      if (proves(cand)) return;
+    if (try_in_order(cs, fa, fb, proves)) return;
     cs.clear();
   }
   near_vertices(a, t.t_ba, fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
   near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
-  order_trials(cs, fa, fb);
-  for (const Candidate& cand : cs)
-    if (proves(cand)) return;
+  try_in_order(cs, fa, fb, proves);
 }
 
 namespace {
