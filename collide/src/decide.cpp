@@ -248,6 +248,26 @@ bool near_outline(const Outline& outline, const Vec3& p, double margin) {
       if (near_segment(i)) return true;
     return false;
   }
+  // Points asked one after another often lie along one stretch of one outline (the crossings of a
+  // pin with a plate, round the hole): the segments next to the last one found near, in outline
+  // order (mostly along the boundary), are tried first. Any near segment gives the answer; a hint
+  // that misses (or is stale: only its index is kept) costs five tests.
+  thread_local const Outline* hint_outline = nullptr;
+  thread_local std::uint32_t hint_segment = 0;
+  const auto n = static_cast<std::uint32_t>(outline.segments.size());
+  if (hint_outline == &outline && hint_segment < n) {
+    const std::uint32_t lo = hint_segment >= 2 ? hint_segment - 2 : 0, hi = std::min(n, hint_segment + 3);
+    for (std::uint32_t i = lo; i < hi; ++i)
+      if (near_segment(i)) {
+        hint_segment = i;
+        return true;
+      }
+  }
+  auto found = [&](std::uint32_t i) {
+    hint_outline = &outline;
+    hint_segment = i;
+    return true;
+  };
   // Nearer child first: most points asked lie by the outline (a foot on a face's edge), and the
   // first near segment answers; any order gives the same answer.
   std::uint32_t stack[64];
@@ -258,7 +278,7 @@ bool near_outline(const Outline& outline, const Vec3& p, double margin) {
     const SurfaceBvh::Node& node = tree.nodes[stack[--top]];
     if (const std::uint32_t count = node.count(); count > 0) {
       for (std::uint32_t i = node.first(); i < node.first() + count; ++i)
-        if (near_segment(tree.item(i))) return true;
+        if (near_segment(tree.item(i))) return found(tree.item(i));
       continue;
     }
     const double dl = tree.node_box(tree.nodes[node.first()]).squaredExteriorDistance(p);

@@ -285,6 +285,33 @@ TEST(NearOutline, AgreesWithAScanOverEverySegment) {
     }
     EXPECT_GT(near, 1000);
     EXPECT_GT(far, 1000);
+    // Points walking round the rim (each answer may come from the segments next to the last one
+    // found), interleaved with another outline's queries (a hint from the wrong outline).
+    TriangleMesh other;
+    for (int j = 0; j <= 3; ++j)
+      for (int i = 0; i <= 3; ++i) other.vertices.push_back(Vec3(offset + i, offset - j, offset));
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const auto v = static_cast<std::uint32_t>(j * 4 + i);
+        other.triangles.push_back({v, v + 1, v + 5});
+        other.triangles.push_back({v, v + 5, v + 4});
+      }
+    const detail::Outline small = detail::make_outline(other);
+    for (int k = 0; k < 2000; ++k) {
+      const double s = 4.0 * n * k / 2000.0;  // along the rim: top, right, bottom, left
+      const Vec3 rim = s < n ? Vec3(s, 0, 0) : s < 2 * n ? Vec3(n, -0.5 * (s - n), 0) : s < 3 * n ? Vec3(3 * n - s, -0.5 * n, 0)
+                                                                                         : Vec3(0, -0.5 * (4 * n - s), 0);
+      for (const detail::Outline* o : {&outline, &small}) {
+        const Vec3 p = Vec3(offset, offset, offset) + rim + Vec3(0.3 * u(rng) - 0.15, 0.3 * u(rng) - 0.15, 0.6 * u(rng) - 0.3);
+        double scan2 = std::numeric_limits<double>::infinity();
+        for (const auto& [a, b] : o->segments) scan2 = std::min(scan2, (closest_on_segment(p, a, b) - p).squaredNorm());
+        for (double margin : {0.05, 0.3, std::sqrt(scan2)}) {
+          const bool want = scan2 <= margin * margin;
+          EXPECT_EQ(detail::near_outline(*o, p, margin), want) << offset << " rim " << k << ' ' << margin;
+          (want ? near : far) += 1;
+        }
+      }
+    }
   }
   EXPECT_FALSE(detail::near_outline(detail::Outline{}, Vec3::Zero(), 1e9));
 }
