@@ -239,7 +239,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   Run run{model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline};
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
-#pragma omp parallel for num_threads(threads) schedule(guided) if (n >= 64)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (n >= 64)
   for (std::ptrdiff_t k = 0; k < n; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     run.pending[ku] = from_mesh(model, eps, tasks[ku], o);
