@@ -96,45 +96,39 @@ void make_outlines(Run& run, const std::vector<std::size_t>& ks) {
   for (SurfaceId f : faces) run.outlines.ready[f] = 1;
 }
 
-// Steps 2b to 3c: witnesses of contact, each a few point queries (certified mode).
+// Steps 2b to 3c: witnesses of contact, each a few point queries (certified mode). Each open pair
+// runs them in order until one settles it, all pairs in one parallel loop: a pair's steps depend on
+// it alone, so this is the answer of running each step over all pairs in turn.
 void witness_steps(Run& run) {
   const auto& tasks = run.tasks;
-  auto meshed = [&](std::size_t k) { return run.meshed(k); };
-  // Step 2b: analytic contact witnesses, on the outlines of the open pairs' surfaces.
-  const std::vector<std::size_t> open = run.open(meshed);
-  make_outlines(run, open);
+  const std::vector<std::size_t> open = run.open([&](std::size_t k) { return run.meshed(k); });
+  make_outlines(run, open);  // step 2b asks the outlines of the open pairs' surfaces
   run.step(open, [&](std::size_t k) {
-    analytic_contact(run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k], run.o);
-  });
-  // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing.
-  // Only where the triangles cross deeper than T: faces lying on each other or meeting at an edge
-  // cross by round-off only, and the vertex witnesses prove those.
-  run.step(run.open([&](std::size_t k) {
-             return meshed(k) && tasks[k].outcome->intersecting && tasks[k].outcome->crosses_threshold;
-           }),
-           [&](std::size_t k) {
-             crossing_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
-                           run.o, run.task_counters[k]);
-           });
-  // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
-  run.step(run.open(meshed), [&](std::size_t k) {
-    tangent_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k], run.o,
-                 run.task_counters[k]);
-  });
-  // Step 3: witness vertices near the other face (a few exact point queries each).
-  run.step(run.open(meshed), [&](std::size_t k) {
-    witness_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), tasks[k].outcome,
-                 run.pending[k].band, run.pending[k], run.o, run.task_counters[k]);
-  });
-  // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
-  run.step(run.open(meshed), [&](std::size_t k) {
-    edge_witness_step(run.model, run.poses, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
-                      run.o, run.task_counters[k]);
-  });
-  // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
-  run.step(run.open(meshed), [&](std::size_t k) {
-    edge_support_step(run.model, run.eps, tasks[k], run.view(tasks[k].sa), run.view(tasks[k].sb), run.pending[k],
-                      run.o, run.task_counters[k]);
+    Pending& p = run.pending[k];
+    const DecideTask& t = tasks[k];
+    const FaceView a = run.view(t.sa), b = run.view(t.sb);
+    CollideCounters& c = run.task_counters[k];
+    // Each step only while the pair is open and the time lasts (a step past the deadline marks it cut).
+    auto next = [&] {
+      if (p.settled || p.cut) return false;
+      if (run.deadline.expired()) p.cut = true;
+      return !p.cut;
+    };
+    // Step 2b: analytic contact witnesses, on the outlines.
+    analytic_contact(run.eps, t, a, b, p, run.o);
+    // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing. Only
+    // where the triangles cross deeper than T: faces lying on each other or meeting at an edge cross
+    // by round-off only, and the vertex witnesses prove those.
+    if (t.outcome->intersecting && t.outcome->crosses_threshold && next())
+      crossing_step(run.model, run.eps, t, a, b, p, run.o, c);
+    // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
+    if (next()) tangent_step(run.model, run.eps, t, a, b, p, run.o, c);
+    // Step 3: witness vertices near the other face (a few exact point queries each).
+    if (next()) witness_step(run.model, run.eps, t, a, b, t.outcome, p.band, p, run.o, c);
+    // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
+    if (next()) edge_witness_step(run.model, run.poses, t, a, b, p, run.o, c);
+    // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
+    if (next()) edge_support_step(run.model, run.eps, t, a, b, p, run.o, c);
   });
 }
 
