@@ -27,6 +27,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cadclash {
@@ -86,6 +87,26 @@ TEST(SurfacePoint, FootAndNormalOnTheSurfaceAndBoundsOnTheEdges) {
   EXPECT_NEAR(*rim, std::sqrt(2.0), 1e-9);
 }
 
+// Asks `src` for the foot on `face` of 96 points (24 angles round the seam, each at 4 offsets from
+// the surface: inside, on, just and well outside); at(k, angle, offset) gives a point and its exact
+// foot.
+template <class At>
+void expect_exact_feet(const BrepSource& src, std::uint32_t face, const std::string& what, At at) {
+  int checked = 0;
+  for (int k = 0; k < 24; ++k) {
+    const double a = 2.0 * std::numbers::pi * (k + 0.37) / 24.0;
+    for (double off : {-0.01, 0.0, 0.004, 0.05}) {
+      const auto [q, foot] = at(k, a, off);
+      const auto sp = src.surface_point(face, q);
+      ASSERT_TRUE(sp.has_value()) << what << " k " << k << " off " << off;
+      EXPECT_NEAR((sp->point - foot).norm(), 0.0, 1e-9) << what << " k " << k << " off " << off;
+      EXPECT_GT(sp->rounding, 0.0);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 96) << what;
+}
+
 // surface_point on B-spline faces (as1's faces of revolution are stored so): the foot of points
 // near a NURBS cylinder and a NURBS torus is the exact one, from its own Gauss-Newton steps or
 // OCCT's solver, at every angle round the seam and for points inside, outside and on the surface.
@@ -101,28 +122,15 @@ TEST(SurfacePoint, FootOnBsplineFacesIsTheExactFoot) {
     for (std::uint32_t i = 0; i < src->face_count(); ++i)
       if (part == 1 || m.surfaces[first + i].aabb.sizes().z() > 7.0) face = i;
     ASSERT_NE(face, kInvalidId);
-    int checked = 0;
-    for (int k = 0; k < 24; ++k) {
-      const double a = 2.0 * std::numbers::pi * (k + 0.37) / 24.0;
-      for (double off : {-0.01, 0.0, 0.004, 0.05}) {
-        Vec3 q, foot;
-        if (part == 0) {
-          q = Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k);
-          foot = Vec3(3 * std::cos(a), 3 * std::sin(a), q.z());
-        } else {
-          const double b = 0.7 + 0.2 * k;  // round the tube
-          const Vec3 ring(10 * std::cos(a), 10 * std::sin(a), 0.0);
-          const Vec3 out = std::cos(b) * Vec3(std::cos(a), std::sin(a), 0.0) + std::sin(b) * Vec3::UnitZ();
-          q = ring + (2 + off) * out;
-          foot = ring + 2 * out;
-        }
-        const auto sp = src->surface_point(face, q);
-        ASSERT_TRUE(sp.has_value()) << "part " << part << " k " << k << " off " << off;
-        EXPECT_NEAR((sp->point - foot).norm(), 0.0, 1e-9) << "part " << part << " k " << k << " off " << off;
-        ++checked;
-      }
-    }
-    EXPECT_EQ(checked, 96);
+    expect_exact_feet(*src, face, "part " + std::to_string(part), [&](int k, double a, double off) {
+      if (part == 0)
+        return std::pair{Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k),
+                         Vec3(3 * std::cos(a), 3 * std::sin(a), 1.0 + 0.25 * k)};
+      const double b = 0.7 + 0.2 * k;  // round the tube
+      const Vec3 ring(10 * std::cos(a), 10 * std::sin(a), 0.0);
+      const Vec3 out = std::cos(b) * Vec3(std::cos(a), std::sin(a), 0.0) + std::sin(b) * Vec3::UnitZ();
+      return std::pair{Vec3(ring + (2 + off) * out), Vec3(ring + 2 * out)};
+    });
   }
 }
 
@@ -154,31 +162,22 @@ TEST(SurfacePoint, FootOnPlacedElementaryFacesIsTheExactFoot) {
     for (std::uint32_t i = 0; i < src->face_count(); ++i)
       if (const auto sp = src->surface_point(i, placed(q0)); sp && (sp->point - placed(foot0)).norm() < 1e-6) face = i;
     ASSERT_NE(face, kInvalidId) << "part " << part;
-    int checked = 0;
-    for (int k = 0; k < 24; ++k) {
-      const double a = 2.0 * std::numbers::pi * (k + 0.37) / 24.0;
-      for (double off : {-0.01, 0.0, 0.004, 0.05}) {
-        Vec3 q, foot;
-        if (part == 0) {
-          q = Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k);
-          foot = Vec3(3 * std::cos(a), 3 * std::sin(a), q.z());
-        } else if (part == 1) {
-          const double b = -1.2 + 0.1 * k;
-          const Vec3 out(std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b));
-          q = (4 + off) * out;
-          foot = 4 * out;
-        } else {
-          q = Vec3(0.2 * k, 0.25 * k, 7 + off);
-          foot = Vec3(q.x(), q.y(), 7);
-        }
-        const auto sp = src->surface_point(face, placed(q));
-        ASSERT_TRUE(sp.has_value()) << "part " << part << " k " << k << " off " << off;
-        EXPECT_NEAR((sp->point - placed(foot)).norm(), 0.0, 1e-9) << "part " << part << " k " << k << " off " << off;
-        EXPECT_GT(sp->rounding, 0.0);
-        ++checked;
+    expect_exact_feet(*src, face, "placed part " + std::to_string(part), [&](int k, double a, double off) {
+      Vec3 q, foot;
+      if (part == 0) {
+        q = Vec3((3 + off) * std::cos(a), (3 + off) * std::sin(a), 1.0 + 0.25 * k);
+        foot = Vec3(3 * std::cos(a), 3 * std::sin(a), q.z());
+      } else if (part == 1) {
+        const double b = -1.2 + 0.1 * k;
+        const Vec3 out(std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b));
+        q = (4 + off) * out;
+        foot = 4 * out;
+      } else {
+        q = Vec3(0.2 * k, 0.25 * k, 7 + off);
+        foot = Vec3(q.x(), q.y(), 7);
       }
-    }
-    EXPECT_EQ(checked, 96);
+      return std::pair{placed(q), placed(foot)};
+    });
   }
 }
 
