@@ -149,11 +149,18 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
   return b;
 }
 
-// The plane of A's largest triangle (the first of equal ones); nullopt when none has an area.
+// A plane core is the plane of one triangle, chosen among at most this many evenly spread: any plane
+// is a valid core (the bound is the triangles' own), and a flat face's triangles all lie on its plane.
+// (An axis fitted to a sample was worse: on as1 at 0.001 mm it held fewer pairs off, 2.5x the box tests.)
+constexpr std::size_t kCoreSample = 64;
+std::size_t core_stride(std::size_t n) { return std::max<std::size_t>(1, n / kCoreSample); }
+
+// The plane of the largest of the sampled triangles (the first of equal ones); nullopt when none has
+// an area.
 std::optional<Core> plane_core(const std::vector<std::array<Vec3, 3>>& ta) {
   std::size_t best = 0;
   double best_area = 0.0;
-  for (std::size_t i = 0; i < ta.size(); ++i) {
+  for (std::size_t i = 0; i < ta.size(); i += core_stride(ta.size())) {
     const double a = normal_of(ta[i][0], ta[i][1], ta[i][2]).squaredNorm();
     if (a > best_area) best_area = a, best = i;
   }
