@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 namespace cadclash::detail {
 namespace {
@@ -96,10 +97,10 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
   CrossingBound b;
   b.steep_a.resize(ta.size());
   bool any_a = false, any_b = false;
-  auto certified = [&] {
+  auto certified = [&] {  // b is not used after: moved out, not copied
     b.steep_b.assign(tb.size(), 1);
     b.any = false;
-    return b;
+    return std::optional<CrossingBound>(std::move(b));
   };
   if (core.kind == Core::Plane) {
     // The shell of a plane is its vertices' heights (r of share()): a shell too thick for the level
