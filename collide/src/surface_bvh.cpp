@@ -173,13 +173,6 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
                        std::vector<std::uint32_t>& out, std::uint64_t& box_tests) {
   if (bvh.empty() || query.isEmpty()) return;
   const std::size_t start = out.size();
-  if (bvh.node_count == 0) {  // no tree: the scan meets the items in ascending order
-    for (std::uint32_t t = 0; t < bvh.items; ++t) {
-      ++box_tests;
-      if (boxes_overlap(triangle_box(mesh, t), query)) out.push_back(t);
-    }
-    return;
-  }
   const GridBox grid = grid_box(bvh, query);
   walk_bvh(
       bvh,
@@ -192,7 +185,7 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
         if (boxes_overlap(triangle_box(mesh, t), query)) out.push_back(t);
         return false;
       });
-  sort_indices(out, start, bvh.items);
+  if (bvh.node_count > 0) sort_indices(out, start, bvh.items);  // without a tree the scan is in order
 }
 
 double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
