@@ -117,6 +117,7 @@ AnalyticSurface transform_analytic(const AnalyticSurface& an, const Pose& t);
 #include "budget.h"
 #include "refine.h"
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -147,5 +148,30 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
                                        std::vector<RefinedSurface>& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
                                        CollideCounters& counters);
+
+// decide_pairs in two halves (certified or exact decision), for a caller that starts each task's
+// decision as soon as its triangles are done, on the thread that did them: early(k) runs steps 1 to
+// 3c of task k (any thread, each task once, after its outcome is final; the outlines it needs are
+// made on first need), skip(k) marks a task that gets no answer (cut before its decision), and
+// finish() runs steps 4 to 6 over the pairs still open and returns decide_pairs' answer, once every
+// task had early() or skip(). The answers are decide_pairs': each pair's steps depend on it alone.
+// The spans and references given must outlive the run; a task's outcome pointer may be set until
+// its early().
+class DecisionRun {
+ public:
+  DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+              std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
+              OutlineCache& outlines, const CollideOptions& options, int threads, const Deadline& deadline);
+  ~DecisionRun();
+  DecisionRun(const DecisionRun&) = delete;
+  DecisionRun& operator=(const DecisionRun&) = delete;
+  void early(std::size_t k);
+  void skip(std::size_t k);
+  std::vector<DecideResult> finish(CollideCounters& counters);
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace cadclash::detail

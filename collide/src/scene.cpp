@@ -42,8 +42,12 @@ void narrow_stages(SceneData& s, QueryState& q) {
   tessellation_stage(s, q);  // triangles and BVHs for exactly those surfaces
   time.tessellation = seconds_since(t);
   t = std::chrono::steady_clock::now();
-  triangle_level_stage(s, q);  // what their triangles say
-  decision_stage(s, q);        // what that proves about the exact faces
+  if (decide_with_triangles(q)) {
+    triangle_and_decision_stage(s, q);  // both, each task's decision right after its triangles
+  } else {
+    triangle_level_stage(s, q);  // what their triangles say
+    decision_stage(s, q);        // what that proves about the exact faces
+  }
   containment_stage(s, q);     // whole instances inside others
   time.triangle_level = seconds_since(t);
   results_stage(s, q);  // the kept prefix, in a fixed order

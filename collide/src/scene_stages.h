@@ -5,6 +5,7 @@
 
 #include "scene_data.h"
 
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -25,11 +26,21 @@ void tessellation_stage(SceneData& s, QueryState& q);
 // (marked ready); past the deadline the rest are skipped. Returns the surfaces built, in wave order.
 std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave, int threads, const Deadline& deadline);
 
-// 4. Triangle level of every task within the budget: Version 1 or 2 (collide.h).
-void triangle_level_stage(SceneData& s, QueryState& q);
+// 4. Triangle level of every task within the budget: Version 1 or 2 (collide.h). Version 1 only:
+//    `after(k)`, when given, runs on the thread that finished task k, once its outcome is final
+//    (also for a task the deadline cut).
+void triangle_level_stage(SceneData& s, QueryState& q, const std::function<void(std::size_t)>& after = {});
 
 // 5. The certified (or fast, or exact) decision of every finished task → q.pair_results.
 void decision_stage(SceneData& s, QueryState& q);
+
+// Stages 4 and 5 as one pass when decide_with_triangles(q) (Version 1, a certified or exact decision,
+// no memory budget): each task's decision steps up to the witnesses run right after its triangle
+// level, on the same thread, and the rest of stage 5 after the loop. The same answers and counters
+// as stage 4 then stage 5, since each task's steps depend on it alone; it saves the barrier between
+// the stages and the threads' idle time at the end of each loop.
+bool decide_with_triangles(const QueryState& q);
+void triangle_and_decision_stage(SceneData& s, QueryState& q);
 
 // 6. Containment of instance pairs whose boxes nest and whose surfaces do not cross.
 void containment_stage(const SceneData& s, QueryState& q);

@@ -6,6 +6,9 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <thread>
 
 namespace cadclash::detail {
 namespace {
@@ -17,15 +20,6 @@ std::vector<std::size_t> select(const std::vector<Pending>& pending, Keep keep) 
   for (std::size_t k = 0; k < pending.size(); ++k)
     if (!pending[k].settled && !pending[k].cut && keep(k)) out.push_back(k);
   return out;
-}
-
-// The surfaces of the listed tasks, each once, ascending.
-std::vector<SurfaceId> faces_of(std::span<const DecideTask> tasks, const std::vector<std::size_t>& ks) {
-  std::vector<SurfaceId> faces;
-  for (std::size_t k : ks) faces.insert(faces.end(), {tasks[k].sa, tasks[k].sb});
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  return faces;
 }
 
 // The faces refinement helps for the listed tasks (faces_to_refine), each once, ascending.
@@ -55,8 +49,10 @@ void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending,
   }
 }
 
+}  // namespace
+
 // One decision run: its inputs, and each pair's state between the steps.
-struct Run {
+struct DecisionRun::Impl {
   const Model& model;
   std::span<const Pose> poses;
   std::span<const double> eps;
@@ -69,6 +65,7 @@ struct Run {
   const Deadline& deadline;
   std::vector<Pending> pending = std::vector<Pending>(tasks.size());
   std::vector<CollideCounters> task_counters = std::vector<CollideCounters>(tasks.size());
+  std::vector<char> ambiguous = std::vector<char>(tasks.size(), 0);  // open after steps 1 and 2
 
   bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
   FaceView view(SurfaceId f) const {
@@ -81,56 +78,67 @@ struct Run {
   std::vector<std::size_t> open(Keep keep) const { return select(pending, keep); }
   template <class Step>
   void step(const std::vector<std::size_t>& ks, Step s) { run_step(ks, pending, threads, deadline, s); }
+
+  // Surface f's outline, made on its first need by the thread that meets it (the Scene keeps it);
+  // a thread that needs it meanwhile waits. The outline depends on the triangles alone, so which
+  // thread makes it changes nothing.
+  void need_outline(SurfaceId f) {
+    std::atomic_ref<char> state(outlines.ready[f]);  // 0: not made, 1: made, 2: being made
+    if (state.load(std::memory_order_acquire) == 1) return;
+    char expected = 0;
+    if (state.compare_exchange_strong(expected, 2, std::memory_order_acq_rel)) {
+      outlines.outline[f] = make_outline(model.surfaces[f].mesh);
+      state.store(1, std::memory_order_release);
+      return;
+    }
+    while (state.load(std::memory_order_acquire) != 1) std::this_thread::yield();
+  }
+
+  // Steps 1 to 3c of task k, on the calling thread: each task's answer depends on it alone, so
+  // the tasks may run in any order and on any threads.
+  void early(std::size_t k);
 };
 
-// The outlines of the listed pairs' surfaces the Scene does not have yet.
-void make_outlines(Run& run, const std::vector<std::size_t>& ks) {
-  std::vector<SurfaceId> faces = faces_of(run.tasks, ks);
-  std::erase_if(faces, [&](SurfaceId f) { return run.outlines.ready[f] != 0; });
-  const auto nfaces = static_cast<std::ptrdiff_t>(faces.size());
-#pragma omp parallel for num_threads(run.threads) schedule(dynamic, 4) if (nfaces >= 8)
-  for (std::ptrdiff_t i = 0; i < nfaces; ++i) {
-    const SurfaceId f = faces[static_cast<std::size_t>(i)];
-    run.outlines.outline[f] = make_outline(run.model.surfaces[f].mesh);
-  }
-  for (SurfaceId f : faces) run.outlines.ready[f] = 1;
+void DecisionRun::Impl::early(std::size_t k) {
+  Pending& p = pending[k];
+  const DecideTask& t = tasks[k];
+  // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
+  p = from_mesh(model, eps, t, o);
+  const bool certified = o.decision == DecisionMode::Certified;
+  if (!p.settled && certified && meshed(k)) analytic(model, eps, t, p, o);
+  ambiguous[k] = !p.settled;
+  if (!certified || p.settled || !meshed(k)) return;
+  // Steps 2b to 3c: witnesses of contact, each a few point queries, in order until one settles it;
+  // each only while the time lasts (a step past the deadline marks the pair cut).
+  auto next = [&] {
+    if (p.settled || p.cut) return false;
+    if (deadline.expired()) p.cut = true;
+    return !p.cut;
+  };
+  if (!next()) return;
+  need_outline(t.sa);  // step 2b asks the outlines of both surfaces
+  need_outline(t.sb);
+  const FaceView a = view(t.sa), b = view(t.sb);
+  CollideCounters& c = task_counters[k];
+  // Step 2b: analytic contact witnesses, on the outlines.
+  analytic_contact(eps, t, a, b, p, o);
+  // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing. Only
+  // where the triangles cross deeper than T: faces lying on each other or meeting at an edge cross
+  // by round-off only, and the vertex witnesses prove those.
+  if (t.outcome->intersecting && t.outcome->crosses_threshold && next()) crossing_step(model, eps, t, a, b, p, o, c);
+  // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
+  if (next()) tangent_step(model, eps, t, a, b, p, o, c);
+  // Step 3: witness vertices near the other face (a few exact point queries each).
+  if (next()) witness_step(model, eps, t, a, b, t.outcome, p.band, p, o, c);
+  // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
+  if (next()) edge_witness_step(model, poses, t, a, b, p, o, c);
+  // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
+  if (next()) edge_support_step(model, eps, t, a, b, p, o, c);
 }
 
-// Steps 2b to 3c: witnesses of contact, each a few point queries (certified mode). Each open pair
-// runs them in order until one settles it, all pairs in one parallel loop: a pair's steps depend on
-// it alone, so this is the answer of running each step over all pairs in turn.
-void witness_steps(Run& run) {
-  const auto& tasks = run.tasks;
-  const std::vector<std::size_t> open = run.open([&](std::size_t k) { return run.meshed(k); });
-  make_outlines(run, open);  // step 2b asks the outlines of the open pairs' surfaces
-  run.step(open, [&](std::size_t k) {
-    Pending& p = run.pending[k];
-    const DecideTask& t = tasks[k];
-    const FaceView a = run.view(t.sa), b = run.view(t.sb);
-    CollideCounters& c = run.task_counters[k];
-    // Each step only while the pair is open and the time lasts (a step past the deadline marks it cut).
-    auto next = [&] {
-      if (p.settled || p.cut) return false;
-      if (run.deadline.expired()) p.cut = true;
-      return !p.cut;
-    };
-    // Step 2b: analytic contact witnesses, on the outlines.
-    analytic_contact(run.eps, t, a, b, p, run.o);
-    // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing. Only
-    // where the triangles cross deeper than T: faces lying on each other or meeting at an edge cross
-    // by round-off only, and the vertex witnesses prove those.
-    if (t.outcome->intersecting && t.outcome->crosses_threshold && next())
-      crossing_step(run.model, run.eps, t, a, b, p, run.o, c);
-    // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
-    if (next()) tangent_step(run.model, run.eps, t, a, b, p, run.o, c);
-    // Step 3: witness vertices near the other face (a few exact point queries each).
-    if (next()) witness_step(run.model, run.eps, t, a, b, t.outcome, p.band, p, run.o, c);
-    // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
-    if (next()) edge_witness_step(run.model, run.poses, t, a, b, p, run.o, c);
-    // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
-    if (next()) edge_support_step(run.model, run.eps, t, a, b, p, run.o, c);
-  });
-}
+namespace {
+
+using Run = DecisionRun::Impl;
 
 // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see (apart),
 // not a contact within T (far below any band): crossing or touching triangles go on.
@@ -226,24 +234,34 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
     return results;
   }
-  const bool certified = o.decision == DecisionMode::Certified;
-  // Outlines are made for the surfaces of the open pairs (step 2b) unless the Scene has them already.
-  outline_cache.outline.resize(model.surfaces.size());
-  outline_cache.ready.resize(model.surfaces.size(), 0);
-  Run run{model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline};
-  // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
+  DecisionRun run(model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline);
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (n >= 64)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    run.pending[ku] = from_mesh(model, eps, tasks[ku], o);
-    if (!run.pending[ku].settled && certified && run.meshed(ku)) analytic(model, eps, tasks[ku], run.pending[ku], o);
-  }
-  for (const Pending& p : run.pending) counters.ambiguous_pairs += !p.settled;
-  if (certified) {
-    witness_steps(run);
-    refinement_step(run, counters);
-  }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (n >= 2)
+  for (std::ptrdiff_t k = 0; k < n; ++k) run.early(static_cast<std::size_t>(k));
+  return run.finish(counters);
+}
+
+DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+                         std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
+                         std::vector<RefinedSurface>& refined, OutlineCache& outlines, const CollideOptions& o,
+                         int threads, const Deadline& deadline) {
+  assert(o.decision != DecisionMode::Fast);
+  // Outlines are made on first need (step 2b) unless the Scene has them already.
+  outlines.outline.resize(model.surfaces.size());
+  outlines.ready.resize(model.surfaces.size(), 0);
+  impl_ = std::unique_ptr<Impl>(new Impl{model, poses, eps, bvh, tasks, refined, outlines, o, threads, deadline});
+}
+
+DecisionRun::~DecisionRun() = default;
+
+void DecisionRun::early(std::size_t k) { impl_->early(k); }
+
+void DecisionRun::skip(std::size_t k) { impl_->pending[k].cut = true; }
+
+std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
+  Run& run = *impl_;
+  for (char a : run.ambiguous) counters.ambiguous_pairs += a != 0;
+  if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
   exact_steps(run, counters);
   return collect(run, counters);
 }
@@ -257,40 +275,43 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 
 #include "cadclash/internal/progress_meter.h"
 
+#include <cassert>
+#include <functional>
+
 namespace cadclash::detail {
 
-void decision_stage(SceneData& s, QueryState& q) {
-  const Model& model = s.model;
+namespace {
+
+// The per-instance-pair state the decisions fill in.
+void start_pair_results(QueryState& q) {
   const std::size_t npairs = q.pairs.size();
   q.pair_cut.assign(npairs, 0);
   for (std::size_t k = 0; k < npairs; ++k) q.pair_cut[k] = q.pairs[k].cut;
   q.pair_intersects.assign(npairs, 0);
   q.pair_distance.assign(npairs, std::numeric_limits<double>::infinity());
   q.pair_results.assign(npairs, {});
-  std::vector<DecideTask> decide;
-  std::vector<std::size_t> task_of;  // decide[i] is task task_of[i]
-  for (std::size_t k = 0; k < q.first_task[q.cutoff]; ++k) {
-    const Task& t = q.tasks[k];
-    if (q.task_cut[k]) {
-      q.pair_cut[t.pair] = 1;
-      continue;
-    }
-    const InstancePair& ip = q.pairs[t.pair];
-    const bool usable = model.surfaces[t.sa].has_triangles && model.surfaces[t.sb].has_triangles;
-    if (usable && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
-    decide.push_back({ip.a, ip.b, t.sa, t.sb, usable ? &q.outcomes[k] : nullptr, ip.t_ab, ip.t_ba, ip.roundoff});
-    task_of.push_back(k);
-  }
-  // Progress: the pairs with nothing to decide are through at once, the rest when every step is.
-  ProgressMeter meter(q.progress, ProgressStage::CheckPairs, npairs, "decisions");
+}
+
+// Task k as the decision takes it (`outcome` null when a surface has no triangles).
+DecideTask decide_task(const QueryState& q, std::size_t k, const PairOutcome* outcome) {
+  const Task& t = q.tasks[k];
+  const InstancePair& ip = q.pairs[t.pair];
+  return {ip.a, ip.b, t.sa, t.sb, outcome, ip.t_ab, ip.t_ba, ip.roundoff};
+}
+
+bool usable(const Model& model, const Task& t) {
+  return model.surfaces[t.sa].has_triangles && model.surfaces[t.sb].has_triangles;
+}
+
+// The decisions' answers (results[i] for task task_of[i]) into the per-instance-pair results, after
+// the decisions' progress: the pairs with nothing to decide are through at once, the rest now.
+void conclude(QueryState& q, std::vector<DecideResult>& results, const std::vector<std::size_t>& task_of,
+              ProgressMeter& meter) {
   if (meter.active()) {
-    std::vector<char> open(npairs, 0);
+    std::vector<char> open(q.pairs.size(), 0);
     for (std::size_t k : task_of) open[q.tasks[k].pair] = 1;
     meter.add(static_cast<std::size_t>(std::count(open.begin(), open.end(), 0)));
   }
-  std::vector<DecideResult> results =
-      decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
-                   q.report.counters);
   meter.finish();
   for (std::size_t i = 0; i < results.size(); ++i) {
     const std::size_t k = task_of[i];
@@ -306,6 +327,76 @@ void decision_stage(SceneData& s, QueryState& q) {
     q.charge[pair] += result_bytes(r);
     q.pair_results[pair].push_back(std::move(r));
   }
+}
+
+}  // namespace
+
+void decision_stage(SceneData& s, QueryState& q) {
+  const Model& model = s.model;
+  start_pair_results(q);
+  std::vector<DecideTask> decide;
+  std::vector<std::size_t> task_of;  // decide[i] is task task_of[i]
+  decide.reserve(q.first_task[q.cutoff]);
+  task_of.reserve(q.first_task[q.cutoff]);
+  for (std::size_t k = 0; k < q.first_task[q.cutoff]; ++k) {
+    const Task& t = q.tasks[k];
+    if (q.task_cut[k]) {
+      q.pair_cut[t.pair] = 1;
+      continue;
+    }
+    const bool meshed = usable(model, t);
+    if (meshed && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
+    decide.push_back(decide_task(q, k, meshed ? &q.outcomes[k] : nullptr));
+    task_of.push_back(k);
+  }
+  ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
+  std::vector<DecideResult> results =
+      decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
+                   q.report.counters);
+  conclude(q, results, task_of, meter);
+}
+
+bool decide_with_triangles(const QueryState& q) {
+  return q.o.version == ParallelVersion::V1 && q.o.decision != DecisionMode::Fast && q.o.memory_budget_bytes == 0;
+}
+
+void triangle_and_decision_stage(SceneData& s, QueryState& q) {
+  assert(decide_with_triangles(q));
+  const Model& model = s.model;
+  // Without a memory budget every task is kept (the cutoff stays past the last pair), so each task
+  // is decided: its outcome pointer is set by the thread that finished its triangles, before early().
+  const std::size_t ntasks = q.first_task[q.cutoff];
+  std::vector<DecideTask> decide;
+  decide.reserve(ntasks);
+  for (std::size_t k = 0; k < ntasks; ++k) decide.push_back(decide_task(q, k, nullptr));
+  DecisionRun run(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline);
+  triangle_level_stage(s, q, [&](std::size_t k) {
+    if (q.task_cut[k] || q.outcomes[k].cut) {
+      run.skip(k);  // cut by the deadline: no answer, as decision_stage leaves it
+      return;
+    }
+    if (usable(model, q.tasks[k])) decide[k].outcome = &q.outcomes[k];
+    run.early(k);
+  });
+  assert(q.first_task[q.cutoff] == ntasks);
+  start_pair_results(q);
+  std::vector<std::size_t> task_of;  // the tasks decide_pairs would have been given
+  task_of.reserve(ntasks);
+  for (std::size_t k = 0; k < ntasks; ++k) {
+    const Task& t = q.tasks[k];
+    if (q.task_cut[k]) {
+      q.pair_cut[t.pair] = 1;
+      continue;
+    }
+    if (decide[k].outcome != nullptr && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
+    task_of.push_back(k);
+  }
+  ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
+  std::vector<DecideResult> all = run.finish(q.report.counters);
+  std::vector<DecideResult> results;  // in task_of's order, as decide_pairs returns them
+  results.reserve(task_of.size());
+  for (std::size_t k : task_of) results.push_back(std::move(all[k]));
+  conclude(q, results, task_of, meter);
 }
 
 }  // namespace cadclash::detail

@@ -33,6 +33,9 @@ void release_past_cutoff(SceneData& s, const QueryState& q) {
 void results_stage(SceneData& s, QueryState& q) {
   Report& report = q.report;
   CollideCounters& total = report.counters;
+  std::size_t kept = 0;
+  for (std::uint32_t k = 0; k < q.cutoff; ++k) kept += q.pair_results[k].size();
+  report.pairs.reserve(report.pairs.size() + kept);
   for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
     if (k >= q.cutoff || q.pair_cut[k]) report.unexamined_pairs.push_back({q.pairs[k].a, q.pairs[k].b});
     if (k >= q.cutoff) continue;
@@ -55,10 +58,15 @@ void results_stage(SceneData& s, QueryState& q) {
   else if (time_cut) report.stopped_by = "time budget";
   std::sort(report.unexamined_pairs.begin(), report.unexamined_pairs.end());
   if (memory_cut) release_past_cutoff(s, q);
-  std::sort(report.pairs.begin(), report.pairs.end(), [](const SurfacePairResult& x, const SurfacePairResult& y) {
+  // The keys are distinct (one result per surface pair, one containment result per instance pair), so
+  // the order is the same whether or not the pairs came in it already (they mostly do: tasks are made
+  // in pair order).
+  auto before = [](const SurfacePairResult& x, const SurfacePairResult& y) {
     return std::tie(x.instance_a, x.instance_b, x.surface_a, x.surface_b) <
            std::tie(y.instance_a, y.instance_b, y.surface_a, y.surface_b);
-  });
+  };
+  if (!std::is_sorted(report.pairs.begin(), report.pairs.end(), before))
+    std::sort(report.pairs.begin(), report.pairs.end(), before);
 }
 
 }  // namespace cadclash::detail

@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
+#include <functional>
 
 namespace cadclash::detail {
 namespace {
@@ -77,7 +79,8 @@ bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::
   return true;
 }
 
-void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
+void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes,
+            const std::function<void(std::size_t)>& after) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
   PairsThrough through(q, ntasks, [&](std::size_t k) { return q.tasks[k].pair; });
 #pragma omp parallel num_threads(q.threads) if (n >= kMinParallel)
@@ -94,6 +97,7 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
         run_pair(s.model.surfaces[q.tasks[ku].sa], scratch, 0, scratch.la.size(), q.o, q.outcomes[ku],
                  q.task_counters[ku], &q.deadline);
       }
+      if (after) after(ku);
       through.item_done(q.tasks[ku].pair);
     }
   }
@@ -143,7 +147,8 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
 
 }  // namespace
 
-void triangle_level_stage(SceneData& s, QueryState& q) {
+void triangle_level_stage(SceneData& s, QueryState& q, const std::function<void(std::size_t)>& after) {
+  assert(!after || q.o.version == ParallelVersion::V1);
   const std::size_t ntasks = q.first_task[q.cutoff];
   q.prepared.assign(q.o.version == ParallelVersion::V1 ? 0 : q.tasks.size(), PreparedPair{});  // V1: per thread
   q.outcomes.assign(q.tasks.size(), PairOutcome{});
@@ -151,7 +156,7 @@ void triangle_level_stage(SceneData& s, QueryState& q) {
   q.task_cut.assign(q.tasks.size(), 0);
   std::vector<std::uint64_t> bytes(q.tasks.size(), 0);
   if (q.o.version == ParallelVersion::V1) {
-    run_v1(s, q, ntasks, bytes);
+    run_v1(s, q, ntasks, bytes, after);
     for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
     q.apply_memory_budget();
   } else {

@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -441,6 +442,44 @@ TEST(CertifiedDeterminism, OneAndTwoThreadsGiveTheSameReport) {
                     two.seconds * 1e3);
         EXPECT_EQ(serialize(one.report), serialize(two.report)) << scene->name << " " << decision_mode_name(mode) << " " << tol;
       }
+}
+
+// Version 1 without a memory budget decides each pair right after its triangles, inside the triangle
+// level's loop (scene_stages.h, triangle_and_decision_stage); with a memory budget, and in Version 2,
+// the triangle level and the decisions run in turn. Both must give the same report, counters included.
+TEST(CertifiedDeterminism, DecisionsRightAfterTheTrianglesEqualTheStagesInTurn) {
+  REQUIRE_SAMPLES();
+  ASSERT_TRUE(as1().ok());
+  ASSERT_TRUE(board().ok());
+  auto text = [](const Report& r) {
+    const CollideCounters& c = r.counters;
+    return serialize(r) + "witness " + std::to_string(c.witness_queries) + " distance " +
+           std::to_string(c.distance_tests) + " triangles " + std::to_string(c.triangle_tests) + " boxes " +
+           std::to_string(c.aabb_tests) + " unexamined " + std::to_string(r.unexamined_pairs.size()) + "\n";
+  };
+  for (const BuiltScene* scene : {&as1(), &board()})
+    for (double tol : kTolerances)
+      for (DecisionMode mode : kModes)
+        for (int threads : {1, 2}) {
+          Model m = scene->model;
+          CollideOptions o;
+          o.tolerance = tol;
+          o.decision = mode;
+          o.threads = threads;
+          const Report together = Scene(m).check(o);
+          o.memory_budget_bytes = std::numeric_limits<std::size_t>::max();  // a budget that cuts nothing
+          const Report in_turn = Scene(m).check(o);
+          o.memory_budget_bytes = 0;
+          o.version = ParallelVersion::V2;
+          const Report v2 = Scene(m).check(o);
+          const std::string what = scene->name + " " + decision_mode_name(mode) + " " + std::to_string(tol) + " " +
+                                   std::to_string(threads) + " threads";
+          EXPECT_FALSE(together.pairs.empty()) << what;
+          EXPECT_EQ(text(together), text(in_turn)) << what;
+          // Version 2 counts box tests per block of triangles: everything else must agree.
+          EXPECT_EQ(serialize(together), serialize(v2)) << what;
+          EXPECT_EQ(together.counters.witness_queries, v2.counters.witness_queries) << what;
+        }
 }
 
 // OCCT 7.6's face-face distance misses the minimum of these B-spline half-cylinders: 0.0394 mm,
