@@ -123,7 +123,11 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
     b.any = any_a && any_b;
     return b;
   }
-  std::vector<Share> sa, sb;  // appended: a resized list would be filled first
+  // Appended (a resized list would be filled first), into the thread's lists: a run asks for a
+  // bound per pair, and these are its only scratch.
+  thread_local std::vector<Share> sa, sb;
+  sa.clear();
+  sb.clear();
   sa.reserve(ta.size());
   sb.reserve(tb.size());
   double lo_a = std::numeric_limits<double>::infinity(), hi_a = -lo_a, lo_b = lo_a, hi_b = -lo_a;
@@ -213,17 +217,22 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
                              const std::vector<std::uint32_t>& la, std::size_t begin, std::size_t end,
                              const std::vector<std::array<Vec3, 3>>& tri_b, double level, double slack,
                              bool curved) {
-  std::vector<std::array<Vec3, 3>> ta;
+  // Everything may cross: what is left when no core says more.
+  auto fallback = [&] {
+    CrossingBound b;
+    b.steep_a.assign(end - begin, 1);
+    b.steep_b.assign(tri_b.size(), 1);
+    b.any = end > begin && !tri_b.empty();
+    return b;
+  };
+  if (end == begin || tri_b.empty() || !(level > slack)) return fallback();  // nothing, or no room
+  thread_local std::vector<std::array<Vec3, 3>> ta;  // A's survivors' corners (the thread's list)
+  ta.clear();
   ta.reserve(end - begin);
   for (std::size_t i = begin; i < end; ++i) {
     const auto& t = mesh_a.triangles[la[i]];
     ta.push_back({mesh_a.vertices[t[0]], mesh_a.vertices[t[1]], mesh_a.vertices[t[2]]});
   }
-  CrossingBound fallback;
-  fallback.steep_a.assign(ta.size(), 1);
-  fallback.steep_b.assign(tri_b.size(), 1);
-  fallback.any = !ta.empty() && !tri_b.empty();
-  if (!fallback.any || !(level > slack)) return fallback;  // no room: everything may cross
   // Cores, the likeliest first: A's own analytic axis or centre; for a plane a plane; for another
   // face a fitted axis, then the plane of its largest triangle; then B's plane and fitted axis.
   std::optional<CrossingBound> best;
@@ -256,7 +265,7 @@ CrossingBound crossing_bound(const TriangleMesh& mesh_a, const AnalyticSurface& 
   }
   // Then B's: the plane a pin stands on, the axis of a pin through a plate's hole.
   if (!done && !consider(plane_core(tri_b)) && curved) consider(fitted_axis(tri_b));
-  return best ? *best : fallback;
+  return best ? std::move(*best) : fallback();
 }
 
 }  // namespace cadclash::detail
