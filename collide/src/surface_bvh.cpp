@@ -182,7 +182,7 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
       },
       [&](std::uint32_t t) {
         ++box_tests;
-        if (boxes_overlap(triangle_box(mesh, t), query)) out.push_back(t);
+        if (triangle_meets_box(mesh, t, query)) out.push_back(t);
         return false;
       });
   if (bvh.node_count > 0) sort_indices(out, start, bvh.items);  // without a tree the scan is in order

@@ -14,6 +14,7 @@
 
 #include "cadclash/collide.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -121,6 +122,20 @@ inline Aabb triangle_box(const TriangleMesh& mesh, std::uint32_t t) {
   Aabb b(mesh.vertices[tri[0]]);
   b.extend(mesh.vertices[tri[1]]).extend(mesh.vertices[tri[2]]);
   return b;
+}
+
+// boxes_overlap(triangle_box(mesh, t), query) for a non-empty `query` and finite vertices, axis by
+// axis with an early out (most triangles a query reaches in a leaf miss it on one axis).
+inline bool triangle_meets_box(const TriangleMesh& mesh, std::uint32_t t, const Aabb& query) {
+  const auto& tri = mesh.triangles[t];
+  const Vec3& a = mesh.vertices[tri[0]];
+  const Vec3& b = mesh.vertices[tri[1]];
+  const Vec3& c = mesh.vertices[tri[2]];
+  for (int k = 0; k < 3; ++k) {
+    if (std::min(std::min(a[k], b[k]), c[k]) > query.max()[k]) return false;
+    if (std::max(std::max(a[k], b[k]), c[k]) < query.min()[k]) return false;
+  }
+  return true;
 }
 
 // Builds the tree over `mesh`'s triangles (split at a multiple of kLeafSize on the longest axis of

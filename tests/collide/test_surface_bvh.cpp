@@ -136,10 +136,22 @@ TEST(SurfaceBvh, TriangleQueriesReturnTheMeetingTrianglesAscending) {
     const SurfaceBvh bvh = detail::build_surface_bvh(mesh);
     EXPECT_EQ(bvh.node_count == 0, n <= SurfaceBvh::kFlatLimit);
     std::size_t large = 0;
+    std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(n - 1));
     for (const double side : {0.5, 3.0, 20.0, 60.0, 120.0}) {
-      for (int q = 0; q < 10; ++q) {
+      for (int q = 0; q < 16; ++q) {
         const Vec3 lo(100 * u(gen) - side / 2, 100 * u(gen) - side / 2, 100 * u(gen) - side / 2);
-        const Aabb query(lo, lo + Vec3::Constant(side));
+        Aabb query(lo, lo + Vec3::Constant(side));
+        if (q >= 10) {
+          // A query box whose face lies exactly on a face of a triangle's box (closed boxes: they meet),
+          // below it on one axis for q even, above it for q odd.
+          const auto& tri = mesh.triangles[pick(gen)];
+          Aabb b(mesh.vertices[tri[0]]);
+          b.extend(mesh.vertices[tri[1]]).extend(mesh.vertices[tri[2]]);
+          const int k = q % 3;
+          query = Aabb(b.center() - Vec3::Constant(side / 2), b.center() + Vec3::Constant(side / 2));
+          if (q % 2 == 0) query.max()[k] = b.min()[k], query.min()[k] = b.min()[k] - side;
+          else query.min()[k] = b.max()[k], query.max()[k] = b.max()[k] + side;
+        }
         std::vector<std::uint32_t> expected{7, 3};  // what the caller held: kept in front, unsorted
         for (std::uint32_t t = 0; t < n; ++t) {
           const auto& tri = mesh.triangles[t];
