@@ -106,7 +106,10 @@ struct QueryState {
   // Per instance pair.
   std::vector<char> pair_cut, pair_intersects, contained;
   std::vector<double> pair_distance;
-  std::vector<std::vector<SurfacePairResult>> pair_results;
+  // The reported pairs of the decisions and the containment test (in no particular order: the
+  // report sorts them), each with its instance pair; those past the final cutoff are dropped.
+  std::vector<SurfacePairResult> results;
+  std::vector<std::uint32_t> result_pair;
 
   QueryState(const CollideOptions& options, std::chrono::steady_clock::time_point start);
   // Moves the cutoff to the first pair whose running charge exceeds the budget. Charges only grow,

@@ -31,7 +31,7 @@ std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave
 //    (also for a task the deadline cut).
 void triangle_level_stage(SceneData& s, QueryState& q, const std::function<void(std::size_t)>& after = {});
 
-// 5. The certified (or fast, or exact) decision of every finished task → q.pair_results.
+// 5. The certified (or fast, or exact) decision of every finished task → q.results.
 void decision_stage(SceneData& s, QueryState& q);
 
 // Stages 4 and 5 as one pass when decide_with_triangles(q) (Version 1, a certified or exact decision,

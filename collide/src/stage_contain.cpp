@@ -9,7 +9,7 @@
 namespace cadclash::detail {
 namespace {
 
-constexpr std::ptrdiff_t kMinParallel = 4;
+constexpr std::ptrdiff_t kMinParallel = 2;
 
 // True when every surface of instance `inner` has its first vertex inside `outer`'s triangles.
 bool inside(const SceneData& s, InstanceId inner, InstanceId outer, const Pose& inner_to_outer) {
@@ -34,12 +34,15 @@ bool inside(const SceneData& s, InstanceId inner, InstanceId outer, const Pose& 
 
 void containment_stage(const SceneData& s, QueryState& q) {
   q.contained.assign(q.pairs.size(), 0);
-  const auto n = static_cast<std::ptrdiff_t>(q.cutoff);
+  // The pairs whose boxes nest and whose surfaces do not cross: usually none, so no team for them.
+  std::vector<std::uint32_t> nested;
+  for (std::uint32_t k = 0; k < q.cutoff; ++k)
+    if (q.pairs[k].containment && !q.pair_intersects[k] && !q.pair_cut[k]) nested.push_back(k);
+  const auto n = static_cast<std::ptrdiff_t>(nested.size());
 #pragma omp parallel for num_threads(q.threads) schedule(dynamic, 1) if (n >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const std::uint32_t ku = nested[static_cast<std::size_t>(i)];
     const InstancePair& ip = q.pairs[ku];
-    if (!ip.containment || q.pair_intersects[ku] || q.pair_cut[ku]) continue;
     if (q.deadline.expired()) {
       q.pair_cut[ku] = 1;
       continue;
@@ -55,7 +58,8 @@ void containment_stage(const SceneData& s, QueryState& q) {
     r.distance = q.pair_distance[k];
     r.distance_lo = r.distance_hi = r.distance;
     q.charge[k] += result_bytes(r);
-    q.pair_results[k].push_back(std::move(r));
+    q.results.push_back(std::move(r));
+    q.result_pair.push_back(static_cast<std::uint32_t>(k));
   }
   q.apply_memory_budget();
 }

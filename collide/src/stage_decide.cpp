@@ -283,13 +283,14 @@ namespace cadclash::detail {
 namespace {
 
 // The per-instance-pair state the decisions fill in.
-void start_pair_results(QueryState& q) {
+void start_results(QueryState& q) {
   const std::size_t npairs = q.pairs.size();
   q.pair_cut.assign(npairs, 0);
   for (std::size_t k = 0; k < npairs; ++k) q.pair_cut[k] = q.pairs[k].cut;
   q.pair_intersects.assign(npairs, 0);
   q.pair_distance.assign(npairs, std::numeric_limits<double>::infinity());
-  q.pair_results.assign(npairs, {});
+  q.results.clear();
+  q.result_pair.clear();
 }
 
 // Task k as the decision takes it (`outcome` null when a surface has no triangles).
@@ -303,29 +304,34 @@ bool usable(const Model& model, const Task& t) {
   return model.surfaces[t.sa].has_triangles && model.surfaces[t.sb].has_triangles;
 }
 
-// The decisions' answers (results[i] for task task_of[i]) into the per-instance-pair results, after
-// the decisions' progress: the pairs with nothing to decide are through at once, the rest now.
+// The decisions' answers into the query's results, after the decisions' progress: the pairs with
+// nothing to decide are through at once, the rest now. The answer for task task_of[i] is results[i],
+// or results[task_of[i]] when `by_task`.
 void conclude(QueryState& q, std::vector<DecideResult>& results, const std::vector<std::size_t>& task_of,
-              ProgressMeter& meter) {
+              bool by_task, ProgressMeter& meter) {
   if (meter.active()) {
     std::vector<char> open(q.pairs.size(), 0);
     for (std::size_t k : task_of) open[q.tasks[k].pair] = 1;
     meter.add(static_cast<std::size_t>(std::count(open.begin(), open.end(), 0)));
   }
   meter.finish();
-  for (std::size_t i = 0; i < results.size(); ++i) {
+  q.results.reserve(task_of.size());
+  q.result_pair.reserve(task_of.size());
+  for (std::size_t i = 0; i < task_of.size(); ++i) {
     const std::size_t k = task_of[i];
-    const std::size_t pair = q.tasks[k].pair;
-    if (results[i].cut) {
+    DecideResult& answer = results[by_task ? k : i];
+    const std::uint32_t pair = q.tasks[k].pair;
+    if (answer.cut) {
       q.task_cut[k] = 1;
       q.pair_cut[pair] = 1;
       continue;
     }
-    if (!results[i].result) continue;
-    SurfacePairResult& r = *results[i].result;
+    if (!answer.result) continue;
+    SurfacePairResult& r = *answer.result;
     q.pair_distance[pair] = std::min(q.pair_distance[pair], r.distance);
     q.charge[pair] += result_bytes(r);
-    q.pair_results[pair].push_back(std::move(r));
+    q.results.push_back(std::move(r));
+    q.result_pair.push_back(pair);
   }
 }
 
@@ -333,7 +339,7 @@ void conclude(QueryState& q, std::vector<DecideResult>& results, const std::vect
 
 void decision_stage(SceneData& s, QueryState& q) {
   const Model& model = s.model;
-  start_pair_results(q);
+  start_results(q);
   std::vector<DecideTask> decide;
   std::vector<std::size_t> task_of;  // decide[i] is task task_of[i]
   decide.reserve(q.first_task[q.cutoff]);
@@ -353,7 +359,7 @@ void decision_stage(SceneData& s, QueryState& q) {
   std::vector<DecideResult> results =
       decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
                    q.report.counters);
-  conclude(q, results, task_of, meter);
+  conclude(q, results, task_of, /*by_task=*/false, meter);
 }
 
 bool decide_with_triangles(const QueryState& q) {
@@ -379,7 +385,7 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
     run.early(k);
   });
   assert(q.first_task[q.cutoff] == ntasks);
-  start_pair_results(q);
+  start_results(q);
   std::vector<std::size_t> task_of;  // the tasks decide_pairs would have been given
   task_of.reserve(ntasks);
   for (std::size_t k = 0; k < ntasks; ++k) {
@@ -392,11 +398,8 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
     task_of.push_back(k);
   }
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
-  std::vector<DecideResult> all = run.finish(q.report.counters);
-  std::vector<DecideResult> results;  // in task_of's order, as decide_pairs returns them
-  results.reserve(task_of.size());
-  for (std::size_t k : task_of) results.push_back(std::move(all[k]));
-  conclude(q, results, task_of, meter);
+  std::vector<DecideResult> all = run.finish(q.report.counters);  // every task's, task_of's among them
+  conclude(q, all, task_of, /*by_task=*/true, meter);
 }
 
 }  // namespace cadclash::detail

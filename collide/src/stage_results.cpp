@@ -33,9 +33,9 @@ void release_past_cutoff(SceneData& s, const QueryState& q) {
 void results_stage(SceneData& s, QueryState& q) {
   Report& report = q.report;
   CollideCounters& total = report.counters;
-  std::size_t kept = 0;
-  for (std::uint32_t k = 0; k < q.cutoff; ++k) kept += q.pair_results[k].size();
-  report.pairs.reserve(report.pairs.size() + kept);
+  report.pairs.reserve(report.pairs.size() + q.results.size());
+  for (std::size_t i = 0; i < q.results.size(); ++i)
+    if (q.result_pair[i] < q.cutoff) report.pairs.push_back(std::move(q.results[i]));
   for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
     if (k >= q.cutoff || q.pair_cut[k]) report.unexamined_pairs.push_back({q.pairs[k].a, q.pairs[k].b});
     if (k >= q.cutoff) continue;
@@ -46,7 +46,6 @@ void results_stage(SceneData& s, QueryState& q) {
       add(total, q.task_counters[t]);
       if (q.outcomes[t].intersecting) ++total.intersecting_pairs;
     }
-    for (SurfacePairResult& r : q.pair_results[k]) report.pairs.push_back(std::move(r));
   }
   for (SurfaceId sid : q.asked) total.tessellated_surfaces += q.first_need[sid] < q.cutoff;
   const bool memory_cut = q.cutoff < q.pairs.size();
@@ -59,8 +58,8 @@ void results_stage(SceneData& s, QueryState& q) {
   std::sort(report.unexamined_pairs.begin(), report.unexamined_pairs.end());
   if (memory_cut) release_past_cutoff(s, q);
   // The keys are distinct (one result per surface pair, one containment result per instance pair), so
-  // the order is the same whether or not the pairs came in it already (they mostly do: tasks are made
-  // in pair order).
+  // the order is the same whether or not the pairs came in it already (they mostly do: the decisions
+  // come in task order, which is pair order).
   auto before = [](const SurfacePairResult& x, const SurfacePairResult& y) {
     return std::tie(x.instance_a, x.instance_b, x.surface_a, x.surface_b) <
            std::tie(y.instance_a, y.instance_b, y.surface_a, y.surface_b);
