@@ -191,36 +191,38 @@ bool in_domain(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
 // Rows a = q - p, b = r - p, w = s - p, each coordinate as hi + lo.
 struct Rows {
   Diff d[3][3];
-  bool exact_differences;
-  double max_abs;  // largest |hi|
 };
 
 Rows rows(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
-  Rows o{{{diff(q.x, p.x), diff(q.y, p.y), diff(q.z, p.z)},
-          {diff(r.x, p.x), diff(r.y, p.y), diff(r.z, p.z)},
-          {diff(s.x, p.x), diff(s.y, p.y), diff(s.z, p.z)}},
-         true, 0.0};
-  for (const auto& row : o.d)
-    for (const Diff& x : row) {
-      o.exact_differences &= x.count == 1;
-      o.max_abs = std::max(o.max_abs, std::abs(x.c[0]));
-    }
-  return o;
+  return {{{diff(q.x, p.x), diff(q.y, p.y), diff(q.z, p.z)},
+           {diff(r.x, p.x), diff(r.y, p.y), diff(r.z, p.z)},
+           {diff(s.x, p.x), diff(s.y, p.y), diff(s.z, p.z)}}};
 }
 
-// The fast path (4. above), or kNoFastPath when it does not apply.
-int grid_sign(const Rows& o) {
-  if (o.max_abs == 0.0) return 0;  // all four points equal
-  if (!o.exact_differences) return kNoFastPath;
-  const int g = biased_exponent(o.max_abs) - 1023 - 15;
+// The fast path (4. above), or kNoFastPath when it does not apply. Cheap to reject: the grid test on
+// the rounded differences fails at once on data that is not a lattice; only then is it checked that
+// the differences are exact (a rounded difference can lie on the grid too).
+int grid_sign(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
+  const double d[9] = {q.x - p.x, q.y - p.y, q.z - p.z, r.x - p.x, r.y - p.y, r.z - p.z, s.x - p.x, s.y - p.y, s.z - p.z};
+  double m = 0.0;
+  for (const double x : d) m = std::max(m, std::abs(x));
+  if (m == 0.0) return 0;  // fl(a - b) == 0 iff a == b: all four points equal
+  const int g = biased_exponent(m) - 1023 - 15;
   if (g < -352) return kNoFastPath;
   const double scale = power_of_two(-g);
-  for (const auto& row : o.d)
-    for (const Diff& x : row)
-      if (!is_integer(x.c[0] * scale)) return kNoFastPath;
-  const double ax = o.d[0][0].c[0], ay = o.d[0][1].c[0], az = o.d[0][2].c[0];
-  const double bx = o.d[1][0].c[0], by = o.d[1][1].c[0], bz = o.d[1][2].c[0];
-  const double wx = o.d[2][0].c[0], wy = o.d[2][1].c[0], wz = o.d[2][2].c[0];
+  for (const double x : d)
+    if (!is_integer(x * scale)) return kNoFastPath;
+  const Pt3* const from[3] = {&q, &r, &s};
+  for (int i = 0; i < 3; ++i) {
+    double hi, lo;
+    two_diff(from[i]->x, p.x, hi, lo);
+    if (lo != 0.0) return kNoFastPath;
+    two_diff(from[i]->y, p.y, hi, lo);
+    if (lo != 0.0) return kNoFastPath;
+    two_diff(from[i]->z, p.z, hi, lo);
+    if (lo != 0.0) return kNoFastPath;
+  }
+  const double ax = d[0], ay = d[1], az = d[2], bx = d[3], by = d[4], bz = d[5], wx = d[6], wy = d[7], wz = d[8];
   const double det = wx * (ay * bz - az * by) + wy * (az * bx - ax * bz) + wz * (ax * by - ay * bx);
   return (det > 0.0) - (det < 0.0);
 }
@@ -256,14 +258,13 @@ int expansion_sign(const Rows& o) {
 
 int orient3d_fast_sign(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
   if (!in_domain(p, q, r, s)) return kUnsupported;
-  return grid_sign(rows(p, q, r, s));
+  return grid_sign(p, q, r, s);
 }
 
 int orient3d_exact_sign(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
   if (!in_domain(p, q, r, s)) return kUnsupported;
-  const Rows o = rows(p, q, r, s);
-  const int fast = grid_sign(o);
-  return fast != kNoFastPath ? fast : expansion_sign(o);
+  const int fast = grid_sign(p, q, r, s);
+  return fast != kNoFastPath ? fast : expansion_sign(rows(p, q, r, s));
 }
 
 int orient3d_expansion_sign(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
