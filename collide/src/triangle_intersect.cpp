@@ -1,18 +1,23 @@
 // triangles_intersect: Guigue–Devillers ("Fast and robust triangle-triangle overlap test using
 // orientation predicates", JGT 2003) with every orientation sign made exact by stages:
 //   1. double, with a static error bound (below): certifies the sign of almost every generic call;
-//   2. long double, the same evaluation and bound with u = 2^-64 (side_extended);
-//   3. exact: exact::orient3d_exact_sign / orient2d_exact_sign (exact_orient.cpp), expansion
-//      arithmetic on the same doubles, which also gives the exact zeros of coplanar and touching
-//      configurations.
-// Stage 3 runs only for a sign the two bounds leave open; before any open sign is resolved, two cheap
-// special cases settle the call: a shared vertex (the closed triangles meet there; a shared edge is
-// two shared vertices) and both triangles in one coordinate plane (a z = c contact; the 2D test
-// below). With exact signs, zeros included, the degenerate configurations are decided here too:
-// exactly coplanar triangles in any plane by a 2D closed-triangle test, vertices on the other plane
-// by CGAL's own case analysis. What still goes to triangles_intersect_exact (CGAL, the "exact
-// fallback"): degenerate triangles (collinear or repeated vertices), coordinates beyond 2^48, and
-// nonzero coordinates below 2^-300 that reach stage 3 (outside exact_orient's domain).
+//   2. for a sign it leaves open, the exact lattice fast path (exact_orient.cpp: when the coordinate
+//      differences are exact and lie on a common grid of at most 16 bits, the plain double
+//      evaluation has no rounding; cheap, and it settles the exact zeros of lattice contacts);
+//   3. long double, the same evaluation and bound with u = 2^-64 (side_extended);
+//   4. exact: exact::orient3d_expansion_sign (exact_orient.cpp), expansion arithmetic on the same
+//      doubles, which also gives the exact zeros of coplanar and touching configurations.
+// 2D signs (coplanar pairs) go double filter -> exact::orient2d_exact_sign. Before any open 3D sign is
+// resolved, two cheap special cases settle the call: a shared vertex (the closed triangles meet
+// there; a shared edge is two shared vertices) and both triangles in one coordinate plane (a z = c
+// contact; the 2D test below). With exact signs, zeros included, the degenerate configurations are
+// decided here too: exactly coplanar triangles in any plane by a 2D closed-triangle test, vertices on
+// the other plane by CGAL's own case analysis. What still goes to triangles_intersect_exact (CGAL, the
+// "exact fallback"): degenerate triangles (collinear or repeated vertices), coordinates beyond 2^48,
+// and nonzero coordinates below 2^-300 in a sign the float stages cannot settle (outside
+// exact_orient's domain). The float-only benchmark mode (testing::set_float_only_for_benchmark) runs
+// stages 1 and 3 and the special cases only, exactly as before the exact stage: whatever they leave
+// open is answered "intersect" and counted in exact_fallbacks, with no exact arithmetic.
 //
 // Decision (exact signs; A = (a0, a1, a2) is CGAL's t1 and B its t2, the oracle's order):
 //  - da_i = orientation(b0, b1, b2, a_i). All three strictly of one sign: A lies in an open half-
@@ -54,15 +59,18 @@
 // product; the total absolute error from underflow is below 2^-1020 and the floor 2^-1000 (plus
 // the u·P spare) covers it. A certified sign is never zero.
 //
-// Why stage 3 is exact: it does not bound an error, it has none. Each coordinate difference is
-// split into two doubles whose sum is exactly the difference (Two-Diff), each product of doubles
-// into two doubles whose sum is exactly the product (Dekker's Two-Product with Veltkamp's split;
-// FMA is not used and not contracted), and the resulting doubles are added with Two-Sum, which is
-// exact, into a nonoverlapping expansion: a list of doubles whose exact sum is the determinant and
-// whose largest component has its sign (0 iff the list is empty). These transformations are exact
-// when no intermediate result overflows or is rounded in the subnormal range; the domain (every
-// coordinate 0 or 2^-300 <= |x| <= 2^48) guarantees both, because every intermediate value is then a
-// multiple of 2^-1056 below 2^155. The full argument is at the top of exact_orient.cpp.
+// Why stages 2 and 4 are exact: they do not bound an error, they have none. Stage 2 evaluates the
+// determinant in plain double only when every difference is exact and a multiple of 2^g below
+// 2^(g+16): every product and sum then has at most 51 significant bits on a grid of at least
+// 2^-1056, so no operation rounds. Stage 4 splits each coordinate difference into two doubles whose
+// sum is exactly the difference (Two-Diff), each product of doubles into two doubles whose sum is
+// exactly the product (Dekker's Two-Product with Veltkamp's split; FMA is not used and not
+// contracted), and adds the resulting doubles with Two-Sum, which is exact, into a nonoverlapping
+// expansion: a list of doubles whose exact sum is the determinant and whose largest component has its
+// sign (0 iff the list is empty). These transformations are exact when no intermediate result
+// overflows or is rounded in the subnormal range; the domain (every coordinate 0 or
+// 2^-300 <= |x| <= 2^48) guarantees both, because every intermediate value is then a multiple of
+// 2^-1056 below 2^155. The full argument is at the top of exact_orient.cpp.
 #include "cadclash/geometry.h"
 #include "cadclash/testing/benchmark_switches.h"
 #include "exact_orient.h"
