@@ -284,6 +284,13 @@ Verdict coplanar_2d(const P2* a, const P2* b, int oa, int ob, TrianglePredicateS
   return open ? Verdict::Unsure : Verdict::Intersect;
 }
 
+inline bool same_point(const P3& a, const P3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+// A repeated vertex: the triangle is degenerate (CGAL decides), known without any sign.
+inline bool repeated_vertex(const P3* t) {
+  return same_point(t[0], t[1]) || same_point(t[1], t[2]) || same_point(t[2], t[0]);
+}
+
 inline bool shared_vertex(const P3* A, const P3* B) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -346,6 +353,9 @@ Verdict decide_exact(const P3* A, const P3* B, TrianglePredicateStats& st) {
   if (da[0] == 0 || da[1] == 0 || da[2] == 0) {
     const Verdict v = touching_special_cases<true>(A, B, st);
     if (v != Verdict::Open) return v;
+    // All three open is what a degenerate B gives (every sign exactly 0): a repeated vertex shows it
+    // without resolving them.
+    if (da[0] == 0 && da[1] == 0 && da[2] == 0 && repeated_vertex(B)) return Verdict::Unsure;
     for (int i = 0; i < 3; ++i)
       if (da[i] == 0 && (da[i] = resolve(pb, A[i], st)) == kUnsupported) return Verdict::Unsure;
   }
