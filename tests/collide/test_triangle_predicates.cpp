@@ -217,6 +217,12 @@ const Known kKnown[] = {
      {Vec3(1, 1, 2), Vec3(2, 1, 3), Vec3(1, 2, 3)}, true, kExactStage},
     {"tilted plane, sharing an edge", {Vec3(0, 0, 0), Vec3(4, 1, 5), Vec3(1, 4, 5)},
      {Vec3(4, 1, 5), Vec3(1, 4, 5), Vec3(4, 4, 8)}, true, kFilters},
+    // Coplanar in the vertical plane y = 3x with B a sliver whose differences round: B's rounded
+    // normal has its largest component in z (2.7e11), where the exact one is 0. The projection must
+    // take the exact check and fall back to the next axis, not hand the pair to CGAL.
+    {"vertical plane, rounded normal points the wrong way",
+     {Vec3(0x1p45 + 1, 3 * (0x1p45 + 1), 0), Vec3(0x3p-8, 0x9p-8, 0), Vec3(0x1p44 + 5, 3 * (0x1p44 + 5), 0x1p-10)},
+     {Vec3(0x1p44, 0x3p44, -1), Vec3(0x1p44, 0x3p44, 1), Vec3(1, 3, 0)}, true, kExactStage},
     // A vertex or an edge on the other's plane, outside the other triangle (boxes overlap).
     {"vertex on plane, outside", kUnit, {Vec3(0.75, 0.75, 0), Vec3(0, 0, 1), Vec3(1, 0, 1)}, false, kExactStage},
     {"edge in plane, outside", kUnit, {Vec3(0.75, 0.75, 0), Vec3(1, 0.25, 0), Vec3(0, 0, 1)}, false, kNoCgal},
