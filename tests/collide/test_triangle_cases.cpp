@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include <functional>
 #include <utility>
 
 namespace cadclash::test {
@@ -339,6 +340,71 @@ TriPair tiny_huge(Rng& rng) {
   return p;
 }
 
+// Exact contacts in planes whose exact orientation signs need the expansion arithmetic: (i) a wide
+// lattice (plane spanned by integer vectors of up to 2^10, coordinates up to ~2^24: exact differences
+// of more than 16 bits), (ii) a plane a x + z = c (a small integer, x and c on a 2^-7 grid, so z is
+// exact) with y free over 2^-20..2^30 with full mantissas (differences rounded), axes permuted. B is
+// coplanar with A, has one vertex on A's plane (the others on one side or across) or an edge in it.
+TriPair wide_coplanar(Rng& rng) {
+  TriPair p;
+  // point(i, j): a point of A's plane; off(pt, k): pt moved k steps off the plane.
+  std::function<Vec3()> in_plane;
+  std::function<Vec3(const Vec3&, int)> off;
+  Vec3 u, v, n, o;
+  int a_coef = 0;
+  double c = 0;
+  const bool lattice = rng.integer(0, 1);
+  if (lattice) {
+    do {
+      u = rng.ivec(-1024, 1024);
+      v = rng.ivec(-1024, 1024);
+      n = u.cross(v);
+    } while (n.squaredNorm() == 0);
+    o = rng.ivec(-(1 << 20), 1 << 20);
+    in_plane = [&] { return Vec3(o + rng.integer(-8, 8) * u + rng.integer(-8, 8) * v); };
+    off = [&](const Vec3& pt, int k) { return Vec3(pt + k * n + rng.integer(-8, 8) * u); };
+  } else {
+    a_coef = rng.integer(-3, 3);
+    c = rng.integer(-4096, 4096) * 0x1p-7;
+    in_plane = [&] {
+      const double x = rng.integer(-1024, 1024) * 0x1p-7;
+      const double y = rng.uniform(-1, 1) * std::ldexp(1.0, rng.integer(-20, 30));
+      return Vec3(x, y, c - a_coef * x);
+    };
+    // Along the normal (a, 0, 1): a x' + z' = c + (a^2 + 1) t, exact on the 2^-7 grid.
+    off = [&](const Vec3& pt, int k) {
+      const double t = k * 0x1p-5;
+      return Vec3(pt.x() + a_coef * t, pt.y(), pt.z() + t);
+    };
+  }
+  p.a = {in_plane(), in_plane(), in_plane()};
+  const int side = rng.integer(0, 1) ? 1 : -1;
+  switch (rng.integer(0, 3)) {
+    case 0:  // coplanar
+      p.b = {in_plane(), in_plane(), in_plane()};
+      break;
+    case 1: {  // one vertex on the plane, the others on one side
+      const Vec3 t = in_plane();
+      p.b = {t, off(in_plane(), side * rng.integer(1, 3)), off(in_plane(), side * rng.integer(1, 3))};
+      break;
+    }
+    case 2: {  // one vertex on the plane, the others across it
+      const Vec3 t = in_plane();
+      p.b = {t, off(in_plane(), side * rng.integer(1, 3)), off(in_plane(), -side * rng.integer(1, 3))};
+      break;
+    }
+    default:  // an edge in the plane
+      p.b = {in_plane(), in_plane(), off(in_plane(), side * rng.integer(1, 3))};
+      break;
+  }
+  if (!lattice) {  // a plane along any axis, not only y
+    const int r = rng.integer(0, 2);
+    for (Tri* tri : {&p.a, &p.b})
+      for (Vec3& x : *tri) x = Vec3(x[r], x[(r + 1) % 3], x[(r + 2) % 3]);
+  }
+  return p;
+}
+
 }  // namespace
 
 std::string_view family_name(Family f) {
@@ -357,6 +423,7 @@ std::string_view family_name(Family f) {
     case Family::NearlyCoplanar: return "nearly_coplanar";
     case Family::TJunction: return "t_junction";
     case Family::TinyHuge: return "tiny_huge";
+    case Family::WideCoplanar: return "wide_coplanar";
     case Family::kCount: break;
   }
   return "?";
@@ -406,6 +473,7 @@ TriPair make_case(Family f, Rng& rng) {
     case Family::NearlyCoplanar: p = nearly_coplanar(rng); break;
     case Family::TJunction: p = t_junction(rng); break;
     case Family::TinyHuge: p = tiny_huge(rng); break;
+    case Family::WideCoplanar: p = wide_coplanar(rng); break;
     case Family::kCount: break;
   }
   return shuffle(p, rng);
@@ -463,6 +531,20 @@ bool intersect_with(const Tri& ta, const Tri& tb) {
 }  // namespace
 
 bool oracle_intersect(const Tri& ta, const Tri& tb) { return intersect_with<EK>(ta, tb); }
+
+bool may_need_cgal(const Tri& a, const Tri& b) {
+  for (const Tri* t : {&a, &b}) {
+    for (const Vec3& v : *t)
+      for (int k = 0; k < 3; ++k) {
+        const double x = std::abs(v[k]);
+        if (x > 0x1p48 || (x != 0 && x < 0x1p-300)) return true;
+      }
+    const EK::Point_3 p((*t)[0].x(), (*t)[0].y(), (*t)[0].z()), q((*t)[1].x(), (*t)[1].y(), (*t)[1].z()),
+        r((*t)[2].x(), (*t)[2].y(), (*t)[2].z());
+    if (CGAL::collinear(p, q, r)) return true;
+  }
+  return false;
+}
 
 bool float_only_intersect(const Tri& ta, const Tri& tb, bool* failed) {
   if (failed) *failed = false;

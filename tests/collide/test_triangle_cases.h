@@ -67,6 +67,10 @@ enum class Family {
   NearlyCoplanar,  // B = a triangle in A's plane rotated by 1e-15..1e-6 rad about an in-plane axis
   TJunction,       // a vertex of B on the inside of an edge of A (exact, or rounded onto it), B coplanar or not
   TinyHuge,        // a triangle of 1e-9..1e-3 crossing, touching or just off a triangle of 1e2..1e6
+  // Exact contacts whose exact signs need the expansions, not the lattice fast path.
+  WideCoplanar,    // coplanar, vertex-on-plane and edge-in-plane pairs, exact in any plane: wide lattices
+                   // (differences of 20-30 bits) or planes along an axis with a free coordinate spread
+                   // over 2^-20..2^30 (differences that are not doubles)
   kCount
 };
 
@@ -81,6 +85,11 @@ TriPair rigid_motion(const TriPair& p, Rng& rng, double max_shift);
 
 // The oracle: exact intersection of the closed point sets with CGAL's Epeck (exact constructions).
 bool oracle_intersect(const Tri& a, const Tri& b);
+
+// True when triangles_intersect may hand (a, b) to CGAL (triangles_intersect_exact): one of them is
+// degenerate (collinear or repeated vertices, decided with Epeck), or a coordinate is beyond 2^48 in
+// magnitude, or nonzero and below 2^-300 (outside the exact stage's domain).
+bool may_need_cgal(const Tri& a, const Tri& b);
 
 // The float-only answer: the same closed-set decision (CGAL's Guigue–Devillers triangle test, the
 // algorithm triangles_intersect filters) evaluated in plain double (Simple_cartesian<double>), with
