@@ -48,7 +48,7 @@ struct Settings {
   int threads = 0;
   double scale_triangles = 10e6;
   std::uint32_t scale_min_instances = 1000;
-  int reps = 5;           // timed repetitions per row at most...
+  int reps = 15;          // timed repetitions per row at most...
   double rep_cap = 3.0;   // ...and no new one once a row has used this many seconds
 };
 

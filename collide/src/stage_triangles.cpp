@@ -19,6 +19,7 @@ namespace {
 // Work blocks of Version 2: this many of A's surviving triangles per item.
 constexpr std::size_t kV2Block = 64;
 constexpr std::ptrdiff_t kMinParallel = 4;
+constexpr std::ptrdiff_t kFewItems = 64;
 
 bool usable(const Model& m, const Task& t) {
   return m.surfaces[t.sa].has_triangles && m.surfaces[t.sb].has_triangles;
@@ -83,14 +84,15 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
             const std::function<void(std::size_t)>& after) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
   PairsThrough through(q, ntasks, [&](std::size_t k) { return q.tasks[k].pair; });
+  // Guided gives a thread half of the items at its first request: with a handful of items that is
+  // half the work on one thread (collide.h, Schedule), so a short loop takes them one at a time.
+  const bool few = n < kFewItems && q.o.schedule == Schedule::Guided;
 #pragma omp parallel num_threads(q.threads) if (n >= kMinParallel)
   {
     // One pair at a time per thread: its survivor lists reuse the thread's buffers, freed with them
     // when the stage ends.
     PreparedPair scratch;
-#pragma omp for schedule(runtime)
-    for (std::ptrdiff_t k = 0; k < n; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
+    auto one = [&](std::size_t ku) {
       if (q.deadline.expired()) {
         q.task_cut[ku] = 1;
       } else if (prepare(s, q, ku, bytes, /*one_run=*/true, scratch)) {
@@ -99,6 +101,13 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
       }
       if (after) after(ku);
       through.item_done(q.tasks[ku].pair);
+    };
+    if (few) {
+#pragma omp for schedule(dynamic, 1)
+      for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
+    } else {
+#pragma omp for schedule(runtime)
+      for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
     }
   }
   through.finish();
