@@ -128,8 +128,11 @@ struct DecideTask {
   InstanceId ia = kInvalidId, ib = kInvalidId;
   SurfaceId sa = kInvalidId, sb = kInvalidId;
   const PairOutcome* outcome = nullptr;  // null when a surface has no triangles: decided exactly
-  Pose t_ab = Pose::Identity(), t_ba = Pose::Identity();
+  const Pose* ab = nullptr;              // B's frame into A's (the instance pair's, which outlives the task)
+  const Pose* ba = nullptr;              // A's frame into B's
   double roundoff = 0.0;                 // pair_roundoff of the instance pair
+  const Pose& t_ab() const { return *ab; }
+  const Pose& t_ba() const { return *ba; }
 };
 
 struct DecideResult {

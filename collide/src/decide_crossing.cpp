@@ -257,9 +257,9 @@ void prove_against_plane(const Model& m, std::span<const double> eps, const Deci
   const Part& pb = m.parts[fb.surface.part];
   std::optional<Proof> proof;
   if (fa.surface.analytic.shape == SurfaceShape::Plane && other_ok(fb.surface))
-    proof = side(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba, t.t_ab, t.roundoff, p.threshold, c);
+    proof = side(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba(), t.t_ab(), t.roundoff, p.threshold, c);
   if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && other_ok(fa.surface))
-    proof = side(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab, t.t_ba, t.roundoff, p.threshold, c);
+    proof = side(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab(), t.t_ba(), t.roundoff, p.threshold, c);
   if (!proof || !(proof->hi <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, proof->hi);
   settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);

@@ -41,7 +41,7 @@ Interval finer_interval(std::span<const double> eps, const DecideTask& t, FaceVi
                         const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band) {
   band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
   const double reach = p.threshold + band;
-  out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab, t.t_ba, reach, o.clearance, c);
+  out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab(), t.t_ba(), reach, o.clearance, c);
   Interval d = mesh_interval(out, band, reach);
   if (!out.intersecting)
     d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, eps[t.sa], eps[t.sb], t, p.threshold));

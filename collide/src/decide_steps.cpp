@@ -45,7 +45,7 @@ Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask&
   p.band = p.mesh_band = a.deflection + b.deflection + t.roundoff;
   const double reach = p.threshold + p.band;
   if (t.outcome == nullptr) {  // no triangles on one side: only the boxes are known
-    p.d = {box_distance(own_box(a), transform_box(own_box(b), t.t_ab)), std::numeric_limits<double>::infinity()};
+    p.d = {box_distance(own_box(a), transform_box(own_box(b), t.t_ab())), std::numeric_limits<double>::infinity()};
     return p;
   }
   p.d = mesh_interval(*t.outcome, p.band, reach);
@@ -67,23 +67,23 @@ double analytic_bound(const Surface& a, const Surface& b, double eps_a, double e
   double lb = 0.0;
   // The two surfaces' parameters: where the faces can come within T of each other, both lie in A's
   // face box and in B's grown by T.
-  const Aabb box_b = transform_box(own_box(b), t.t_ab);
+  const Aabb box_b = transform_box(own_box(b), t.t_ab());
   const Aabb region = own_box(a).intersection(pad_box(box_b, threshold));
   if (region.isEmpty()) {
     lb = box_distance(own_box(a), box_b);  // the boxes enclose the exact faces
-  } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab), region)) {
+  } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab()), region)) {
     lb = std::max(lb, *g - eps_a - eps_b - r);
   }
   // The triangles' gap is searched up to twice what proving "apart" needs (farther triangles are
   // skipped and count as that reach), so a gap that proves it is never cut short.
   if (b.has_triangles) {
     const double reach = 2.0 * (threshold + b.deflection + r + eps_a);
-    if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab, own_box(a), reach))
+    if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab(), own_box(a), reach))
       lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps_a);
   }
   if (a.has_triangles) {
     const double reach = 2.0 * (threshold + a.deflection + r + eps_b);
-    if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba, own_box(b), reach))
+    if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba(), own_box(b), reach))
       lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps_b);
   }
   return lb;
@@ -102,7 +102,7 @@ double hull_bound(const Model& m, std::span<const double> eps, const DecideTask&
     const Surface& plane_face = m.surfaces[sp];
     const Part& part_q = m.parts[m.surfaces[sq].part];
     if (plane_face.analytic.shape != SurfaceShape::Plane || !part_q.source) continue;
-    const AnalyticSurface plane = transform_analytic(plane_face.analytic, side == 0 ? t.t_ba : t.t_ab);
+    const AnalyticSurface plane = transform_analytic(plane_face.analytic, side == 0 ? t.t_ba() : t.t_ab());
     const auto range = part_q.source->height_range(sq - part_q.first_surface, plane.origin, plane.axis.normalized());
     if (!range) continue;
     const double gap = (*range)[0] > 0.0 ? (*range)[0] : (*range)[1] < 0.0 ? -(*range)[1] : 0.0;
@@ -132,13 +132,13 @@ void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView
   const double r = t.roundoff;
   const Aabb box_a = own_box(a), box_b = own_box(b);
   // A's vertices on B's surface, in B's frame; then B's on A's, in A's frame.
-  const Aabb region_b = box_b.intersection(pad_box(transform_box(box_a, t.t_ba), p.threshold));
-  std::optional<double> g = analytic_witness(b.analytic, b.mesh, fb.bvh, *fb.outline, b.deflection, a.mesh, t.t_ba,
+  const Aabb region_b = box_b.intersection(pad_box(transform_box(box_a, t.t_ba()), p.threshold));
+  std::optional<double> g = analytic_witness(b.analytic, b.mesh, fb.bvh, *fb.outline, b.deflection, a.mesh, t.t_ba(),
                                              region_b, o.tolerance + eps[t.sb] - r, r);
   double own = eps[t.sa];
   if (!g) {
-    const Aabb region_a = box_a.intersection(pad_box(transform_box(box_b, t.t_ab), p.threshold));
-    g = analytic_witness(a.analytic, a.mesh, fa.bvh, *fa.outline, a.deflection, b.mesh, t.t_ab, region_a,
+    const Aabb region_a = box_a.intersection(pad_box(transform_box(box_b, t.t_ab()), p.threshold));
+    g = analytic_witness(a.analytic, a.mesh, fa.bvh, *fa.outline, a.deflection, b.mesh, t.t_ab(), region_a,
                          o.tolerance + eps[t.sa] - r, r);
     own = eps[t.sb];
   }
@@ -270,18 +270,18 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   std::vector<Candidate> cs;
   if (out->witness[0] != kInvalidId && out->witness[1] != kInvalidId) {
     for (std::uint32_t v : a.mesh.triangles[out->witness[0]]) {
-      const Vec3 w = t.t_ba * a.mesh.vertices[v];
+      const Vec3 w = t.t_ba() * a.mesh.vertices[v];
       if (const double d = point_mesh_distance(fb.bvh, b.mesh, w, limit_a); d <= limit_a) cs.push_back({d, true, w});
     }
     for (std::uint32_t v : b.mesh.triangles[out->witness[1]]) {
-      const Vec3 w = t.t_ab * b.mesh.vertices[v];
+      const Vec3 w = t.t_ab() * b.mesh.vertices[v];
       if (const double d = point_mesh_distance(fa.bvh, a.mesh, w, limit_b); d <= limit_b) cs.push_back({d, false, w});
     }
     if (try_in_order(cs, fa, fb, proves)) return;
     cs.clear();
   }
-  near_vertices(a, t.t_ba, fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
-  near_vertices(b, t.t_ab, fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
+  near_vertices(a, t.t_ba(), fb, pad_box(own_box(b), limit_a), limit_a, true, cs);
+  near_vertices(b, t.t_ab(), fa, pad_box(own_box(a), limit_b), limit_b, false, cs);
   try_in_order(cs, fa, fb, proves);
 }
 
@@ -330,15 +330,15 @@ void edge_witness_step(const Model& m, std::span<const Pose> poses, const Decide
   if (!pa.source || !pb.source || fa.outline == nullptr || fb.outline == nullptr) return;  // closed faces: no outline
   // Both in A's frame: A's outline near B, and B's near A.
   const double reach = p.threshold + p.band;
-  const auto sa = outline_near(*fa.outline, Pose::Identity(), pad_box(transform_box(own_box(fb.surface), t.t_ab), reach));
-  const auto sb = outline_near(*fb.outline, t.t_ab, pad_box(own_box(fa.surface), reach));
+  const auto sa = outline_near(*fa.outline, Pose::Identity(), pad_box(transform_box(own_box(fb.surface), t.t_ab()), reach));
+  const auto sb = outline_near(*fb.outline, t.t_ab(), pad_box(own_box(fa.surface), reach));
   if (sa.empty() || sb.empty() || sa.size() * sb.size() > kMaxOutlinePairs) return;
   Closest best;
   vertices_against_segments(sa, sb, true, best);
   vertices_against_segments(sb, sa, false, best);
   ++c.witness_queries;
   const std::optional<double> d = pa.source->edge_distance(t.sa - pa.first_surface, poses[t.ia], *pb.source,
-                                                           t.sb - pb.first_surface, poses[t.ib], best.a, t.t_ba * best.b);
+                                                           t.sb - pb.first_surface, poses[t.ib], best.a, t.t_ba() * best.b);
   if (!d || !(*d + t.roundoff <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, *d + t.roundoff);
   settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);

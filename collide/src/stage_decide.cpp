@@ -297,7 +297,7 @@ void start_results(QueryState& q) {
 DecideTask decide_task(const QueryState& q, std::size_t k, const PairOutcome* outcome) {
   const Task& t = q.tasks[k];
   const InstancePair& ip = q.pairs[t.pair];
-  return {ip.a, ip.b, t.sa, t.sb, outcome, ip.t_ab, ip.t_ba, ip.roundoff};
+  return {ip.a, ip.b, t.sa, t.sb, outcome, &ip.t_ab, &ip.t_ba, ip.roundoff};
 }
 
 bool usable(const Model& model, const Task& t) {
