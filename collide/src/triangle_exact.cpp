@@ -1,7 +1,9 @@
-// The exact triangle–triangle decision: CGAL's filtered exact predicates (EPICK), which the float
-// filter of triangle_intersect.cpp falls back to. Kept in its own object library because CGAL needs
+// The exact triangle–triangle decision for degenerate triangles (CGAL's filtered exact predicates,
+// EPICK), which triangle_intersect.cpp falls back to, and the exact orientation signs its own
+// decision asks for (exact_orient.h). Kept in its own object library because CGAL needs
 // -frounding-math, which would slow down the rest of the collide module.
 #include "cadclash/geometry.h"
+#include "exact_orient.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Intersections_3/Point_3_Segment_3.h>
@@ -97,3 +99,17 @@ bool triangles_intersect_exact(const Vec3& a0, const Vec3& a1, const Vec3& a2,
 }
 
 }  // namespace cadclash
+
+namespace cadclash::exact {
+
+int orient3d_sign(const Pt3& p, const Pt3& q, const Pt3& r, const Pt3& s) {
+  using P = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  return static_cast<int>(CGAL::orientation(P(p.x, p.y, p.z), P(q.x, q.y, q.z), P(r.x, r.y, r.z), P(s.x, s.y, s.z)));
+}
+
+int orient2d_sign(const Pt2& a, const Pt2& b, const Pt2& c) {
+  using P = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
+  return static_cast<int>(CGAL::orientation(P(a.x, a.y), P(b.x, b.y), P(c.x, c.y)));
+}
+
+}  // namespace cadclash::exact

@@ -1,23 +1,20 @@
 // triangles_intersect: Guigue–Devillers ("Fast and robust triangle-triangle overlap test using
 // orientation predicates", JGT 2003) with every orientation sign made exact by stages:
 //   1. double, with a static error bound (below): certifies the sign of almost every generic call;
-//   2. for a sign it leaves open, the exact lattice fast path (exact_orient.cpp: when the coordinate
-//      differences are exact and lie on a common grid of at most 16 bits, the plain double
-//      evaluation has no rounding; cheap, and it settles the exact zeros of lattice contacts);
-//   3. long double, the same evaluation and bound with u = 2^-64 (side_extended);
-//   4. exact: exact::orient3d_expansion_sign (exact_orient.cpp), expansion arithmetic on the same
-//      doubles, which also gives the exact zeros of coplanar and touching configurations.
-// 2D signs (coplanar pairs) go double filter -> exact::orient2d_exact_sign. Before any open 3D sign is
+//   2. for a sign it leaves open, CGAL's filtered orientation (exact_orient.h: interval arithmetic,
+//      then exact arithmetic where the interval contains 0), which also gives the exact zeros of
+//      coplanar and touching configurations.
+// 2D signs (coplanar pairs) go double filter -> exact::orient2d_sign. Before any open 3D sign is
 // resolved, two cheap special cases settle the call: a shared vertex (the closed triangles meet
 // there; a shared edge is two shared vertices) and both triangles in one coordinate plane (a z = c
 // contact; the 2D test below). With exact signs, zeros included, the degenerate configurations are
 // decided here too: exactly coplanar triangles in any plane by a 2D closed-triangle test, vertices on
-// the other plane by CGAL's own case analysis. What still goes to triangles_intersect_exact (CGAL, the
-// "exact fallback"): degenerate triangles (collinear or repeated vertices), coordinates beyond 2^48,
-// and nonzero coordinates below 2^-300 in a sign the float stages cannot settle (outside
-// exact_orient's domain). The float-only benchmark mode (testing::set_float_only_for_benchmark) runs
-// stages 1 and 3 and the special cases only, exactly as before the exact stage: whatever they leave
-// open is answered "intersect" and counted in exact_fallbacks, with no exact arithmetic.
+// the other plane by CGAL's own case analysis. What still goes to triangles_intersect_exact (CGAL's
+// do_intersect, the "exact fallback"): degenerate triangles (collinear or repeated vertices) and
+// coordinates beyond 2^48 (the static bound's range). The float-only benchmark mode
+// (testing::set_float_only_for_benchmark) runs stage 1, a long-double stage with the same bound and
+// the special cases only: whatever they leave open is answered "intersect" and counted in
+// exact_fallbacks, with no exact arithmetic.
 //
 // Decision (exact signs; A = (a0, a1, a2) is CGAL's t1 and B its t2, the oracle's order):
 //  - da_i = orientation(b0, b1, b2, a_i). All three strictly of one sign: A lies in an open half-
@@ -58,19 +55,6 @@
 // that underflows adds at most 2^-1075 absolute error, magnified by at most 2^49 by the following
 // product; the total absolute error from underflow is below 2^-1020 and the floor 2^-1000 (plus
 // the u·P spare) covers it. A certified sign is never zero.
-//
-// Why stages 2 and 4 are exact: they do not bound an error, they have none. Stage 2 evaluates the
-// determinant in plain double only when every difference is exact and a multiple of 2^g below
-// 2^(g+16): every product and sum then has at most 51 significant bits on a grid of at least
-// 2^-1056, so no operation rounds. Stage 4 splits each coordinate difference into two doubles whose
-// sum is exactly the difference (Two-Diff), each product of doubles into two doubles whose sum is
-// exactly the product (Dekker's Two-Product with Veltkamp's split; FMA is not used and not
-// contracted), and adds the resulting doubles with Two-Sum, which is exact, into a nonoverlapping
-// expansion: a list of doubles whose exact sum is the determinant and whose largest component has its
-// sign (0 iff the list is empty). These transformations are exact when no intermediate result
-// overflows or is rounded in the subnormal range; the domain (every coordinate 0 or
-// 2^-300 <= |x| <= 2^48) guarantees both, because every intermediate value is then a multiple of
-// 2^-1056 below 2^155. The full argument is at the top of exact_orient.cpp.
 #include "cadclash/geometry.h"
 #include "cadclash/testing/benchmark_switches.h"
 #include "exact_orient.h"
@@ -94,8 +78,6 @@ using P2 = exact::Pt2;
 constexpr double kOrientBound = 9.0 * 0x1p-53;
 constexpr double kAbsFloor = 0x1p-1000;
 constexpr double kMaxCoord = 0x1p48;
-static_assert(kMaxCoord <= exact::kExactMaxCoord, "the exact stage must cover the filters' range");
-constexpr int kUnsupported = exact::kUnsupported;
 
 inline P3 load(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
@@ -121,11 +103,10 @@ inline Plane make_plane(const P3& p, const P3& q, const P3& r) {
           std::abs(axby) + std::abs(aybx)};
 }
 
-// Second stage, for the few signs the double filter leaves open (nearly coplanar points, e.g. a
-// coplanar contact after a rotation rounded the coordinates): the same evaluation and the same
-// bound in long double, where that is an IEEE format with more precision (x87 extended: u = 2^-64,
-// so it certifies determinants 2^11 times smaller). The derivation above holds for any unit
-// roundoff u; the floor 2^-1000 still covers underflow. Exact zeros go on to the exact stage.
+// The float-only benchmark mode's second stage, for the signs the double filter leaves open: the
+// same evaluation and the same bound in long double, where that is an IEEE format with more precision
+// (x87 extended: u = 2^-64, so it certifies determinants 2^11 times smaller). The derivation above
+// holds for any unit roundoff u; the floor 2^-1000 still covers underflow.
 [[gnu::noinline]] int side_extended(const P3& p, const P3& q, const P3& r, const P3& s) {
   using L = long double;
   if constexpr (!std::numeric_limits<L>::is_iec559 || std::numeric_limits<L>::digits <= 53) {
@@ -164,25 +145,13 @@ inline int side_float(const Plane& pl, const P3& s, TrianglePredicateStats& st) 
   return side_extended(*pl.p, *pl.q, *pl.r, s);
 }
 
-// The exact sign of a sign the double stage left open: the exact lattice fast path (exact
-// differences on a common grid of at most 16 bits, where the plain double evaluation is exact:
-// cheaper than long double, and it settles the exact zeros of lattice contacts), long double, then
-// the exact expansion. -1, 0, +1, or kUnsupported (a coordinate outside exact_orient's domain that
-// long double cannot settle either: the call goes to CGAL).
+// The exact sign (-1, 0, +1) of a sign the double stage left open.
 [[gnu::noinline]] int resolve(const Plane& pl, const P3& s, TrianglePredicateStats& st) {
-  const int fast = exact::orient3d_fast_sign(*pl.p, *pl.q, *pl.r, s);
-  if (fast != exact::kNoFastPath && fast != kUnsupported) {
-    ++st.exact_signs;
-    return fast;
-  }
-  ++st.extended_signs;
-  if (const int d = side_extended(*pl.p, *pl.q, *pl.r, s)) return d;
-  if (fast == kUnsupported) return kUnsupported;
   ++st.exact_signs;
-  return exact::orient3d_expansion_sign(*pl.p, *pl.q, *pl.r, s);
+  return exact::orient3d_sign(*pl.p, *pl.q, *pl.r, s);
 }
 
-// All stages: the exact sign of orientation(p, q, r, s), or kUnsupported.
+// Both stages: the exact sign of orientation(p, q, r, s).
 inline int orient_exact(const P3& p, const P3& q, const P3& r, const P3& s, TrianglePredicateStats& st) {
   const Plane pl = make_plane(p, q, r);
   if (const int d = side_double(pl, s)) return d;
@@ -233,14 +202,14 @@ inline int orient2_filter(const P2& a, const P2& b, const P2& c) {
   return (det > bound) - (det < -bound);
 }
 
-// kExact: the exact sign (or kUnsupported); otherwise the filter's (0: not certain).
+// kExact: the exact sign; otherwise the filter's (0: not certain).
 template <bool kExact>
 inline int orient2(const P2& a, const P2& b, const P2& c, TrianglePredicateStats& st) {
   const int d = orient2_filter(a, b, c);
   if constexpr (kExact) {
     if (d == 0) {
       ++st.exact_signs;
-      return exact::orient2d_exact_sign(a, b, c);
+      return exact::orient2d_sign(a, b, c);
     }
   }
   return d;
@@ -252,7 +221,7 @@ inline int orient2(const P2& a, const P2& b, const P2& c, TrianglePredicateStats
 // certainly separates, certainly does not (a vertex certainly inside), or leaves the call open.
 template <bool kExact>
 Verdict coplanar_2d(const P2* a, const P2* b, int oa, int ob, TrianglePredicateStats& st) {
-  if (oa == 0 || ob == 0 || oa == kUnsupported || ob == kUnsupported) return Verdict::Unsure;
+  if (oa == 0 || ob == 0) return Verdict::Unsure;
   bool open = false;
   for (int pass = 0; pass < 2; ++pass) {
     const P2* t = pass ? b : a;
@@ -263,9 +232,7 @@ Verdict coplanar_2d(const P2* a, const P2* b, int oa, int ob, TrianglePredicateS
       if constexpr (kExact) {
         int j = 0;
         for (; j < 3; ++j) {
-          const int d = orient2<true>(e0, e1, o[j], st);
-          if (d == kUnsupported) return Verdict::Unsure;
-          if (d * ot >= 0) break;  // o[j] on the line or inside: this edge does not separate
+          if (orient2<true>(e0, e1, o[j], st) * ot >= 0) break;  // o[j] on the line or inside: this edge does not separate
         }
         if (j == 3) return Verdict::Disjoint;
       } else {
@@ -335,7 +302,6 @@ template <bool kExact>
     const auto u = kCoord[(k + 1) % 3], w = kCoord[(k + 2) % 3];
     const P2 b2[3] = {{B[0].*u, B[0].*w}, {B[1].*u, B[1].*w}, {B[2].*u, B[2].*w}};
     const int ob = orient2<true>(b2[0], b2[1], b2[2], st);
-    if (ob == kUnsupported) return Verdict::Unsure;
     if (ob == 0) continue;  // B's plane is parallel to axis k (or B is degenerate)
     const P2 a2[3] = {{A[0].*u, A[0].*w}, {A[1].*u, A[1].*w}, {A[2].*u, A[2].*w}};
     const int oa = orient2<true>(a2[0], a2[1], a2[2], st);
@@ -344,8 +310,7 @@ template <bool kExact>
   return Verdict::Unsure;  // B's normal is exactly 0: B is degenerate
 }
 
-// The exact decision (see the top of the file); Unsure only for degenerate triangles and
-// coordinates outside exact_orient's domain.
+// The exact decision (see the top of the file); Unsure only for degenerate triangles.
 Verdict decide_exact(const P3* A, const P3* B, TrianglePredicateStats& st) {
   // Signs of A's vertices relative to B's plane (orientation(b0, b1, b2, a_i)), then the reverse.
   const Plane pb = make_plane(B[0], B[1], B[2]);
@@ -357,14 +322,14 @@ Verdict decide_exact(const P3* A, const P3* B, TrianglePredicateStats& st) {
     // without resolving them.
     if (da[0] == 0 && da[1] == 0 && da[2] == 0 && repeated_vertex(B)) return Verdict::Unsure;
     for (int i = 0; i < 3; ++i)
-      if (da[i] == 0 && (da[i] = resolve(pb, A[i], st)) == kUnsupported) return Verdict::Unsure;
+      if (da[i] == 0) da[i] = resolve(pb, A[i], st);
   }
   if (da[0] == da[1] && da[1] == da[2]) return da[0] != 0 ? Verdict::Disjoint : coplanar_any_plane(A, B, pb, st);
 
   const Plane pa = make_plane(A[0], A[1], A[2]);
   int db[3] = {side_double(pa, B[0]), side_double(pa, B[1]), side_double(pa, B[2])};
   for (int i = 0; i < 3; ++i)
-    if (db[i] == 0 && (db[i] = resolve(pa, B[i], st)) == kUnsupported) return Verdict::Unsure;
+    if (db[i] == 0) db[i] = resolve(pa, B[i], st);
   if (db[0] == db[1] && db[1] == db[2]) return db[0] != 0 ? Verdict::Disjoint : Verdict::Unsure;  // 0: A degenerate
 
   const Arranged s1 = arrange(A, da);
@@ -373,10 +338,8 @@ Verdict decide_exact(const P3* A, const P3* B, TrianglePredicateStats& st) {
   // The segments in which each triangle meets the other's plane overlap iff both hold (CGAL's
   // non-strict tests: a zero is a touching contact).
   const int o1 = orient_exact(*s1.smin, *s1.tmin, *s2.smin, *s2.tmin, st);
-  if (o1 == kUnsupported) return Verdict::Unsure;
   if (o1 > 0) return Verdict::Disjoint;
   const int o2 = orient_exact(*s1.smax, *s1.tmax, *s2.tmax, *s2.smax, st);
-  if (o2 == kUnsupported) return Verdict::Unsure;
   if (o2 > 0) return Verdict::Disjoint;
   return Verdict::Intersect;
 }

@@ -5,20 +5,16 @@
 //
 // triangles_intersect is exact: its answer equals what exact arithmetic on the given doubles decides.
 // It is a Guigue–Devillers test whose every orientation sign is staged: a double filter with a proven
-// error bound, then the same bound in long double, then (only for the signs both leave open) an
-// exact sign by expansion arithmetic on the same doubles (Two-Sum, Dekker's Two-Product; zeros
-// included). With exact signs the touching configurations are decided in the test itself: exactly
-// coplanar triangles in any plane (a closed 2D overlap test after projecting along an axis the plane
-// is not parallel to), vertices or edges on the other triangle's plane (CGAL's own case analysis,
-// mirrored), shared vertices and edges (answered on sight). Only degenerate triangles (collinear or
-// repeated vertices) and coordinates beyond 2^48 in magnitude (or nonzero below 2^-300, where an
-// exact sign is needed) still go to CGAL's exact predicates (`exact_fallbacks`). On the test
-// families (tests/collide/test_triangle_predicates.cpp, which checks that every CGAL call has a
-// degenerate triangle or an out-of-range coordinate): CGAL calls are 0 on random, far-offset, sliver,
-// nearly coplanar and tiny-against-huge pairs, under 1% on shared-feature, touching, T-junction and
-// offset pairs, 2-5% on coplanar lattices and 1-ulp perturbations (collinear lattice points the
-// generators draw) and 11% on the degenerate family (45-65% of the touching families went to CGAL
-// before the exact stage).
+// error bound, then (only for the signs it leaves open) CGAL's filtered exact orientation (interval
+// arithmetic, then exact arithmetic; zeros included). With exact signs the touching configurations
+// are decided in the test itself: exactly coplanar triangles in any plane (a closed 2D overlap test
+// after projecting along an axis the plane is not parallel to), vertices or edges on the other
+// triangle's plane (CGAL's own case analysis, mirrored), shared vertices and edges (answered on
+// sight). Only degenerate triangles (collinear or repeated vertices) and coordinates beyond 2^48 in
+// magnitude still go to CGAL's whole-call do_intersect (`exact_fallbacks`): none on as1, and on the
+// test families (tests/collide/test_triangle_predicates.cpp, which checks that every such call has
+// a degenerate triangle or an out-of-range coordinate) only the collinear lattice points the
+// generators draw (45-65% of the touching families' calls went there before the exact signs).
 // The distance functions are plain double precision (see triangle_distance for the accuracy).
 // The box helpers pad for rounding where they say so, so culling with them never drops what exact
 // arithmetic would keep. All functions are pure and thread-safe (a stats object is the caller's).
@@ -44,9 +40,10 @@ struct TrianglePredicateStats {
                                       // benchmark): calls the double / long-double filters and the
                                       // shared-vertex / coordinate-plane cases leave open, answered
                                       // "intersect" with no exact work at all (no exact stage, no CGAL)
-  std::uint64_t extended_signs = 0;   // orientation signs the double filter left to long double
-  std::uint64_t exact_signs = 0;      // orientation signs (3D or 2D) neither float filter certified,
-                                      // settled by the exact expansion stage (zeros included)
+  std::uint64_t extended_signs = 0;   // float-only mode: orientation signs the double filter left to
+                                      // long double
+  std::uint64_t exact_signs = 0;      // orientation signs (3D or 2D) the double filter left open,
+                                      // settled by the exact stage (zeros included)
 };
 
 // True iff the closed triangles (a0,a1,a2) and (b0,b1,b2) share at least one point, exactly as exact
