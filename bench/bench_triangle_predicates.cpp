@@ -1,7 +1,7 @@
 // Speed of the triangle predicates on the test generators' families. Each benchmark loops over a
 // fixed set of 4096 pairs; items/s is pairs per second, `fallback` the share of calls sent to CGAL
-// (triangles_intersect_exact), `exact_signs` the orientation signs settled by the exact expansion
-// stage per call (both per pass over the set, so independent of the iteration count).
+// (triangles_intersect_exact), `exact_signs` the orientation signs settled by the exact stage (CGAL's
+// filtered orientation) per call (both per pass over the set, so independent of the iteration count).
 //   build-rel/bench/bench_triangle_predicates --benchmark_min_time=0.2
 #include "test_triangle_cases.h"
 #include "cadclash/geometry.h"
@@ -57,7 +57,7 @@ void run(benchmark::State& state, const std::vector<TriPair>& pairs, F&& f) {
   benchmark::DoNotOptimize(hits);
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * pairs.size()));
   if (stats.tests) {
-    // Share of calls decided by CGAL, and exact orientation signs (expansion stage) per call.
+    // Share of calls decided by CGAL, and exact orientation signs (exact stage) per call.
     state.counters["fallback"] = double(stats.exact_fallbacks) / double(stats.tests);
     state.counters["exact_signs"] = double(stats.exact_signs) / double(stats.tests);
   }
