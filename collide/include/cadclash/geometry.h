@@ -5,8 +5,8 @@
 //
 // triangles_intersect is exact: its answer equals what exact arithmetic on the given doubles decides.
 // It is a Guigue–Devillers test whose every orientation sign is staged: a double filter with a proven
-// error bound, then (only for the signs it leaves open) CGAL's filtered exact orientation (interval
-// arithmetic, then exact arithmetic; zeros included). With exact signs the touching configurations
+// error bound, then the same bound in long double, then (only for the signs both leave open) CGAL's
+// filtered exact orientation (interval arithmetic, then exact arithmetic; zeros included). With exact signs the touching configurations
 // are decided in the test itself: exactly coplanar triangles in any plane (a closed 2D overlap test
 // after projecting along an axis the plane is not parallel to), vertices or edges on the other
 // triangle's plane (CGAL's own case analysis, mirrored), shared vertices and edges (answered on
@@ -40,9 +40,8 @@ struct TrianglePredicateStats {
                                       // benchmark): calls the double / long-double filters and the
                                       // shared-vertex / coordinate-plane cases leave open, answered
                                       // "intersect" with no exact work at all (no exact stage, no CGAL)
-  std::uint64_t extended_signs = 0;   // float-only mode: orientation signs the double filter left to
-                                      // long double
-  std::uint64_t exact_signs = 0;      // orientation signs (3D or 2D) the double filter left open,
+  std::uint64_t extended_signs = 0;   // orientation signs the double filter left to long double
+  std::uint64_t exact_signs = 0;      // orientation signs (3D or 2D) the float filters left open,
                                       // settled by the exact stage (zeros included)
 };
 
