@@ -335,14 +335,11 @@ void conclude(QueryState& q, std::vector<DecideResult>& results, const std::vect
   }
 }
 
-}  // namespace
-
-void decision_stage(SceneData& s, QueryState& q) {
-  const Model& model = s.model;
+// The per-pair results' state for stage 5, with the pairs of tasks the deadline cut marked cut and
+// those with intersecting triangles marked intersecting: the tasks to decide, ascending.
+std::vector<std::size_t> tasks_to_decide(const Model& model, QueryState& q) {
   start_results(q);
-  std::vector<DecideTask> decide;
-  std::vector<std::size_t> task_of;  // decide[i] is task task_of[i]
-  decide.reserve(q.first_task[q.cutoff]);
+  std::vector<std::size_t> task_of;
   task_of.reserve(q.first_task[q.cutoff]);
   for (std::size_t k = 0; k < q.first_task[q.cutoff]; ++k) {
     const Task& t = q.tasks[k];
@@ -350,11 +347,20 @@ void decision_stage(SceneData& s, QueryState& q) {
       q.pair_cut[t.pair] = 1;
       continue;
     }
-    const bool meshed = usable(model, t);
-    if (meshed && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
-    decide.push_back(decide_task(q, k, meshed ? &q.outcomes[k] : nullptr));
+    if (usable(model, t) && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
     task_of.push_back(k);
   }
+  return task_of;
+}
+
+}  // namespace
+
+void decision_stage(SceneData& s, QueryState& q) {
+  const Model& model = s.model;
+  const std::vector<std::size_t> task_of = tasks_to_decide(model, q);  // decide[i] is task task_of[i]
+  std::vector<DecideTask> decide;
+  decide.reserve(task_of.size());
+  for (std::size_t k : task_of) decide.push_back(decide_task(q, k, usable(model, q.tasks[k]) ? &q.outcomes[k] : nullptr));
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
   std::vector<DecideResult> results =
       decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
@@ -385,18 +391,7 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
     run.early(k);
   });
   assert(q.first_task[q.cutoff] == ntasks);
-  start_results(q);
-  std::vector<std::size_t> task_of;  // the tasks decide_pairs would have been given
-  task_of.reserve(ntasks);
-  for (std::size_t k = 0; k < ntasks; ++k) {
-    const Task& t = q.tasks[k];
-    if (q.task_cut[k]) {
-      q.pair_cut[t.pair] = 1;
-      continue;
-    }
-    if (decide[k].outcome != nullptr && q.outcomes[k].intersecting) q.pair_intersects[t.pair] = 1;
-    task_of.push_back(k);
-  }
+  const std::vector<std::size_t> task_of = tasks_to_decide(model, q);  // what decide_pairs would be given
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
   std::vector<DecideResult> all = run.finish(q.report.counters);  // every task's, task_of's among them
   conclude(q, all, task_of, /*by_task=*/true, meter);
