@@ -269,6 +269,9 @@ struct WorkloadResult {
   std::string subset_note;  // what that is, in words
   std::vector<Row> rows;
   std::size_t instance_triangles = 0, part_triangles = 0;
+  // Core-to-core round trip (ns) before the first row and after the last: where the host had the
+  // two vCPUs while this table ran (compare_workload.h).
+  double round_trip_before = 0.0, round_trip_after = 0.0;
 };
 
 void finish(WorkloadResult& r) {
@@ -334,6 +337,12 @@ std::string markdown(const std::vector<WorkloadResult>& results, const Settings&
      << "[subset] rows ran on the instances named under the table.\n\n";
   for (const WorkloadResult& r : results) {
     md << "## " << r.w.name << "\n\n" << r.description << "\n\n";
+    if (r.round_trip_before > 0.0)
+      md << "Core-to-core round trip " << fmt("%.0f", r.round_trip_before) << " ns before the rows, "
+         << fmt("%.0f", r.round_trip_after) << " ns after (the vCPUs "
+         << (std::max(r.round_trip_before, r.round_trip_after) >= cb::kFarCoresNs ? "were far apart for part of it"
+                                                                                  : "were near each other")
+         << "; see the parallel-efficiency notes).\n\n";
     if (!r.subset_note.empty()) md << "[subset]: " << r.subset_note << "\n\n";
     md << "| method | median time | reps | ratio | triangle tests | exact fallbacks | surface pairs | agreement (both/only cadclash/only method) | build | bytes/triangle |\n"
        << "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
@@ -369,6 +378,7 @@ nlohmann::json json_of(const std::vector<WorkloadResult>& results, const Setting
   for (const WorkloadResult& r : results) {
     nlohmann::json w;
     w["name"] = r.w.name;
+    w["round_trip_ns"] = {r.round_trip_before, r.round_trip_after};
     w["description"] = r.description;
     w["deflection"] = r.w.deflection;
     w["instances"] = r.w.model->instances.size();
@@ -518,6 +528,7 @@ int main(int argc, char** argv) {
     WorkloadResult& r = results[k];
     r.instance_triangles = cb::instance_triangle_count(*r.w.model);
     r.part_triangles = cadclash::triangle_count(*r.w.model);
+    r.round_trip_before = cb::core_round_trip_ns();
     for (Method& m : methods_for(r.w, s.threads, r.subset, slow[k])) {
       Row row;
       row.method = std::move(m);
@@ -529,6 +540,7 @@ int main(int argc, char** argv) {
                    row.error.empty() ? "" : " not run: ", row.error.c_str());
       r.rows.push_back(std::move(row));
     }
+    r.round_trip_after = cb::core_round_trip_ns();
     finish(r);
   }
 

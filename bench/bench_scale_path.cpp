@@ -261,6 +261,7 @@ int main(int argc, char** argv) {
   }
   const InstanceId nut = path.moving.at(0);
   std::vector<PathRun> runs;
+  std::vector<double> turn_round_trip;  // ns, measured before each turn of kPathBlock steps
   {
     CollideOptions o1, o2;
     o1.threads = 1;
@@ -268,11 +269,28 @@ int main(int argc, char** argv) {
     PathRunner one(scene_model, nut, o1), two(scene_model, nut, o2);
     for (std::size_t b = 0; b < path.steps.size(); b += kPathBlock) {
       const std::size_t e = std::min(path.steps.size(), b + kPathBlock);
+      turn_round_trip.push_back(cb::core_round_trip_ns(2000));
       one.steps(path, b, e, 1);
       two.steps(path, b, e, 1);
     }
     runs.push_back(std::move(one.run));
     runs.push_back(std::move(two.run));
+  }
+  // The path's medians by where the host had put the two vCPUs during each turn (near: cores sharing
+  // a cache; far: across the package, every exchange between the threads ~6x dearer).
+  struct Placement {
+    const char* name;
+    std::vector<double> seconds[2], round_trip;
+  } placements[2] = {{"near", {}, {}}, {"far", {}, {}}};
+  for (std::size_t t = 0; t < turn_round_trip.size(); ++t) {
+    Placement& p = placements[turn_round_trip[t] >= cb::kFarCoresNs ? 1 : 0];
+    p.round_trip.push_back(turn_round_trip[t]);
+    for (int th = 0; th < 2; ++th) {
+      const auto& v = runs[static_cast<std::size_t>(th)].step_seconds;
+      const std::size_t b = t * kPathBlock, e = std::min(v.size(), b + kPathBlock);
+      p.seconds[th].insert(p.seconds[th].end(), v.begin() + static_cast<std::ptrdiff_t>(b),
+                           v.begin() + static_cast<std::ptrdiff_t>(e));
+    }
   }
   for (int threads : {1, 2}) {
     const PathRun& r = runs[static_cast<std::size_t>(threads - 1)];
@@ -306,6 +324,19 @@ int main(int argc, char** argv) {
                                  {"largest", 1.0}})
     line(std::string("| path step, ") + label + " | " + fmt("%.3f ms", 1e3 * percentile(runs[0].step_seconds, q)) +
          " | " + fmt("%.3f ms", 1e3 * percentile(runs[1].step_seconds, q)) + " |");
+  for (const Placement& p : placements) {
+    if (p.round_trip.empty()) continue;
+    const double m1 = percentile(p.seconds[0], 0.5), m2 = percentile(p.seconds[1], 0.5);
+    line(std::string("| path step, median in the turns with the vCPUs ") + p.name + " (" +
+         std::to_string(p.round_trip.size()) + " of " + std::to_string(turn_round_trip.size()) +
+         " turns, core-to-core round trip " + fmt("%.0f ns", percentile(p.round_trip, 0.5)) +
+         "; parallel efficiency " + fmt("%.0f %%", 100.0 * m1 / (2.0 * m2)) + ") | " + fmt("%.3f ms", 1e3 * m1) +
+         " | " + fmt("%.3f ms", 1e3 * m2) + " |");
+    j["path"]["placement"][p.name] = {{"turns", p.round_trip.size()},
+                                      {"round_trip_ns", percentile(p.round_trip, 0.5)},
+                                      {"median_ms_1", 1e3 * m1},
+                                      {"median_ms_2", 1e3 * m2}};
+  }
   line("| path: instance pairs / triangle tests over all steps | " + std::to_string(runs[0].counters.instance_pairs) +
        " / " + std::to_string(runs[0].counters.triangle_tests) + " | " + std::to_string(runs[1].counters.instance_pairs) +
        " / " + std::to_string(runs[1].counters.triangle_tests) + " |");

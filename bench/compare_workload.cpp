@@ -5,10 +5,13 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <omp.h>
 
 namespace cadclash::bench {
 namespace {
@@ -257,6 +260,34 @@ std::size_t instance_triangle_count(const Model& model) {
   std::size_t n = 0;
   for (const Instance& in : model.instances) n += per_part[in.part];
   return n;
+}
+
+double core_round_trip_ns(int trips) {
+  // On the OpenMP team's own two threads: a fresh thread would share a core with the team's worker
+  // while that still spins after a parallel region, and measure the time slice, not the cache.
+  alignas(64) std::atomic<long> turn{0};
+  double ns = 0.0;
+#pragma omp parallel num_threads(2)
+  {
+    if (omp_get_num_threads() == 2) {
+      if (omp_get_thread_num() == 1) {
+        for (long i = 0; i < trips; ++i) {
+          while (turn.load(std::memory_order_acquire) != 2 * i + 1) {
+          }
+          turn.store(2 * i + 2, std::memory_order_release);
+        }
+      } else {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (long i = 0; i < trips; ++i) {
+          turn.store(2 * i + 1, std::memory_order_release);
+          while (turn.load(std::memory_order_acquire) != 2 * i + 2) {
+          }
+        }
+        ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / trips;
+      }
+    }
+  }
+  return ns;
 }
 
 }  // namespace cadclash::bench

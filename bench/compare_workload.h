@@ -103,4 +103,14 @@ Model instanced_grid(const Model& base, std::uint32_t copies);
 // Triangles over all instances (a part's triangles counted once per instance).
 std::size_t instance_triangle_count(const Model& model);
 
+// Nanoseconds for one cache line to go from one thread to another and back (two threads taking
+// turns on one atomic; mean of `trips` round trips). On a VM the host may put the two vCPUs on
+// cores that share a cache or on cores far apart in the package: every exchange between threads
+// (a team's start and end, a dynamic loop's next item, results one thread wrote and another
+// reads) costs accordingly, so benchmarks report it beside parallel timings.
+double core_round_trip_ns(int trips = 20000);
+
+// Round trips above this are "far" cores: this 2-vCPU machine reads 50-130 ns or 330-480 ns.
+constexpr double kFarCoresNs = 200.0;
+
 }  // namespace cadclash::bench
