@@ -4,12 +4,14 @@
 #include "cadclash/tessellate.h"
 
 #include <TopoDS_Face.hxx>
+#include <BRepAdaptor_Surface.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
 #include <TopoDS_Edge.hxx>
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -25,6 +27,8 @@ namespace detail {
 // What a point query needs of one face, made once per face on first use: OCCT's classifier of its
 // parameter domain (a polygon of the boundary's pcurves, points nearer than the polygon's measured
 // deviation counting as on it) and its edges with their boxes.
+std::uint64_t next_source_id();  // brep_face_cache.h
+
 struct FaceLocator {
   // Perform() is const but not thread-safe: the classifier keeps its wires in NCollection_Sequence,
   // whose Value() moves a cached cursor. Every call holds domain_mutex.
@@ -55,6 +59,8 @@ struct BrepSource::Impl {
   mutable std::vector<std::unique_ptr<const detail::FaceLocator>> locators;
   mutable std::mutex locator_mutex;
   const detail::FaceLocator& locator(std::uint32_t local_index) const;
+  // Names this source in the witness queries' per-thread caches (brep_face_cache.h).
+  const std::uint64_t id = detail::next_source_id();
 };
 
 namespace detail {
@@ -106,8 +112,8 @@ void describe_face(const TopoDS_Face& face, Surface& out);
 // than the boundary polygon's measured deviation from it; otherwise the nearest point found on the
 // face's edge curves. The evaluation's rounding is added. nullopt when the face has no triangulation
 // with parameters or Newton fails. Reads the face only. May throw Standard_Failure.
-std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
-                                         const gp_Pnt& p);
+std::optional<double> face_point_witness(const BRepAdaptor_Surface& surface, const TopoDS_Face& face,
+                                         const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p);
 
 // An upper bound on the distance from `p` to the face's boundary: the nearest point found on its edge
 // curves (ShapeAnalysis_Curve, nearest edge box first), the evaluation's rounding added. May throw.
@@ -126,7 +132,8 @@ std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& 
 // The foot point of `p` on the face's surface by the same Newton, with the unit normal there and the
 // evaluation's rounding; not classified (it may lie outside the face). nullopt when Newton fails or
 // the surface is singular there. Reads the face only. May throw Standard_Failure.
-std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
+std::optional<SurfaceSource::SurfacePoint> face_surface_point(const BRepAdaptor_Surface& surface,
+                                                              const TopoDS_Face& face, const Aabb& face_box,
                                                               const gp_Pnt& p);
 
 // An upper bound on the distance between two placed faces realised by a point on an edge of each:

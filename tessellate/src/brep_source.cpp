@@ -1,4 +1,5 @@
 // BrepSource: the exact faces of one part, tessellated on demand and measured exactly.
+#include "brep_face_cache.h"
 #include "brep_internal.h"
 
 #include "cadclash/geometry.h"
@@ -88,7 +89,8 @@ std::optional<double> BrepSource::point_distance(std::uint32_t local_index, cons
   std::shared_lock<std::shared_mutex> lock(a.mutex);
   try {
     const gp_Pnt p(point.x(), point.y(), point.z());
-    if (auto near = detail::face_point_witness(a.faces[local_index], a.locator(local_index), a.boxes[local_index], p))
+    if (auto near = detail::face_point_witness(detail::face_surface(a, local_index), a.faces[local_index],
+                                               detail::face_locator(a, local_index), a.boxes[local_index], p))
       return near;
     const TopoDS_Vertex v = BRepBuilderAPI_MakeVertex(p);
     BRepExtrema_DistShapeShape dist(v, a.faces[local_index], Extrema_ExtFlag_MIN);
@@ -105,7 +107,8 @@ std::optional<SurfaceSource::SurfacePoint> BrepSource::surface_point(std::uint32
   assert(local_index < a.faces.size());
   std::shared_lock<std::shared_mutex> lock(a.mutex);
   try {
-    return detail::face_surface_point(a.faces[local_index], a.boxes[local_index], gp_Pnt(point.x(), point.y(), point.z()));
+    return detail::face_surface_point(detail::face_surface(a, local_index), a.faces[local_index], a.boxes[local_index],
+                                      gp_Pnt(point.x(), point.y(), point.z()));
   } catch (const Standard_Failure&) {
     return std::nullopt;
   }
@@ -129,7 +132,7 @@ std::optional<SurfaceSource::SurfacePoint> BrepSource::edge_support(std::uint32_
   assert(local_index < a.faces.size());
   std::shared_lock<std::shared_mutex> lock(a.mutex);
   try {
-    return detail::face_edge_support(a.locator(local_index), a.boxes[local_index], direction,
+    return detail::face_edge_support(detail::face_locator(a, local_index), a.boxes[local_index], direction,
                                      gp_Pnt(near.x(), near.y(), near.z()));
   } catch (const Standard_Failure&) {
     return std::nullopt;
@@ -141,7 +144,7 @@ std::optional<double> BrepSource::boundary_distance(std::uint32_t local_index, c
   assert(local_index < a.faces.size());
   std::shared_lock<std::shared_mutex> lock(a.mutex);
   try {
-    return detail::face_boundary_witness(a.locator(local_index), a.boxes[local_index],
+    return detail::face_boundary_witness(detail::face_locator(a, local_index), a.boxes[local_index],
                                          gp_Pnt(point.x(), point.y(), point.z()));
   } catch (const Standard_Failure&) {
     return std::nullopt;
@@ -158,8 +161,8 @@ std::optional<double> BrepSource::edge_distance(std::uint32_t local_a, const Pos
   assert(local_a < a.faces.size() && local_b < b.faces.size());
   const PairLock lock(a, b);
   try {
-    return detail::edge_pair_witness(a.locator(local_a), detail::to_trsf(pose_a), gp_Pnt(near_a.x(), near_a.y(), near_a.z()),
-                                     b.locator(local_b), detail::to_trsf(pose_b), gp_Pnt(near_b.x(), near_b.y(), near_b.z()));
+    return detail::edge_pair_witness(detail::face_locator(a, local_a), detail::to_trsf(pose_a), gp_Pnt(near_a.x(), near_a.y(), near_a.z()),
+                                     detail::face_locator(b, local_b), detail::to_trsf(pose_b), gp_Pnt(near_b.x(), near_b.y(), near_b.z()));
   } catch (const Standard_Failure&) {
     return std::nullopt;
   }

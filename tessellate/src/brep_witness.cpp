@@ -234,9 +234,8 @@ std::optional<Foot> newton_foot(const BRepAdaptor_Surface& surface, const TopoDS
 
 }  // namespace
 
-std::optional<double> face_point_witness(const TopoDS_Face& face, const FaceLocator& where, const Aabb& face_box,
-                                         const gp_Pnt& p) {
-  const BRepAdaptor_Surface surface(face, Standard_False);
+std::optional<double> face_point_witness(const BRepAdaptor_Surface& surface, const TopoDS_Face& face,
+                                         const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p) {
   const std::optional<Foot> f = newton_foot(surface, face, face_box, p);
   if (!f) return std::nullopt;
   // Parameters the classifier puts inside name a point of the face. A foot on or past the boundary
@@ -282,9 +281,9 @@ std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& 
   return out;
 }
 
-std::optional<SurfaceSource::SurfacePoint> face_surface_point(const TopoDS_Face& face, const Aabb& face_box,
+std::optional<SurfaceSource::SurfacePoint> face_surface_point(const BRepAdaptor_Surface& surface,
+                                                              const TopoDS_Face& face, const Aabb& face_box,
                                                               const gp_Pnt& p) {
-  const BRepAdaptor_Surface surface(face, Standard_False);
   // A plane's, cylinder's or sphere's foot point in closed form (ElSLib: the orthogonal projection,
   // as parameters of the face's own placed surface); other surfaces by Newton from the nearest node.
   // Either way the point used is S(u, v), a point of the surface.

@@ -87,6 +87,42 @@ TEST(SurfacePoint, FootAndNormalOnTheSurfaceAndBoundsOnTheEdges) {
   EXPECT_NEAR(*rim, std::sqrt(2.0), 1e-9);
 }
 
+// Each thread keeps the surface adaptor of every face it has queried (brep_face_cache.h): a face of
+// another source, or another face of the same one, never gets it, and neither does a source made
+// where a freed one was (same address, same face index, other surface).
+TEST(SurfacePoint, EachFaceOfEachSourceItsOwnSurfaceAcrossModels) {
+  auto side_of = [](const Model& m) {
+    std::uint32_t side = kInvalidId;
+    for (std::uint32_t i = 0; i < m.surfaces.size(); ++i)
+      if (m.surfaces[i].aabb.sizes().z() > 7.0) side = i;
+    return side;
+  };
+  auto foot_radius = [](const Model& m, std::uint32_t face) {
+    const auto* src = dynamic_cast<const BrepSource*>(m.parts[0].source.get());
+    const auto sp = src->surface_point(face, Vec3(9, 0, 4));
+    return sp ? std::hypot(sp->point.x(), sp->point.y()) : -1.0;
+  };
+  for (int round = 0; round < 3; ++round) {
+    const double r = 2.0 + round;
+    const Model thin = build({BRepPrimAPI_MakeCylinder(r, 8).Shape()}, 0.1);
+    const Model thick = build({BRepPrimAPI_MakeCylinder(r + 0.5, 8).Shape()}, 0.1);
+    const std::uint32_t side = side_of(thin);
+    ASSERT_NE(side, kInvalidId);
+    ASSERT_EQ(side, side_of(thick));
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(foot_radius(thin, side), r, 1e-9) << "round " << round;
+      EXPECT_NEAR(foot_radius(thick, side), r + 0.5, 1e-9) << "round " << round;
+    }
+    // A top or bottom cap (a plane z = 0 or 8) of the same source: its foot keeps x = 9.
+    const std::uint32_t cap = side == 0 ? 1 : 0;
+    const auto* src = dynamic_cast<const BrepSource*>(thin.parts[0].source.get());
+    const auto sp = src->surface_point(cap, Vec3(9, 0, 4));
+    ASSERT_TRUE(sp.has_value());
+    EXPECT_NEAR(sp->point.x(), 9.0, 1e-9);
+    EXPECT_NEAR(std::abs(sp->normal.z()), 1.0, 1e-9);
+  }
+}
+
 // Asks `src` for the foot on `face` of 96 points (24 angles round the seam, each at 4 offsets from
 // the surface: inside, on, just and well outside); at(k, angle, offset) gives a point and its exact
 // foot.
