@@ -82,6 +82,9 @@ struct QueryState {
   Report report;
 
   std::vector<InstancePair> pairs;
+  // Per part: SceneData::part_reach_share, worked out by the broad phase (OAABB only; else by the
+  // surface level) for the surface level too (no surface is tessellated between them).
+  std::vector<double> part_share;
   std::vector<Task> tasks;
   std::vector<std::size_t> first_task;  // tasks of pair k: [first_task[k], first_task[k+1])
   // The memory budget's ledger: per instance pair, the bytes it makes this query build. Each surface

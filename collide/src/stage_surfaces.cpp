@@ -30,7 +30,8 @@ bool worth_a_team(const SceneData& s, const std::vector<InstancePair>& pairs) {
   return comparisons >= kMinParallelComparisons;
 }
 
-void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o) {
+// `part_share`: SceneData::part_reach_share per part (QueryState::part_share, from the broad phase).
+void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share) {
   const Model& model = s.model;
   const Instance& ia = model.instances[ip.a];
   const Instance& ib = model.instances[ip.b];
@@ -53,8 +54,7 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
     c.surface_pairs += ip.candidates.size();
     return;
   }
-  const double tol_margin =
-      search_reach(o, s.part_reach_share(ia.part, o), s.part_reach_share(ib.part, o), ip.roundoff);
+  const double tol_margin = search_reach(o, part_share[ia.part], part_share[ib.part], ip.roundoff);
   // The OAABB in A's frame, then its single update into B's frame.
   const Aabb oaabb = pad_box(s.part_box[ia.part], tol_margin)
                          .intersection(transform_box(pad_box(s.part_box[ib.part], tol_margin), ip.t_ab));
@@ -73,18 +73,23 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
   }
   c.surfaces_a += surv_a.size();
   c.surfaces_b += surv_b.size();
+  // B's boxes in A's frame with their round-off pads, and each side's reach share, once per surface
+  // rather than once per comparison.
   std::vector<Aabb> box_b(surv_b.size());
+  std::vector<double> pad_b(surv_b.size()), share_b(surv_b.size());
   for (std::size_t k = 0; k < surv_b.size(); ++k) {
     box_b[k] = transform_box(s.surface_box(surv_b[k]), ip.t_ab);
     ++c.aabb_updates;
+    pad_b[k] = kRelativePad * (1.0 + box_magnitude(box_b[k]));
+    share_b[k] = s.reach_share(surv_b[k], o);
   }
   for (SurfaceId sa : surv_a) {
     const Aabb box_a = s.surface_box(sa);
+    const double share_a = s.reach_share(sa, o);
     for (std::size_t k = 0; k < surv_b.size(); ++k) {
-      const double m = search_reach(o, s.reach_share(sa, o), s.reach_share(surv_b[k], o), ip.roundoff);
+      const double m = search_reach(o, share_a, share_b[k], ip.roundoff);
       ++c.aabb_tests;
-      if (boxes_within(box_a, box_b[k], m + kRelativePad * (1.0 + box_magnitude(box_b[k]))))
-        ip.candidates.push_back({sa, surv_b[k]});
+      if (boxes_within(box_a, box_b[k], m + pad_b[k])) ip.candidates.push_back({sa, surv_b[k]});
     }
   }
   c.surface_pairs += ip.candidates.size();
@@ -97,11 +102,15 @@ void surface_level_stage(const SceneData& s, QueryState& q) {
   const auto npairs = static_cast<std::ptrdiff_t>(q.pairs.size());
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "surface level");
   const bool team = worth_a_team(s, q.pairs);
+  if (q.o.use_oaabb && q.part_share.size() != model.parts.size()) {  // check_part runs no broad phase
+    q.part_share.resize(model.parts.size());
+    for (PartId p = 0; p < model.parts.size(); ++p) q.part_share[p] = s.part_reach_share(p, q.o);
+  }
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (team)
   for (std::ptrdiff_t k = 0; k < npairs; ++k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
     if (q.deadline.expired()) ip.cut = true;
-    else surface_level(s, ip, q.o);
+    else surface_level(s, ip, q.o, q.part_share);
     meter.add();
   }
   meter.finish();
