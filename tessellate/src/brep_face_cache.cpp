@@ -10,22 +10,30 @@ namespace cadclash::detail {
 namespace {
 
 struct Entry {
+  std::weak_ptr<const char> alive;  // the source's (BrepSource::Impl::alive)
   std::optional<BRepAdaptor_Surface> surface;
   const FaceLocator* locator = nullptr;
 };
 
-// Bounds what a thread keeps (each entry holds its face's geometry alive): past this many faces the
-// cache starts again. A check meets a few hundred faces at most per thread.
-constexpr std::size_t kMaxEntries = 4096;
+// An adaptor holds its face's shape, and with it the face's triangulation: a thread keeps at most
+// this many, and lets go of those of sources that are gone every kSweep new entries (a model
+// unloaded by an application that goes on checking others is not kept alive by the threads that
+// checked it). A check meets a few hundred faces per thread.
+constexpr std::size_t kMaxEntries = 1024;
+constexpr std::size_t kSweep = 64;
 
 Entry& entry(const BrepSource::Impl& source, std::uint32_t local_index) {
   thread_local std::unordered_map<std::uint64_t, std::unique_ptr<Entry>> cache;
+  thread_local std::size_t added = 0;
   assert(source.id < (std::uint64_t{1} << 32));
   const std::uint64_t key = (source.id << 32) | local_index;
   auto it = cache.find(key);
   if (it != cache.end()) return *it->second;
+  if (++added % kSweep == 0) std::erase_if(cache, [](const auto& kv) { return kv.second->alive.expired(); });
   if (cache.size() >= kMaxEntries) cache.clear();
-  return *cache.emplace(key, std::make_unique<Entry>()).first->second;
+  auto e = std::make_unique<Entry>();
+  e->alive = source.alive;
+  return *cache.emplace(key, std::move(e)).first->second;
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ std::uint64_t next_source_id();
 
 // The calling thread's adaptor of face `local_index` of `source` (part-local, the face's location
 // applied, no restriction to its domain). Valid until this thread asks for a face its cache does not
-// hold yet (a full cache starts again). The adaptor is the thread's own: its evaluations need no
+// hold yet (the cache may then let go of entries). The adaptor is the thread's own: its evaluations need no
 // lock (a B-spline adaptor's evaluation cache is mutable state). Reading the
 // face's surface is safe while another thread meshes the part (meshing adds triangulations and
 // polygons, it never replaces a face's surface).

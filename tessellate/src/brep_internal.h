@@ -24,11 +24,11 @@ class BRepTopAdaptor_FClass2d;
 namespace cadclash {
 
 namespace detail {
+std::uint64_t next_source_id();  // brep_face_cache.h
+
 // What a point query needs of one face, made once per face on first use: OCCT's classifier of its
 // parameter domain (a polygon of the boundary's pcurves, points nearer than the polygon's measured
 // deviation counting as on it) and its edges with their boxes.
-std::uint64_t next_source_id();  // brep_face_cache.h
-
 struct FaceLocator {
   // Perform() is const but not thread-safe: the classifier keeps its wires in NCollection_Sequence,
   // whose Value() moves a cached cursor. Every call holds domain_mutex.
@@ -59,8 +59,10 @@ struct BrepSource::Impl {
   mutable std::vector<std::unique_ptr<const detail::FaceLocator>> locators;
   mutable std::mutex locator_mutex;
   const detail::FaceLocator& locator(std::uint32_t local_index) const;
-  // Names this source in the witness queries' per-thread caches (brep_face_cache.h).
+  // Names this source in the witness queries' per-thread caches (brep_face_cache.h), which let go of
+  // its faces once `alive` has expired.
   const std::uint64_t id = detail::next_source_id();
+  const std::shared_ptr<const char> alive = std::make_shared<const char>(0);
 };
 
 namespace detail {
@@ -111,7 +113,8 @@ void describe_face(const TopoDS_Face& face, Surface& out);
 // surface, kept when the face's classifier (`where`) puts its parameters inside the face, farther
 // than the boundary polygon's measured deviation from it; otherwise the nearest point found on the
 // face's edge curves. The evaluation's rounding is added. nullopt when the face has no triangulation
-// with parameters or Newton fails. Reads the face only. May throw Standard_Failure.
+// with parameters or Newton fails. `surface`: the face's adaptor (face_surface). Reads the face only.
+// May throw Standard_Failure.
 std::optional<double> face_point_witness(const BRepAdaptor_Surface& surface, const TopoDS_Face& face,
                                          const FaceLocator& where, const Aabb& face_box, const gp_Pnt& p);
 
@@ -131,7 +134,8 @@ std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& 
 
 // The foot point of `p` on the face's surface by the same Newton, with the unit normal there and the
 // evaluation's rounding; not classified (it may lie outside the face). nullopt when Newton fails or
-// the surface is singular there. Reads the face only. May throw Standard_Failure.
+// the surface is singular there. `surface`: the face's adaptor (face_surface). Reads the face only.
+// May throw Standard_Failure.
 std::optional<SurfaceSource::SurfacePoint> face_surface_point(const BRepAdaptor_Surface& surface,
                                                               const TopoDS_Face& face, const Aabb& face_box,
                                                               const gp_Pnt& p);

@@ -123,6 +123,30 @@ TEST(SurfacePoint, EachFaceOfEachSourceItsOwnSurfaceAcrossModels) {
   }
 }
 
+// The adaptors a thread keeps hold their faces' shapes (and triangulations): once the model is gone,
+// the thread lets go of them as it goes on querying other faces.
+TEST(SurfacePoint, AThreadLetsGoOfTheFacesOfAModelThatIsGone) {
+  TopoDS_Face kept;
+  {
+    const Model gone = build({BRepPrimAPI_MakeBox(1, 2, 3).Shape()}, 0.1);
+    const auto* src = dynamic_cast<const BrepSource*>(gone.parts[0].source.get());
+    ASSERT_NE(src, nullptr);
+    ASSERT_TRUE(src->surface_point(0, Vec3(0.5, 1.0, 1.5)).has_value());
+    kept = src->face(0);
+  }
+  const int held_by_cache = kept.TShape()->GetRefCount();
+  ASSERT_GE(held_by_cache, 2) << "the thread's adaptor holds the face";
+  // 22 boxes: 132 faces never asked before.
+  std::vector<TopoDS_Shape> boxes;
+  for (int i = 0; i < 22; ++i) boxes.push_back(BRepPrimAPI_MakeBox(1.0 + i, 2, 3).Shape());
+  const Model other = build(boxes, 0.1);
+  for (PartId p = 0; p < other.parts.size(); ++p) {
+    const auto* src = dynamic_cast<const BrepSource*>(other.parts[p].source.get());
+    for (std::uint32_t f = 0; f < src->face_count(); ++f) src->surface_point(f, Vec3(0.5, 1.0, 1.5));
+  }
+  EXPECT_EQ(kept.TShape()->GetRefCount(), held_by_cache - 1) << "only this test's copy is left of the face";
+}
+
 // Asks `src` for the foot on `face` of 96 points (24 angles round the seam, each at 4 offsets from
 // the surface: inside, on, just and well outside); at(k, angle, offset) gives a point and its exact
 // foot.
