@@ -110,7 +110,7 @@ std::size_t instance_triangle_count(const Model& model);
 // reads) costs accordingly, so benchmarks report it beside parallel timings.
 double core_round_trip_ns(int trips = 20000);
 
-// Round trips above this are "far" cores: this 2-vCPU machine reads 50-130 ns or 330-480 ns.
+// Round trips above this are "far" cores: this 2-vCPU machine reads 50-140 ns or 330-500 ns.
 constexpr double kFarCoresNs = 200.0;
 
 }  // namespace cadclash::bench
