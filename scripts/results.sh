@@ -32,6 +32,9 @@ if cmake --build "$build" --target help | grep -q '^bench_compare:'; then
 fi
 mkdir -p "$out" "$docs"
 start=$(date +%s)
+# The tree as measured: taken before this script writes its plots into docs/.
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git status --porcelain 2>/dev/null)" ]; then commit="$commit (with uncommitted changes)"; fi
 
 echo "results: accuracy against the exact geometry"
 "$build/bench/bench_accuracy" --out "$out" | tee "$out/accuracy.log"
@@ -107,8 +110,6 @@ relink() { sed -E 's#\]\(([^/():]+\.(svg|png))\)#](results/\1)#g' "$1"; }
 demote() { awk '/^```/ { code = !code } !code && /^#/ { $0 = "##" $0 } { print }'; }
 
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
-commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-if [ -n "$(git status --porcelain 2>/dev/null)" ]; then commit="$commit (with uncommitted changes)"; fi
 
 page=$root/docs/results.md
 while IFS= read -r line || [ -n "$line" ]; do
