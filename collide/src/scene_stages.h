@@ -35,10 +35,11 @@ void triangle_level_stage(SceneData& s, QueryState& q, const std::function<void(
 void decision_stage(SceneData& s, QueryState& q);
 
 // Stages 4 and 5 as one pass when decide_with_triangles(q) (Version 1, a certified or exact decision,
-// no memory budget): each task's decision steps up to the witnesses run right after its triangle
-// level, on the same thread, and the rest of stage 5 after the loop. The same answers and counters
-// as stage 4 then stage 5, since each task's steps depend on it alone; it saves the barrier between
-// the stages and the threads' idle time at the end of each loop.
+// no memory budget, more than one thread): each task's decision steps up to the witnesses run right
+// after its triangle level, on the same thread, and the rest of stage 5 after the loop. The same
+// answers and counters as stage 4 then stage 5, since each task's steps depend on it alone; it saves
+// the barrier between the stages and the threads' idle time at the end of each loop. One thread has
+// neither to save, and the stages in turn keep each one's data in cache (as1 at 0.001 mm: 3 % faster).
 bool decide_with_triangles(const QueryState& q);
 void triangle_and_decision_stage(SceneData& s, QueryState& q);
 

@@ -369,7 +369,8 @@ void decision_stage(SceneData& s, QueryState& q) {
 }
 
 bool decide_with_triangles(const QueryState& q) {
-  return q.o.version == ParallelVersion::V1 && q.o.decision != DecisionMode::Fast && q.o.memory_budget_bytes == 0;
+  return q.o.version == ParallelVersion::V1 && q.o.decision != DecisionMode::Fast && q.o.memory_budget_bytes == 0 &&
+         q.threads > 1;
 }
 
 void triangle_and_decision_stage(SceneData& s, QueryState& q) {
