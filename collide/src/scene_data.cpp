@@ -77,9 +77,10 @@ double SceneData::reach_share(SurfaceId s, const CollideOptions& o) const {
   return deflection(s) + (o.decision == DecisionMode::Fast ? 0.0 : eps[s]);
 }
 
-double SceneData::part_reach_share(PartId p, const CollideOptions& o) const {
-  double d = 0.0;
-  for (SurfaceId s = first(p); s < end(p); ++s) d = std::max(d, reach_share(s, o));
+std::vector<double> SceneData::part_reach_shares(const CollideOptions& o) const {
+  std::vector<double> d(model.parts.size(), 0.0);
+  for (PartId p = 0; p < model.parts.size(); ++p)
+    for (SurfaceId s = first(p); s < end(p); ++s) d[p] = std::max(d[p], reach_share(s, o));
   return d;
 }
 

@@ -52,7 +52,8 @@ struct SceneData {
   double deflection(SurfaceId s) const;
   // What a surface adds to the search reach: its deflection, plus its uncertainty unless fast.
   double reach_share(SurfaceId s, const CollideOptions& o) const;
-  double part_reach_share(PartId p, const CollideOptions& o) const;
+  // Per part: the largest reach share of its surfaces.
+  std::vector<double> part_reach_shares(const CollideOptions& o) const;
   bool selected(InstanceId i, InstanceId j) const;
 };
 
@@ -82,8 +83,8 @@ struct QueryState {
   Report report;
 
   std::vector<InstancePair> pairs;
-  // Per part: SceneData::part_reach_share, worked out by the broad phase (OAABB only; else by the
-  // surface level) for the surface level too (no surface is tessellated between them).
+  // SceneData::part_reach_shares, worked out by the broad phase (OAABB only; else by the surface
+  // level) for the surface level too (no surface is tessellated between them).
   std::vector<double> part_share;
   std::vector<Task> tasks;
   std::vector<std::size_t> first_task;  // tasks of pair k: [first_task[k], first_task[k+1])

@@ -30,7 +30,7 @@ bool worth_a_team(const SceneData& s, const std::vector<InstancePair>& pairs) {
   return comparisons >= kMinParallelComparisons;
 }
 
-// `part_share`: SceneData::part_reach_share per part (QueryState::part_share, from the broad phase).
+// `part_share`: SceneData::part_reach_shares (QueryState::part_share).
 void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share) {
   const Model& model = s.model;
   const Instance& ia = model.instances[ip.a];
@@ -102,10 +102,8 @@ void surface_level_stage(const SceneData& s, QueryState& q) {
   const auto npairs = static_cast<std::ptrdiff_t>(q.pairs.size());
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "surface level");
   const bool team = worth_a_team(s, q.pairs);
-  if (q.o.use_oaabb && q.part_share.size() != model.parts.size()) {  // check_part runs no broad phase
-    q.part_share.resize(model.parts.size());
-    for (PartId p = 0; p < model.parts.size(); ++p) q.part_share[p] = s.part_reach_share(p, q.o);
-  }
+  // check_part runs no broad phase.
+  if (q.o.use_oaabb && q.part_share.size() != model.parts.size()) q.part_share = s.part_reach_shares(q.o);
 #pragma omp parallel for num_threads(q.threads) schedule(runtime) if (team)
   for (std::ptrdiff_t k = 0; k < npairs; ++k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
