@@ -1,5 +1,7 @@
 #include "refine.h"
 
+#include "team_loop.h"
+
 #include <omp.h>
 
 #include <map>
@@ -25,8 +27,7 @@ std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfa
   for (auto& [part, ids] : by_part) work.push_back(std::move(ids));
   std::vector<std::size_t> meshed(work.size(), 0);
   const auto n = static_cast<std::ptrdiff_t>(work.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (n >= 2)
-  for (std::ptrdiff_t w = 0; w < n; ++w) {
+  dynamic_loop(n, threads, true, [&](std::ptrdiff_t w) {
     for (SurfaceId s : work[static_cast<std::size_t>(w)]) {
       const Surface& surf = model.surfaces[s];
       RefinedSurface& r = cache[s];
@@ -48,7 +49,7 @@ std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfa
       r.ok = !r.surface.mesh.triangles.empty();
       if (r.ok) r.bvh = build_surface_bvh(r.surface.mesh);
     }
-  }
+  });
   std::size_t total = 0;
   for (std::size_t m : meshed) total += m;
   return total;

@@ -1,6 +1,7 @@
 // Stage 6: containment — instance pairs whose boxes nest and whose surfaces do not cross (not
 // decidable for a pair with a cut surface pair).
 #include "scene_stages.h"
+#include "team_loop.h"
 
 #include <omp.h>
 
@@ -39,16 +40,15 @@ void containment_stage(const SceneData& s, QueryState& q) {
   for (std::uint32_t k = 0; k < q.cutoff; ++k)
     if (q.pairs[k].containment && !q.pair_intersects[k] && !q.pair_cut[k]) nested.push_back(k);
   const auto n = static_cast<std::ptrdiff_t>(nested.size());
-#pragma omp parallel for num_threads(q.threads) schedule(dynamic, 1) if (n >= kMinParallel)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  dynamic_loop(n, q.threads, n >= kMinParallel, [&](std::ptrdiff_t i) {
     const std::uint32_t ku = nested[static_cast<std::size_t>(i)];
     const InstancePair& ip = q.pairs[ku];
     if (q.deadline.expired()) {
       q.pair_cut[ku] = 1;
-      continue;
+      return;
     }
     q.contained[ku] = ip.containment == 1 ? inside(s, ip.b, ip.a, ip.t_ab) : inside(s, ip.a, ip.b, ip.t_ba);
-  }
+  });
   for (std::size_t k = 0; k < q.cutoff; ++k) {
     if (!q.contained[k]) continue;
     SurfacePairResult r;

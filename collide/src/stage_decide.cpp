@@ -2,6 +2,7 @@
 // "Certified decisions"). The steps (decide_steps.h) run over the pairs each leaves open, cheapest
 // first, in parallel, each answer depending on its pair alone.
 #include "decide_steps.h"
+#include "team_loop.h"
 
 #include <omp.h>
 
@@ -41,12 +42,11 @@ template <class Step>
 void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending, int threads,
               const Deadline& deadline, Step step) {
   const auto n = static_cast<std::ptrdiff_t>(ks.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (n >= 2)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  dynamic_loop(n, threads, true, [&](std::ptrdiff_t i) {
     const std::size_t k = ks[static_cast<std::size_t>(i)];
     if (deadline.expired()) pending[k].cut = true;
     else step(k);
-  }
+  });
 }
 
 }  // namespace
@@ -236,8 +236,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   }
   DecisionRun run(model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline);
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (n >= 2)
-  for (std::ptrdiff_t k = 0; k < n; ++k) run.early(static_cast<std::size_t>(k));
+  dynamic_loop(n, threads, true, [&](std::ptrdiff_t k) { run.early(static_cast<std::size_t>(k)); });
   return run.finish(counters);
 }
 

@@ -3,6 +3,7 @@
 #include "cadclash/geometry.h"
 #include "decide.h"
 #include "scene_stages.h"
+#include "team_loop.h"
 
 #include "cadclash/internal/progress_meter.h"
 
@@ -104,13 +105,12 @@ void surface_level_stage(const SceneData& s, QueryState& q) {
   const bool team = worth_a_team(s, q.pairs);
   // check_part runs no broad phase.
   if (q.o.use_oaabb && q.part_share.size() != model.parts.size()) q.part_share = s.part_reach_shares(q.o);
-#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (team)
-  for (std::ptrdiff_t k = 0; k < npairs; ++k) {
+  runtime_loop(npairs, q.threads, team, [&](std::ptrdiff_t k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
     if (q.deadline.expired()) ip.cut = true;
     else surface_level(s, ip, q.o, q.part_share);
     meter.add();
-  }
+  });
   meter.finish();
   q.charge.assign(q.pairs.size(), 0);
   q.first_task.assign(q.pairs.size() + 1, 0);

@@ -2,6 +2,7 @@
 // surface). Under a memory budget in rounds of a fixed number of surfaces in order of first need,
 // checking the budget between rounds, so a small budget does not tessellate the whole scene first.
 #include "scene_stages.h"
+#include "team_loop.h"
 
 #include <omp.h>
 
@@ -54,13 +55,12 @@ std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave
     if (!s.bvh_ready[sid] && s.model.surfaces[sid].has_triangles) to_build.push_back(sid);
   std::vector<char> done(to_build.size(), 0);
   const auto nbuild = static_cast<std::ptrdiff_t>(to_build.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (nbuild >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < nbuild; ++k) {
-    if (deadline.expired()) continue;
+  dynamic_loop(nbuild, threads, nbuild >= kMinParallel, [&](std::ptrdiff_t k) {
+    if (deadline.expired()) return;
     const SurfaceId sid = to_build[static_cast<std::size_t>(k)];
     s.bvh[sid] = build_surface_bvh(s.model.surfaces[sid].mesh);
     done[static_cast<std::size_t>(k)] = 1;
-  }
+  });
   std::vector<SurfaceId> built;
   for (std::size_t k = 0; k < to_build.size(); ++k) {
     if (!done[k]) continue;

@@ -3,6 +3,7 @@
 // remaining items are skipped and marked cut (an OpenMP loop cannot break).
 #include "decide.h"
 #include "scene_stages.h"
+#include "team_loop.h"
 
 #include "cadclash/internal/progress_meter.h"
 
@@ -87,8 +88,10 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
   // Guided gives a thread half of the items at its first request: with a handful of items that is
   // half the work on one thread (collide.h, Schedule), so a short loop takes them one at a time.
   const bool few = n < kFewItems && q.o.schedule == Schedule::Guided;
-#pragma omp parallel num_threads(q.threads) if (n >= kMinParallel)
-  {
+  const bool team = use_team(n, q.threads, n >= kMinParallel);
+  // The region's body: for a team, or for the calling thread alone (team_loop.h: a region with a
+  // false if clause still starts a team of one).
+  auto run = [&] {
     // One pair at a time per thread: its survivor lists reuse the thread's buffers, freed with them
     // when the stage ends.
     PreparedPair scratch;
@@ -102,13 +105,21 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
       if (after) after(ku);
       through.item_done(q.tasks[ku].pair);
     };
-    if (few) {
+    if (!team) {
+      for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
+    } else if (few) {
 #pragma omp for schedule(dynamic, 1)
       for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
     } else {
 #pragma omp for schedule(runtime)
       for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
     }
+  };
+  if (team) {
+#pragma omp parallel num_threads(q.threads)
+    run();
+  } else {
+    run();
   }
   through.finish();
 }
@@ -117,11 +128,10 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
 // blocks run, so pairs past the new cutoff are released unrun.
 void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
-#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (n >= kMinParallel)
-  for (std::ptrdiff_t k = 0; k < n; ++k) {
+  runtime_loop(n, q.threads, n >= kMinParallel, [&](std::ptrdiff_t k) {
     if (q.deadline.expired()) q.task_cut[static_cast<std::size_t>(k)] = 1;
     else prepare(s, q, static_cast<std::size_t>(k), bytes, /*one_run=*/false, q.prepared[static_cast<std::size_t>(k)]);
-  }
+  });
   for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
   q.apply_memory_budget();
   for (std::size_t k = q.first_task[q.cutoff]; k < ntasks; ++k) q.prepared[k] = PreparedPair{};
@@ -137,15 +147,14 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
   std::vector<CollideCounters> item_counters(items.size());
   const auto nitems = static_cast<std::ptrdiff_t>(items.size());
   PairsThrough through(q, items.size(), [&](std::size_t i) { return q.tasks[items[i].task].pair; });
-#pragma omp parallel for num_threads(q.threads) schedule(runtime) if (nitems >= kMinParallel)
-  for (std::ptrdiff_t i = 0; i < nitems; ++i) {
+  runtime_loop(nitems, q.threads, nitems >= kMinParallel, [&](std::ptrdiff_t i) {
     const auto iu = static_cast<std::size_t>(i);
     const Item& it = items[iu];
     if (q.deadline.expired()) item_out[iu].cut = true;
     else run_pair(s.model.surfaces[q.tasks[it.task].sa], q.prepared[it.task], it.begin, it.end, q.o, item_out[iu],
                   item_counters[iu], &q.deadline);
     through.item_done(q.tasks[it.task].pair);
-  }
+  });
   through.finish();
   for (std::size_t i = 0; i < items.size(); ++i) {  // fixed order: independent of the thread count
     merge_outcome(q.outcomes[items[i].task], std::move(item_out[i]));
