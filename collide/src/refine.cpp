@@ -2,8 +2,6 @@
 
 #include "team_loop.h"
 
-#include <omp.h>
-
 #include <map>
 
 namespace cadclash::detail {

@@ -3,8 +3,6 @@
 #include "scene_stages.h"
 #include "team_loop.h"
 
-#include <omp.h>
-
 #include <cmath>
 
 namespace cadclash::detail {

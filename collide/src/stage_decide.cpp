@@ -4,8 +4,6 @@
 #include "decide_steps.h"
 #include "team_loop.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cassert>

@@ -7,8 +7,6 @@
 
 #include "cadclash/internal/progress_meter.h"
 
-#include <omp.h>
-
 namespace cadclash::detail {
 namespace {
 

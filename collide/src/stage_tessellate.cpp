@@ -4,8 +4,6 @@
 #include "scene_stages.h"
 #include "team_loop.h"
 
-#include <omp.h>
-
 #include <algorithm>
 
 namespace cadclash::detail {
