@@ -100,6 +100,10 @@ bool write_path_csv(const Model& model, const GeneratedPath& path, const std::st
 // "/copyK" + the base path and have ids [k * n, (k + 1) * n) for n base instances.
 Model instanced_grid(const Model& base, std::uint32_t copies);
 
+// instanced_grid, but every copy has parts of its own (copies of base's parts and surfaces, sharing
+// their SurfaceSource): a plant of distinct parts, where a model's surfaces grow with the scene.
+Model distinct_grid(const Model& base, std::uint32_t copies);
+
 // Triangles over all instances (a part's triangles counted once per instance).
 std::size_t instance_triangle_count(const Model& model);
 

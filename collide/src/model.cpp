@@ -87,6 +87,7 @@ std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const 
     if (!surf.has_triangles && model.parts[surf.part].source) by_part[surf.part].push_back(s);
   }
   std::vector<std::pair<PartId, std::vector<SurfaceId>>> work(by_part.begin(), by_part.end());
+  if (!work.empty()) ++model.revision;
   std::vector<std::vector<Diagnostic>> errors(work.size());
   std::vector<std::vector<SurfaceId>> failed_ids(work.size());
 

@@ -17,15 +17,7 @@ void set_schedule(Schedule s) {
 }
 
 SceneMemory scene_memory(const SceneData& s) {
-  SceneMemory m;
-  for (SurfaceId sid = 0; sid < s.model.surfaces.size(); ++sid) {
-    if (!s.bvh_ready[sid]) continue;
-    const TriangleMesh& mesh = s.model.surfaces[sid].mesh;
-    m.triangles += mesh.triangles.size() * sizeof(mesh.triangles[0]);
-    m.vertices += mesh.vertices.size() * sizeof(mesh.vertices[0]);
-    m.hierarchies += bvh_heap_bytes(s.bvh[sid]);
-    m.triangle_count += mesh.triangles.size();
-  }
+  SceneMemory m = s.held;
   // Every surface has its slot (exact root box, sizes, pointers) and ready flag, built or not.
   m.hierarchies += s.bvh.size() * (sizeof(SurfaceBvh) + sizeof(s.bvh_ready[0]));
   m.instances = s.poses.size() * sizeof(Pose) + s.world_box.size() * sizeof(Aabb) + s.dirty.size() +

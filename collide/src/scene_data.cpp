@@ -3,6 +3,7 @@
 #include "cadclash/geometry.h"
 #include "decide.h"
 
+#include <algorithm>
 #include <cassert>
 
 namespace cadclash::detail {
@@ -41,6 +42,7 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   refined.resize(model.surfaces.size());
   noted_deflection.assign(model.surfaces.size(), -1.0);
   noted_triangles.assign(model.surfaces.size(), kUntessellatedCost);
+  first_need.resize(model.surfaces.size());
   in_a.assign(n, selection.set_a.empty() ? 1 : 0);
   in_b.assign(n, selection.set_b.empty() ? 1 : 0);
   for (InstanceId i : selection.set_a) {
@@ -77,11 +79,56 @@ double SceneData::reach_share(SurfaceId s, const CollideOptions& o) const {
   return deflection(s) + (o.decision == DecisionMode::Fast ? 0.0 : eps[s]);
 }
 
-std::vector<double> SceneData::part_reach_shares(const CollideOptions& o) const {
-  std::vector<double> d(model.parts.size(), 0.0);
-  for (PartId p = 0; p < model.parts.size(); ++p)
-    for (SurfaceId s = first(p); s < end(p); ++s) d[p] = std::max(d[p], reach_share(s, o));
-  return d;
+void SceneData::work_out_shares(PartId p) {
+  CollideOptions fast, certified;
+  fast.decision = DecisionMode::Fast;
+  certified.decision = DecisionMode::Certified;
+  double d[2] = {0.0, 0.0};
+  for (SurfaceId s = first(p); s < end(p); ++s) {
+    d[0] = std::max(d[0], reach_share(s, fast));
+    d[1] = std::max(d[1], reach_share(s, certified));
+  }
+  shares.part[0][p] = d[0];
+  shares.part[1][p] = d[1];
+}
+
+void SceneData::refresh_reach_shares() {
+  ReachShares& r = shares;
+  const bool all = !r.valid || r.revision != model.revision;
+  if (!all && r.dirty.empty()) return;
+  if (all) {
+    for (auto& v : r.part) v.assign(model.parts.size(), 0.0);
+    for (PartId p = 0; p < model.parts.size(); ++p) work_out_shares(p);
+  } else {
+    for (PartId p : r.dirty) work_out_shares(p);
+  }
+  for (PartId p : r.dirty) r.is_dirty[p] = 0;
+  r.dirty.clear();
+  for (int k = 0; k < 2; ++k)
+    r.largest[k] = r.part[k].empty() ? 0.0 : *std::max_element(r.part[k].begin(), r.part[k].end());
+  r.revision = model.revision;
+  r.valid = true;
+}
+
+void SceneData::surfaces_changed(std::uint64_t revision_before, std::span<const SurfaceId> changed) {
+  ReachShares& r = shares;
+  // Only this scene's change since the shares were worked out: the parts it touched will do.
+  if (r.valid && r.revision == revision_before) r.revision = model.revision;
+  if (r.is_dirty.size() != model.parts.size()) r.is_dirty.assign(model.parts.size(), 0);
+  for (SurfaceId s : changed) {
+    const PartId p = model.surfaces[s].part;
+    if (!r.is_dirty[p]) r.dirty.push_back(p);
+    r.is_dirty[p] = 1;
+  }
+}
+
+void SceneData::hold(SurfaceId s, int sign) {
+  const TriangleMesh& mesh = model.surfaces[s].mesh;
+  const auto add = [sign](std::uint64_t& into, std::uint64_t v) { into = sign > 0 ? into + v : into - v; };
+  add(held.triangles, mesh.triangles.size() * sizeof(mesh.triangles[0]));
+  add(held.vertices, mesh.vertices.size() * sizeof(mesh.vertices[0]));
+  add(held.hierarchies, bvh_heap_bytes(bvh[s]));
+  add(held.triangle_count, mesh.triangles.size());
 }
 
 bool SceneData::selected(InstanceId i, InstanceId j) const {

@@ -15,11 +15,42 @@
 #include <chrono>
 #include <cstdint>
 #include <set>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 namespace cadclash::detail {
+
+// Per part, the largest reach share (SceneData::reach_share) of its surfaces, for fast decisions
+// ([0]) and for the others ([1]), and the largest of all parts. Kept between checks rather than
+// walked by each: a scene of distinct parts has a surface per CAD face (290 distinct copies of as1:
+// 15,370), and walking them made a path step there half again as long as its own work.
+struct ReachShares {
+  std::vector<double> part[2];
+  double largest[2] = {0.0, 0.0};
+  std::vector<PartId> dirty;      // parts with surfaces this scene changed since they were worked out
+  std::vector<char> is_dirty;     // per part
+  std::uint64_t revision = 0;     // the model.revision they reflect
+  bool valid = false;             // worked out at all
+};
+
+// Per surface, the first instance pair of the running query that needs it, or kInvalidId. Entries
+// carry the query's serial, so a query writes only the surfaces it needs instead of clearing one
+// entry per surface of the model (64 bits: no scene lives to see the serial wrap).
+class FirstNeed {
+ public:
+  void resize(std::size_t surfaces) { stamp_.assign(surfaces, 0), pair_.assign(surfaces, kInvalidId); }
+  // A new query: every entry reads kInvalidId again.
+  void start() { ++serial_; }
+  std::uint32_t operator[](SurfaceId s) const { return stamp_[s] == serial_ ? pair_[s] : kInvalidId; }
+  void set(SurfaceId s, std::uint32_t pair) { stamp_[s] = serial_, pair_[s] = pair; }
+
+ private:
+  std::vector<std::uint64_t> stamp_;
+  std::vector<std::uint32_t> pair_;
+  std::uint64_t serial_ = 0;
+};
 
 struct SceneData {
   Model& model;
@@ -42,6 +73,11 @@ struct SceneData {
   std::vector<std::uint64_t> noted_triangles;  // ... and into how many triangles (plan costs)
   std::set<std::pair<InstanceId, InstanceId>> excluded;
   std::unordered_map<std::string, InstanceId> by_path;
+  ReachShares shares;   // see refresh_reach_shares
+  // What the surfaces with a hierarchy hold (triangles, vertices, hierarchy heap bytes, triangle
+  // count): kept as trees are built and released, so Scene::memory() does not walk every surface.
+  SceneMemory held;
+  FirstNeed first_need;  // of the running query (QueryState)
 
   SceneData(Model& m, SceneSelection sel);
 
@@ -52,9 +88,23 @@ struct SceneData {
   double deflection(SurfaceId s) const;
   // What a surface adds to the search reach: its deflection, plus its uncertainty unless fast.
   double reach_share(SurfaceId s, const CollideOptions& o) const;
-  // Per part: the largest reach share of its surfaces.
-  std::vector<double> part_reach_shares(const CollideOptions& o) const;
+  // Brings `shares` up to date: the parts this scene changed, or every part when the model's
+  // revision moved otherwise (require_triangles, another scene's lazy tessellation).
+  void refresh_reach_shares();
+  // Per part: the largest reach share of its surfaces; and the largest of those. Precondition:
+  // refresh_reach_shares() since the last change to the model's surfaces.
+  const std::vector<double>& part_reach_shares(const CollideOptions& o) const { return shares.part[certified(o)]; }
+  double largest_reach_share(const CollideOptions& o) const { return shares.largest[certified(o)]; }
+  // This scene changed `changed` surfaces' triangles or deflections (it read `revision_before` as the
+  // model's revision just before, and added to it since when it changed the model).
+  void surfaces_changed(std::uint64_t revision_before, std::span<const SurfaceId> changed);
+  // A surface's hierarchy was built (+1) or released (-1): `held` follows.
+  void hold(SurfaceId s, int sign);
   bool selected(InstanceId i, InstanceId j) const;
+
+ private:
+  static int certified(const CollideOptions& o) { return o.decision == DecisionMode::Fast ? 0 : 1; }
+  void work_out_shares(PartId p);
 };
 
 // One overlapping instance pair: what the object and surface levels found.
@@ -83,17 +133,13 @@ struct QueryState {
   Report report;
 
   std::vector<InstancePair> pairs;
-  // SceneData::part_reach_shares, worked out by the broad phase (OAABB only; else by the surface
-  // level) for the surface level too (no surface is tessellated between them).
-  std::vector<double> part_share;
   std::vector<Task> tasks;
   std::vector<std::size_t> first_task;  // tasks of pair k: [first_task[k], first_task[k+1])
   // The memory budget's ledger: per instance pair, the bytes it makes this query build. Each surface
   // is charged to the first pair (in pair order) that needs it, so the prefix of pairs that fits the
   // budget does not depend on how the work was spread over threads.
   std::vector<std::uint64_t> charge;
-  std::vector<SurfaceId> needed;           // in order of first need
-  std::vector<std::uint32_t> first_need;   // per surface: first pair needing it, or kInvalidId
+  std::vector<SurfaceId> needed;           // in order of first need (SceneData::first_need)
   std::uint32_t cutoff = 0;                // pairs from here on do not fit the memory budget
 
   // Lazy tessellation: what this query asked for, made, and built (released past the cutoff).

@@ -129,6 +129,7 @@ void Scene::note_deflection(SurfaceId s, double deflection, std::uint64_t triang
   assert(s < impl_->noted_deflection.size());
   impl_->noted_deflection[s] = deflection;
   impl_->noted_triangles[s] = triangles;
+  impl_->surfaces_changed(impl_->model.revision, std::span<const SurfaceId>(&s, 1));
 }
 
 }  // namespace cadclash

@@ -17,7 +17,7 @@ void broad_phase_stage(SceneData& s, QueryState& q);
 
 // 2. Object and surface levels of every instance pair (OAABB, surviving surfaces, candidate surface
 //    pairs), then the task list, the surfaces needed in order of first need, and their ledger.
-void surface_level_stage(const SceneData& s, QueryState& q);
+void surface_level_stage(SceneData& s, QueryState& q);
 
 // 3. Lazy tessellation of the needed surfaces and their BVHs, in rounds under a memory budget.
 void tessellation_stage(SceneData& s, QueryState& q);

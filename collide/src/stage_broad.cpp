@@ -87,9 +87,9 @@ void broad_phase_stage(SceneData& s, QueryState& q) {
   s.dirty_list.clear();
   std::vector<std::array<InstanceId, 2>> ids;
   if (o.use_oaabb) {
-    q.part_share = s.part_reach_shares(o);
+    s.refresh_reach_shares();
     // The largest deflection (+ uncertainty) any surface brings to the reach.
-    const double share = q.part_share.empty() ? 0.0 : *std::max_element(q.part_share.begin(), q.part_share.end());
+    const double share = s.largest_reach_share(o);
     const double margin = search_reach(o, share, share, 0.0);
     const std::vector<InstanceId>* side = small_side(s);
     ids = side != nullptr ? tree_pairs(s, *side, margin, total) : sweep(s, margin, total);

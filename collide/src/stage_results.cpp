@@ -10,15 +10,10 @@ namespace {
 
 // Leaves the model and the scene as if the query had stopped at the cutoff.
 void release_past_cutoff(SceneData& s, const QueryState& q) {
-  for (std::size_t i = 0; i < q.tessellated.size(); ++i) {
-    if (q.first_need[q.tessellated[i]] < q.cutoff) continue;
-    Surface& surf = s.model.surfaces[q.tessellated[i]];
-    surf.mesh = TriangleMesh{};
-    surf.has_triangles = false;
-    surf.deflection = q.old_deflection[i];
-  }
+  // The trees first: what they held is counted off from their meshes.
   for (SurfaceId sid : q.built) {
-    if (q.first_need[sid] < q.cutoff) continue;
+    if (s.first_need[sid] < q.cutoff) continue;
+    s.hold(sid, -1);
     s.bvh[sid] = SurfaceBvh{};
     s.bvh_ready[sid] = 0;
     if (sid < s.outlines.ready.size() && s.outlines.ready[sid]) {
@@ -26,6 +21,18 @@ void release_past_cutoff(SceneData& s, const QueryState& q) {
       s.outlines.ready[sid] = 0;
     }
   }
+  std::vector<SurfaceId> released;
+  for (std::size_t i = 0; i < q.tessellated.size(); ++i) {
+    if (s.first_need[q.tessellated[i]] < q.cutoff) continue;
+    Surface& surf = s.model.surfaces[q.tessellated[i]];
+    surf.mesh = TriangleMesh{};
+    surf.has_triangles = false;
+    surf.deflection = q.old_deflection[i];
+    released.push_back(q.tessellated[i]);
+  }
+  if (released.empty()) return;
+  const std::uint64_t revision = s.model.revision++;
+  s.surfaces_changed(revision, released);
 }
 
 }  // namespace
@@ -47,7 +54,7 @@ void results_stage(SceneData& s, QueryState& q) {
       if (q.outcomes[t].intersecting) ++total.intersecting_pairs;
     }
   }
-  for (SurfaceId sid : q.asked) total.tessellated_surfaces += q.first_need[sid] < q.cutoff;
+  for (SurfaceId sid : q.asked) total.tessellated_surfaces += s.first_need[sid] < q.cutoff;
   const bool memory_cut = q.cutoff < q.pairs.size();
   const bool time_cut =
       std::any_of(q.pair_cut.begin(), q.pair_cut.begin() + q.cutoff, [](char c) { return c != 0; });

@@ -29,7 +29,7 @@ bool worth_a_team(const SceneData& s, const std::vector<InstancePair>& pairs) {
   return comparisons >= kMinParallelComparisons;
 }
 
-// `part_share`: SceneData::part_reach_shares (QueryState::part_share).
+// `part_share`: SceneData::part_reach_shares.
 void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share) {
   const Model& model = s.model;
   const Instance& ia = model.instances[ip.a];
@@ -96,30 +96,30 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
 
 }  // namespace
 
-void surface_level_stage(const SceneData& s, QueryState& q) {
+void surface_level_stage(SceneData& s, QueryState& q) {
   const Model& model = s.model;
   const auto npairs = static_cast<std::ptrdiff_t>(q.pairs.size());
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "surface level");
   const bool team = worth_a_team(s, q.pairs);
-  // check_part runs no broad phase.
-  if (q.o.use_oaabb && q.part_share.size() != model.parts.size()) q.part_share = s.part_reach_shares(q.o);
+  if (q.o.use_oaabb) s.refresh_reach_shares();  // done already unless check_part (no broad phase)
+  const std::vector<double>& part_share = s.part_reach_shares(q.o);
   runtime_loop(npairs, q.threads, team, [&](std::ptrdiff_t k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
     if (q.deadline.expired()) ip.cut = true;
-    else surface_level(s, ip, q.o, q.part_share);
+    else surface_level(s, ip, q.o, part_share);
     meter.add();
   });
   meter.finish();
   q.charge.assign(q.pairs.size(), 0);
   q.first_task.assign(q.pairs.size() + 1, 0);
-  q.first_need.assign(model.surfaces.size(), kInvalidId);
+  s.first_need.start();
   for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
     const InstancePair& ip = q.pairs[k];
     q.first_task[k] = q.tasks.size();
     q.charge[k] += ip.candidates.size() * sizeof(ip.candidates[0]);
     auto need = [&](SurfaceId sid) {
-      if (q.first_need[sid] != kInvalidId) return;
-      q.first_need[sid] = k;
+      if (s.first_need[sid] != kInvalidId) return;
+      s.first_need.set(sid, k);
       q.needed.push_back(sid);
     };
     for (const auto& c : ip.candidates) {

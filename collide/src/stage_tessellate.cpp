@@ -26,7 +26,9 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
       before.push_back(model.surfaces[sid].deflection);
     }
   if (missing.empty()) return;
+  const std::uint64_t revision = model.revision;
   std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.deadline, &q.failed);
+  s.surfaces_changed(revision, missing);
   q.report.diagnostics.insert(q.report.diagnostics.end(), ds.begin(), ds.end());
   q.asked.insert(q.asked.end(), missing.begin(), missing.end());
   for (std::size_t i = 0; i < missing.size(); ++i) {
@@ -34,14 +36,14 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
     if (!surf.has_triangles) continue;
     q.tessellated.push_back(missing[i]);
     q.old_deflection.push_back(before[i]);
-    q.charge[q.first_need[missing[i]]] += mesh_bytes(surf.mesh);
+    q.charge[s.first_need[missing[i]]] += mesh_bytes(surf.mesh);
   }
 }
 
 void build_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wave) {
   for (SurfaceId sid : build_trees(s, wave, q.threads, q.deadline)) {
     q.built.push_back(sid);
-    q.charge[q.first_need[sid]] += bvh_heap_bytes(s.bvh[sid]);
+    q.charge[s.first_need[sid]] += bvh_heap_bytes(s.bvh[sid]);
   }
 }
 
@@ -63,6 +65,7 @@ std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave
   for (std::size_t k = 0; k < to_build.size(); ++k) {
     if (!done[k]) continue;
     s.bvh_ready[to_build[k]] = 1;
+    s.hold(to_build[k], +1);
     built.push_back(to_build[k]);
   }
   return built;
@@ -71,7 +74,7 @@ std::vector<SurfaceId> build_trees(SceneData& s, std::span<const SurfaceId> wave
 void tessellation_stage(SceneData& s, QueryState& q) {
   const std::size_t round = q.o.memory_budget_bytes > 0 ? kBudgetRound : std::max<std::size_t>(q.needed.size(), 1);
   for (std::size_t r = 0; r < q.needed.size(); r += round) {
-    if (q.first_need[q.needed[r]] >= q.cutoff || q.deadline.expired()) break;
+    if (s.first_need[q.needed[r]] >= q.cutoff || q.deadline.expired()) break;
     const std::span<const SurfaceId> wave(q.needed.data() + r, std::min(round, q.needed.size() - r));
     tessellate_round(s, q, wave);
     build_round(s, q, wave);

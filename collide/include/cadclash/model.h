@@ -152,6 +152,11 @@ struct Model {
   std::vector<Part> parts;
   std::vector<Surface> surfaces;
   std::vector<Instance> instances;
+  // Counts changes to surfaces' triangles or deflections while scenes are built on the model:
+  // require_triangles and a scene's own lazy tessellation add one. A Scene keeps what it derives from
+  // those (per-part search reaches) until this changes, so whoever changes a surface's triangles or
+  // deflection by hand while a Scene is on the model adds one too.
+  std::uint64_t revision = 0;
 };
 
 // Supplies what a part's importer knows beyond triangles: lazy tessellation and exact geometry.
@@ -268,7 +273,8 @@ Aabb mesh_aabb(const TriangleMesh& mesh);
 
 // Makes sure every listed surface has triangles, asking its part's SurfaceSource for the missing
 // ones (in parallel across parts). Surfaces that fail are listed in the returned diagnostics and
-// keep has_triangles == false. `deflection` <= 0 uses each source's default.
+// keep has_triangles == false. `deflection` <= 0 uses each source's default. Adds one to
+// model.revision when any listed surface was missing triangles.
 // Precondition: every id < model.surfaces.size().
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
                                           double deflection = 0.0);
