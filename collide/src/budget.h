@@ -35,10 +35,10 @@ class Deadline {
   mutable std::atomic<bool> hit_{false};
 };
 
-// require_triangles (collide.h) that stops asking the sources once `deadline` has expired; surfaces
-// not reached keep has_triangles == false and get no diagnostic. `failed`, when given, receives the
-// surface of each returned diagnostic, in the same order.
+// require_triangles (model.h) on `threads` threads (<= 0: all available) that stops asking the
+// sources once `deadline` has expired; surfaces not reached keep has_triangles == false and get no
+// diagnostic. `failed`, when given, receives the surface of each returned diagnostic, in order.
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces, double deflection,
-                                          const Deadline& deadline, std::vector<SurfaceId>* failed = nullptr);
+                                          int threads, const Deadline& deadline, std::vector<SurfaceId>* failed = nullptr);
 
 }  // namespace cadclash::detail

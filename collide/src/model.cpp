@@ -2,6 +2,9 @@
 #include "cadclash/collide.h"
 
 #include "budget.h"
+#include "team_loop.h"
+
+#include <omp.h>
 
 #include <cassert>
 #include <map>
@@ -72,12 +75,12 @@ Aabb mesh_aabb(const TriangleMesh& mesh) {
 }
 
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
-                                          double deflection) {
-  return detail::require_triangles(model, surfaces, deflection, detail::Deadline());
+                                          double deflection, int threads) {
+  return detail::require_triangles(model, surfaces, deflection, threads, detail::Deadline());
 }
 
 std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const SurfaceId> surfaces,
-                                                  double deflection, const Deadline& deadline,
+                                                  double deflection, int threads, const Deadline& deadline,
                                                   std::vector<SurfaceId>* failed) {
   // Group the missing surfaces by part: a source is thread-safe across parts, not within one.
   std::map<PartId, std::vector<SurfaceId>> by_part;
@@ -91,8 +94,8 @@ std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const 
   std::vector<std::vector<Diagnostic>> errors(work.size());
   std::vector<std::vector<SurfaceId>> failed_ids(work.size());
 
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::ptrdiff_t w = 0; w < static_cast<std::ptrdiff_t>(work.size()); ++w) {
+  const auto nwork = static_cast<std::ptrdiff_t>(work.size());
+  dynamic_loop(nwork, threads > 0 ? threads : omp_get_max_threads(), true, [&](std::ptrdiff_t w) {
     const auto& [part_id, ids] = work[static_cast<std::size_t>(w)];
     const Part& part = model.parts[part_id];
     for (SurfaceId s : ids) {
@@ -110,7 +113,7 @@ std::vector<Diagnostic> detail::require_triangles(Model& model, std::span<const 
         failed_ids[static_cast<std::size_t>(w)].push_back(s);
       }
     }
-  }
+  });
   std::vector<Diagnostic> out;
   for (auto& e : errors) out.insert(out.end(), e.begin(), e.end());
   if (failed != nullptr)

@@ -140,6 +140,10 @@ struct QueryState {
   // budget does not depend on how the work was spread over threads.
   std::vector<std::uint64_t> charge;
   std::vector<SurfaceId> needed;           // in order of first need (SceneData::first_need)
+  // check_part: per surface of `needed`, whether SceneData::refined had it attempted before this
+  // query's decisions (only those surfaces can be refined by them). Filled when `note_refined`.
+  bool note_refined = false;
+  std::vector<char> refined_before;
   std::uint32_t cutoff = 0;                // pairs from here on do not fit the memory budget
 
   // Lazy tessellation: what this query asked for, made, and built (released past the cutoff).

@@ -36,8 +36,7 @@ std::vector<PlannedPair> costed_pairs(const detail::SceneData& s, const detail::
 }
 
 // What the query did per surface (SurfaceWork), and its surfaces' bytes taken out of the charge.
-std::vector<SurfaceWork> surface_work(const detail::SceneData& s, detail::QueryState& q,
-                                      const std::vector<char>& attempted_before) {
+std::vector<SurfaceWork> surface_work(const detail::SceneData& s, detail::QueryState& q) {
   const Model& model = s.model;
   std::map<SurfaceId, SurfaceWork> work;
   auto at = [&](SurfaceId sid) -> SurfaceWork& {
@@ -64,11 +63,15 @@ std::vector<SurfaceWork> surface_work(const detail::SceneData& s, detail::QueryS
   }
   assert(q.failed.size() == q.report.diagnostics.size());
   for (std::size_t i = 0; i < q.failed.size(); ++i) at(q.failed[i]).error = q.report.diagnostics[i];
-  // refine_surfaces counts a face when its source meshed it finer than its triangles.
-  for (SurfaceId sid = 0; sid < s.refined.size(); ++sid)
-    if (!attempted_before[sid] && s.refined[sid].attempted &&
+  // refine_surfaces counts a face when its source meshed it finer than its triangles. The decisions
+  // refine only their tasks' faces, all of them in `needed`.
+  assert(q.refined_before.size() == q.needed.size());
+  for (std::size_t i = 0; i < q.needed.size(); ++i) {
+    const SurfaceId sid = q.needed[i];
+    if (!q.refined_before[i] && s.refined[sid].attempted &&
         s.refined[sid].surface.deflection < model.surfaces[sid].deflection)
       at(sid).refined = true;
+  }
   std::vector<SurfaceWork> out;
   out.reserve(work.size());
   for (auto& [sid, w] : work) {
@@ -113,11 +116,10 @@ PartialCheck Scene::check_part(const CollideOptions& o, const CheckPlan& plan, s
     q.pairs[i].b = plan.pairs[part[i]].b;
   }
   q.report.counters.instance_pairs = part.size();
-  std::vector<char> attempted(s.refined.size());
-  for (std::size_t i = 0; i < s.refined.size(); ++i) attempted[i] = s.refined[i].attempted ? 1 : 0;
+  q.note_refined = true;
   detail::narrow_stages(s, q);
   PartialCheck out;
-  out.surfaces = surface_work(s, q, attempted);
+  out.surfaces = surface_work(s, q);
   q.report.counters.tessellated_surfaces = 0;
   q.report.counters.refined_surfaces = 0;
   q.report.diagnostics.clear();

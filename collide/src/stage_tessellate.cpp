@@ -27,7 +27,7 @@ void tessellate_round(SceneData& s, QueryState& q, std::span<const SurfaceId> wa
     }
   if (missing.empty()) return;
   const std::uint64_t revision = model.revision;
-  std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.deadline, &q.failed);
+  std::vector<Diagnostic> ds = require_triangles(model, missing, 0.0, q.threads, q.deadline, &q.failed);
   s.surfaces_changed(revision, missing);
   q.report.diagnostics.insert(q.report.diagnostics.end(), ds.begin(), ds.end());
   q.asked.insert(q.asked.end(), missing.begin(), missing.end());

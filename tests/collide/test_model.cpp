@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <thread>
+
 namespace cadclash {
 namespace {
 
@@ -93,6 +97,66 @@ TEST(Model, RequireTrianglesAsksSourceOnlyForMissingAndReportsFailures) {
   EXPECT_EQ(source->calls, 2);
   require_triangles(m, wanted);  // surface 0 is done; only the failed one is asked again
   EXPECT_EQ(source->calls, 3);
+}
+
+// Sources that note how many of them are meshing at once; each call takes a millisecond, so two
+// threads given the work overlap.
+struct Concurrency {
+  std::atomic<int> now{0}, most{0};
+};
+class SlowSource : public SurfaceSource {
+ public:
+  explicit SlowSource(Concurrency& c) : c_(c) {}
+  bool triangulate(std::uint32_t, double, TriangleMesh& out, double& achieved, Diagnostic&) override {
+    const int n = ++c_.now;
+    int most = c_.most.load();
+    while (n > most && !c_.most.compare_exchange_weak(most, n)) {
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    out.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+    out.triangles = {{0, 1, 2}};
+    achieved = 0.0;
+    --c_.now;
+    return true;
+  }
+
+ private:
+  Concurrency& c_;
+};
+
+// A caller that asks for one thread (a check with threads = 1, several processes sharing a machine)
+// gets one, also for the lazy tessellation; with more, the parts are meshed side by side.
+TEST(Model, RequireTrianglesUsesTheThreadsAskedFor) {
+  Concurrency c;
+  Model m;
+  constexpr int kParts = 8;
+  for (int p = 0; p < kParts; ++p) {
+    m.parts.push_back({"p" + std::to_string(p), "p.step", static_cast<SurfaceId>(p), 1, std::make_shared<SlowSource>(c)});
+    Surface s;
+    s.part = static_cast<PartId>(p);
+    m.surfaces.push_back(s);
+  }
+  std::vector<SurfaceId> all(kParts);
+  for (int p = 0; p < kParts; ++p) all[static_cast<std::size_t>(p)] = static_cast<SurfaceId>(p);
+  Model one = m;
+  EXPECT_TRUE(require_triangles(one, all, 0.0, 1).empty());
+  EXPECT_EQ(c.most.load(), 1);
+  for (const Surface& s : one.surfaces) EXPECT_TRUE(s.has_triangles);
+  c.most = 0;
+  Model two = m;
+  EXPECT_TRUE(require_triangles(two, all, 0.0, 2).empty());
+  EXPECT_LE(c.most.load(), 2);
+  for (const Surface& s : two.surfaces) EXPECT_TRUE(s.has_triangles);
+  // A check on one thread tessellates its surfaces on one thread too.
+  c.most = 0;
+  for (Surface& s : m.surfaces) s.aabb = mesh_aabb(one.surfaces[0].mesh);
+  for (int p = 0; p < kParts; ++p) m.instances.push_back({"/i" + std::to_string(p), static_cast<PartId>(p), Pose::Identity()});
+  Scene scene(m);
+  CollideOptions o;
+  o.threads = 1;
+  EXPECT_FALSE(scene.check(o).pairs.empty());
+  for (const Surface& s : m.surfaces) EXPECT_TRUE(s.has_triangles);
+  EXPECT_EQ(c.most.load(), 1);
 }
 
 }  // namespace

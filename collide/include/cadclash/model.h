@@ -272,12 +272,12 @@ void append_model(Model& into, Model from, const std::string& path_prefix = {});
 Aabb mesh_aabb(const TriangleMesh& mesh);
 
 // Makes sure every listed surface has triangles, asking its part's SurfaceSource for the missing
-// ones (in parallel across parts). Surfaces that fail are listed in the returned diagnostics and
-// keep has_triangles == false. `deflection` <= 0 uses each source's default. Adds one to
-// model.revision when any listed surface was missing triangles.
+// ones (in parallel across parts, on `threads` threads; <= 0: all available). Surfaces that fail are
+// listed in the returned diagnostics and keep has_triangles == false. `deflection` <= 0 uses each
+// source's default. Adds one to model.revision when any listed surface was missing triangles.
 // Precondition: every id < model.surfaces.size().
 std::vector<Diagnostic> require_triangles(Model& model, std::span<const SurfaceId> surfaces,
-                                          double deflection = 0.0);
+                                          double deflection = 0.0, int threads = 0);
 
 // Counts triangles over all surfaces that have them.
 std::size_t triangle_count(const Model& model);
