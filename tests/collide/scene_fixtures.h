@@ -119,6 +119,34 @@ inline std::vector<Surface> random_surfaces(std::mt19937_64& rng, int surfaces, 
   return out;
 }
 
+// Every counter equal except aabb_updates (a fresh scene's first check updates every instance's box;
+// a scene followed along moves only some).
+inline void expect_same_counters(const CollideCounters& x, const CollideCounters& y) {
+  EXPECT_EQ(x.instance_pairs, y.instance_pairs);
+  EXPECT_EQ(x.aabb_tests, y.aabb_tests);
+  EXPECT_EQ(x.surfaces_a, y.surfaces_a);
+  EXPECT_EQ(x.surfaces_b, y.surfaces_b);
+  EXPECT_EQ(x.surface_pairs, y.surface_pairs);
+  EXPECT_EQ(x.triangles_a, y.triangles_a);
+  EXPECT_EQ(x.triangles_b, y.triangles_b);
+  EXPECT_EQ(x.triangle_tests, y.triangle_tests);
+  EXPECT_EQ(x.exact_fallbacks, y.exact_fallbacks);
+  EXPECT_EQ(x.distance_tests, y.distance_tests);
+  EXPECT_EQ(x.intersecting_pairs, y.intersecting_pairs);
+  EXPECT_EQ(x.tessellated_surfaces, y.tessellated_surfaces);
+  EXPECT_EQ(x.decided_mesh, y.decided_mesh);
+  EXPECT_EQ(x.decided_mesh_exact, y.decided_mesh_exact);
+  EXPECT_EQ(x.decided_analytic, y.decided_analytic);
+  EXPECT_EQ(x.decided_refined, y.decided_refined);
+  EXPECT_EQ(x.decided_exact, y.decided_exact);
+  EXPECT_EQ(x.undecided, y.undecided);
+  EXPECT_EQ(x.ambiguous_pairs, y.ambiguous_pairs);
+  EXPECT_EQ(x.refined_surfaces, y.refined_surfaces);
+  EXPECT_EQ(x.exact_queries, y.exact_queries);
+  EXPECT_EQ(x.witness_queries, y.witness_queries);
+  EXPECT_EQ(x.dismissed_pairs, y.dismissed_pairs);
+}
+
 // Every reported field equal (doubles compared exactly).
 inline void expect_same_pairs(const Report& x, const Report& y, bool compare_triangles = true) {
   ASSERT_EQ(x.pairs.size(), y.pairs.size());
