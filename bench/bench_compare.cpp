@@ -91,43 +91,18 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// A row ready to run: once(first) runs it one time (first: its first run, which records what it
-// found); done() follows its last run. No `once` when the row could not be set up (Row::error).
-struct Prepared {
-  std::function<void(bool)> once;
-  std::function<void()> done;
-};
-
-// Runs the rows in kRounds rounds, each row a block of consecutive runs per round, until it has
-// `reps` timings or has used `rep_cap` seconds (at least one run). A table's ratios compare rows
-// whose runs took milliseconds each: one after the other, a few seconds of a busy host could fall
-// on one row's runs only; in rounds every row sees the whole table's minutes, and within a block the
-// row's data stays as warm as repeated queries keep it.
-constexpr int kRounds = 3;
-void run_rows(const Settings& s, const std::string& table, std::vector<Row>& rows, std::vector<Prepared>& prepared) {
-  const int block = (s.reps + kRounds - 1) / kRounds;
-  std::vector<double> used(rows.size(), 0.0);
-  auto wants = [&](std::size_t k) {
-    const std::vector<double>& t = rows[k].times;
-    return prepared[k].once && static_cast<int>(t.size()) < s.reps && (t.empty() || used[k] + median(t) <= s.rep_cap);
-  };
-  for (bool any = true; any;) {
-    any = false;
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      for (int b = 0; b < block && wants(k); ++b) {
-        const auto t0 = std::chrono::steady_clock::now();
-        prepared[k].once(rows[k].times.empty());
-        rows[k].times.push_back(seconds_since(t0));
-        used[k] += rows[k].times.back();
-        any = true;
-      }
+// Runs `once` until `reps` timings or `cap` seconds are used (at least one run).
+template <class F>
+std::vector<double> repeat(const Settings& s, F&& once) {
+  std::vector<double> times;
+  double used = 0.0;
+  while (static_cast<int>(times.size()) < s.reps && (times.empty() || used + median(times) <= s.rep_cap)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    once(times.empty());
+    times.push_back(seconds_since(t0));
+    used += times.back();
   }
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (prepared[k].done) prepared[k].done();
-    const Row& row = rows[k];
-    std::fprintf(stderr, "[%s] %s: %.2f s (%zu reps, %zu pairs)%s%s\n", table.c_str(), row.method.name.c_str(), used[k],
-                 row.times.size(), row.found.size(), row.error.empty() ? "" : " not run: ", row.error.c_str());
-  }
+  return times;
 }
 
 // The cadclash structures' build time and size: the per-surface hierarchies (what a Scene builds
@@ -143,7 +118,7 @@ void cadclash_build_cost(Model& model, double& seconds, double& bytes_per_triang
                                         : 0.0;
 }
 
-Prepared prepare_cadclash(const cb::Workload& w, Row& row) {
+void run_cadclash(const Settings& s, const cb::Workload& w, Row& row) {
   Model& model = *w.model;
   const cb::Subset& sub = row.method.subset;
   cadclash::SceneSelection selection;
@@ -156,23 +131,22 @@ Prepared prepare_cadclash(const cb::Workload& w, Row& row) {
     for (InstanceId i : w.moving)
       if (sub.instances == 0 || i < sub.instances) selection.set_a.push_back(i);
   }
-  auto scene = std::make_shared<cadclash::Scene>(model, selection);
+  cadclash::Scene scene(model, selection);
   const CollideOptions& o = row.method.options;
   row.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-  auto total = std::make_shared<cadclash::CollideCounters>();
-  Prepared out;
-  out.once = [&w, &row, &model, &o, &sub, scene, total](bool first) {
-    cadclash::testing::set_float_only_for_benchmark(row.method.float_only);
+  cadclash::CollideCounters total;
+  cadclash::testing::set_float_only_for_benchmark(row.method.float_only);
+  row.times = repeat(s, [&](bool first) {
     cb::PoseState state(model);
-    for (InstanceId i : w.moving) scene->set_pose(i, state.poses[i]);
+    for (InstanceId i : w.moving) scene.set_pose(i, state.poses[i]);
     for (std::uint32_t k = 0; k < w.steps.size(); ++k) {
-      for (const cb::PoseUpdate& u : w.steps[k]) scene->set_pose(u.instance, u.pose);
+      for (const cb::PoseUpdate& u : w.steps[k]) scene.set_pose(u.instance, u.pose);
       if (!sub.has_step(k)) continue;
-      const cadclash::Report r = scene->check(o);
+      const cadclash::Report r = scene.check(o);
       if (!first) continue;
       const auto& c = r.counters;
-      total->triangle_tests += c.triangle_tests;
-      total->exact_fallbacks += c.exact_fallbacks;
+      total.triangle_tests += c.triangle_tests;
+      total.exact_fallbacks += c.exact_fallbacks;
       for (const cadclash::SurfacePairResult& p : r.pairs) {
         if (p.surface_a == cadclash::kInvalidId) continue;  // containment: whole instances
         const bool hit = row.method.reference == Reference::WithinT ? (p.intersecting || p.distance <= o.tolerance)
@@ -180,35 +154,26 @@ Prepared prepare_cadclash(const cb::Workload& w, Row& row) {
         if (hit) row.found.insert({k, p.instance_a, p.instance_b, p.surface_a, p.surface_b});
       }
     }
-    cadclash::testing::set_float_only_for_benchmark(false);
-  };
-  out.done = [&row, &model, total] {
-    row.triangle_tests = total->triangle_tests;
-    row.exact_fallbacks = total->exact_fallbacks;
-    cadclash_build_cost(model, row.build_seconds, row.bytes_per_triangle);
-  };
-  return out;
+  });
+  cadclash::testing::set_float_only_for_benchmark(false);
+  row.triangle_tests = total.triangle_tests;
+  row.exact_fallbacks = total.exact_fallbacks;
+  cadclash_build_cost(model, row.build_seconds, row.bytes_per_triangle);
 }
 
-Prepared prepare_peer(const cb::Workload& w, Row& row) {
-  std::shared_ptr<cb::Peer> peer = row.method.peer();
+void run_peer(const Settings& s, const cb::Workload& w, Row& row) {
+  std::unique_ptr<cb::Peer> peer = row.method.peer();
   const auto t0 = std::chrono::steady_clock::now();
-  if (!peer->build(*w.model, row.error)) return {};
+  if (!peer->build(*w.model, row.error)) return;
   row.build_seconds = seconds_since(t0);
   row.bytes_per_triangle = peer->bytes_per_triangle();
   row.threads = 1;
-  Prepared p;
-  p.once = [&w, &row, peer](bool first) {
+  row.times = repeat(s, [&](bool first) {
     cb::PeerRun r = peer->run(w, row.method.subset);
     if (!first) return;
     row.found = std::move(r.found);
     if (r.has_tests) row.triangle_tests = r.triangle_tests;
-  };
-  return p;
-}
-
-Prepared prepare(const cb::Workload& w, Row& row) {
-  return row.method.is_cadclash ? prepare_cadclash(w, row) : prepare_peer(w, row);
+  });
 }
 
 cb::PairSet restricted(const cb::PairSet& set, const cb::Subset& subset) {
@@ -361,8 +326,7 @@ std::string markdown(const std::vector<WorkloadResult>& results, const Settings&
   std::ostringstream md;
   md << "# cadclash side by side (bench_compare" << (s.quick ? " --quick" : "") << ")\n\n"
      << "Median wall time over repeated runs in one process (reps column; a row stops repeating once it has used "
-     << s.rep_cap << " s), the rows of a table run in " << kRounds << " rounds of consecutive runs each, so that every "
-     << "row sees the whole table's minutes of the host. Ratio = median / cadclash default's median on the same instances. "
+     << s.rep_cap << " s). Ratio = median / cadclash default's median on the same instances. "
      << "Agreement = surface pairs found by both / only by cadclash / only by the method, against cadclash's "
      << "intersecting surface pairs at tolerance 0 (OCCT tolerance t: against cadclash's pairs with triangles within t). "
      << "Peers run single-threaded; cadclash rows use " << results.front().rows.front().threads
@@ -566,13 +530,15 @@ int main(int argc, char** argv) {
     r.part_triangles = cadclash::triangle_count(*r.w.model);
     r.round_trip_before = cb::core_round_trip_ns();
     for (Method& m : methods_for(r.w, s.threads, r.subset, slow[k])) {
-      r.rows.emplace_back();
-      r.rows.back().method = std::move(m);
-    }
-    {
-      std::vector<Prepared> prepared;
-      for (Row& row : r.rows) prepared.push_back(prepare(r.w, row));  // rows no longer move: references hold
-      run_rows(s, r.w.name, r.rows, prepared);
+      Row row;
+      row.method = std::move(m);
+      std::fprintf(stderr, "[%s] %s ...", r.w.name.c_str(), row.method.name.c_str());
+      const auto t0 = std::chrono::steady_clock::now();
+      if (row.method.is_cadclash) run_cadclash(s, r.w, row);
+      else run_peer(s, r.w, row);
+      std::fprintf(stderr, " %.2f s (%zu reps, %zu pairs)%s%s\n", seconds_since(t0), row.times.size(), row.found.size(),
+                   row.error.empty() ? "" : " not run: ", row.error.c_str());
+      r.rows.push_back(std::move(row));
     }
     r.round_trip_after = cb::core_round_trip_ns();
     finish(r);
@@ -609,13 +575,10 @@ int main(int argc, char** argv) {
     full.method.name = "cadclash default (OAABB, auto triangle level, early exit, V1 guided)";
     full.method.options.threads = s.threads;
     full.method.is_default = true;
-    {
-      std::vector<Row> one(1);
-      one[0] = std::move(full);
-      std::vector<Prepared> prepared{prepare(r.w, one[0])};
-      run_rows(s, r.w.name, one, prepared);
-      full = std::move(one[0]);
-    }
+    std::fprintf(stderr, "[%s] %s ...", r.w.name.c_str(), full.method.name.c_str());
+    const auto t0 = std::chrono::steady_clock::now();
+    run_cadclash(s, r.w, full);
+    std::fprintf(stderr, " %.2f s (%zu reps, %zu pairs)\n", seconds_since(t0), full.times.size(), full.found.size());
     {  // Copies differ only by a translation: say how many find exactly copy 0's pairs.
       std::vector<std::set<std::array<std::uint32_t, 4>>> per_copy_pairs(copies);
       for (const cb::PairKey& k : full.found)
