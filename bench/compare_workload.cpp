@@ -254,22 +254,11 @@ Model instanced_grid(const Model& base, std::uint32_t copies) {
 }
 
 Model distinct_grid(const Model& base, std::uint32_t copies) {
-  Model out = instanced_grid(base, copies);
-  const auto n = static_cast<std::uint32_t>(base.instances.size());
-  const auto parts = static_cast<PartId>(base.parts.size());
-  for (std::uint32_t k = 1; k < copies; ++k) {
-    const auto first_part = static_cast<PartId>(out.parts.size());
-    for (PartId p = 0; p < parts; ++p) {
-      Part part = base.parts[p];
-      part.first_surface = static_cast<SurfaceId>(out.surfaces.size());
-      for (SurfaceId s = base.parts[p].first_surface; s < base.parts[p].first_surface + base.parts[p].surface_count; ++s) {
-        out.surfaces.push_back(base.surfaces[s]);
-        out.surfaces.back().part = first_part + p;
-      }
-      out.parts.push_back(std::move(part));
-    }
-    for (std::uint32_t i = k * n; i < (k + 1) * n; ++i) out.instances[i].part += first_part;
-  }
+  const Model grid = instanced_grid(base, copies);
+  Model out;
+  // append_model gives each copy its own parts and surfaces (ids shifted) and the "/copyK" paths.
+  for (std::uint32_t k = 0; k < copies; ++k) append_model(out, base, "/copy" + std::to_string(k));
+  for (std::size_t i = 0; i < out.instances.size(); ++i) out.instances[i].pose = grid.instances[i].pose;
   return out;
 }
 
