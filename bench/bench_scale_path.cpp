@@ -44,6 +44,7 @@ struct PathRun {
   CollideCounters counters;  // summed over the steps
   std::vector<std::vector<SurfacePairResult>> pairs;  // per step
   std::vector<CollideCounters> step_counters;
+  std::vector<CollideTimings> step_timings;  // the report's stage times, per step
 };
 
 void add(CollideCounters& into, const CollideCounters& c) {
@@ -71,6 +72,7 @@ struct PathRunner {
       run.step_seconds.push_back(seconds_since(t0));
       add(run.counters, r.counters);
       run.step_counters.push_back(r.counters);
+      run.step_timings.push_back(r.timings);
       run.pairs.push_back(std::move(r.pairs));
     }
   }
@@ -361,6 +363,32 @@ int main(int argc, char** argv) {
     const double m1 = percentile(distinct_runs[0].step_seconds, 0.5), m2 = percentile(distinct_runs[1].step_seconds, 0.5);
     line("| path step, median, distinct parts (parallel efficiency " + fmt("%.0f %%", 100.0 * m1 / (2.0 * m2)) + ") | " +
          fmt("%.3f ms", 1e3 * m1) + " | " + fmt("%.3f ms", 1e3 * m2) + " |");
+  }
+  {
+    // Where a step's time goes (the report's stage timings; a step also holds set_pose and handing
+    // the report over): what a second thread shortens, and what it cannot.
+    struct Stage {
+      const char* name;
+      double (*of)(const CollideTimings&);
+    };
+    const Stage stages[] = {
+        {"broad phase", [](const CollideTimings& t) { return t.broad; }},
+        {"surface level", [](const CollideTimings& t) { return t.surface_level; }},
+        {"tessellation", [](const CollideTimings& t) { return t.tessellation; }},
+        {"triangles and decisions", [](const CollideTimings& t) { return t.triangle_level; }},
+        {"results and report",
+         [](const CollideTimings& t) { return t.total - t.broad - t.surface_level - t.tessellation - t.triangle_level; }}};
+    for (const Stage& st : stages) {
+      double m[2];
+      for (int th = 0; th < 2; ++th) {
+        std::vector<double> v;
+        for (const CollideTimings& t : runs[static_cast<std::size_t>(th)].step_timings) v.push_back(st.of(t));
+        m[th] = percentile(v, 0.5);
+        j["path"][std::to_string(th + 1)]["stage_median_ms"][st.name] = 1e3 * m[th];
+      }
+      line(std::string("| path step, median of its ") + st.name + " | " + fmt("%.4f ms", 1e3 * m[0]) + " | " +
+           fmt("%.4f ms", 1e3 * m[1]) + " |");
+    }
   }
   line("| path: instance pairs / triangle tests over all steps | " + std::to_string(runs[0].counters.instance_pairs) +
        " / " + std::to_string(runs[0].counters.triangle_tests) + " | " + std::to_string(runs[1].counters.instance_pairs) +
