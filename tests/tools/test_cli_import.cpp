@@ -76,6 +76,26 @@ TEST(CliImport, StagesAreInTheTableAndTheJson) {
   EXPECT_EQ(quiet.out.find("stages:"), std::string::npos);
 }
 
+// --threads 1 holds for the import too: files are read one after another (without it, as many at
+// once as there are cores), so the import's wall clock covers every file's own. Read at once, the
+// files' times overlap and add up to more than the import's.
+TEST(CliImport, ThreadsOneReadsOneFileAtATime) {
+  const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step",
+                    linkrods = kExternal + "linkrods.step";
+  for (const std::string& f : {as1, screw, linkrods})
+    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  const std::string json = cadclash::testing::scratch_dir() + "/threads-one.json";
+  fs::remove(json);
+  const CliRun r = cadclash("check '" + as1 + "' '" + screw + "' '" + linkrods + "' --threads 1 --json '" + json + "'");
+  ASSERT_TRUE(r.code == 0 || r.code == 3) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(cadclash::testing::slurp(json));
+  const auto& files_json = j["import_timings"]["files"];
+  ASSERT_EQ(files_json.size(), 3u);
+  double sum = 0.0;
+  for (const auto& f : files_json) sum += f["total"].get<double>();
+  EXPECT_GE(j["import_timings"]["seconds"].get<double>(), sum) << "the files' reads overlapped";
+}
+
 // A damaged entry: the check says so on stderr and in the report's diagnostics, and finds the same pairs.
 TEST(CliImport, DamagedCacheEntryIsReadAgain) {
   const std::string box_a = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
@@ -111,7 +131,10 @@ TEST(CliImport, ConcurrentRunsShareACache) {
   constexpr int kRuns = 3;
   for (int round = 0; round < 2; ++round) {  // all cold at once, then all warm at once
     std::string command = "for k in";
-    for (int k = 0; k < kRuns; ++k) command += " " + std::to_string(k);
+    for (int k = 0; k < kRuns; ++k) {
+      command += ' ';
+      command += std::to_string(k);
+    }
     command += std::string("; do timeout 120 '") + CADCLASH_EXE + "' check " + files + " --no-timings --cache '" + cache +
                "' --json '" + dir + "/shared'$k.json >/dev/null 2>'" + dir + "/shared'$k.err & done; wait";
     ASSERT_EQ(std::system(command.c_str()), 0);

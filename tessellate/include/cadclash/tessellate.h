@@ -50,6 +50,14 @@ struct TessellationOptions {
   ProgressCallback progress;
 };
 
+// Caps the threads OCCT's own parallel loops use in this process (BRepMesh meshing a part's faces
+// at once: TessellationOptions::parallel) at `threads`: they then run on OCCT's thread pool of that
+// size instead of TBB's, which takes every core. Process-wide, like omp_set_num_threads, which caps
+// cadclash's own loops (files read at once, parts meshed at once, lazy tessellation); a program that
+// wants a whole run on N cores calls both, before importing and from one thread (`cadclash check
+// --threads N` does). Returns the pool's thread count. Precondition: threads >= 1; no meshing runs.
+int limit_mesher_threads(int threads);
+
 // Named settings a user understands, like Mayo's and FreeCAD's mesh quality choices.
 // Absolute deflections in millimetres:
 //   coarse     1.0   mm, 0.8  rad     quick look, collision broad checks

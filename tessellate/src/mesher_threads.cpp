@@ -1,0 +1,22 @@
+// limit_mesher_threads: OCCT's parallel loops on a pool of a given size (tessellate.h).
+#include "cadclash/tessellate.h"
+
+#include <OSD_Parallel.hxx>
+#include <OSD_ThreadPool.hxx>
+
+#include <cassert>
+
+namespace cadclash {
+
+int limit_mesher_threads(int threads) {
+  assert(threads >= 1);
+  // OSD_Parallel hands its loops to TBB unless told to use OCCT's own pool; TBB would take every
+  // core. The default pool takes its size when first made, and Init resizes one made already.
+  OSD_Parallel::SetUseOcctThreads(Standard_True);
+  const Handle(OSD_ThreadPool)& pool = OSD_ThreadPool::DefaultPool(threads);
+  if (pool->NbThreads() != threads) pool->Init(threads);
+  pool->SetNbDefaultThreadsToLaunch(threads);
+  return pool->NbThreads();
+}
+
+}  // namespace cadclash
