@@ -40,6 +40,12 @@ struct InputOptions {
 // Adds FILE... and the tessellation switches to `cmd`, bound to `in`.
 void add_input_options(CLI::App& cmd, InputOptions& in);
 
+// Holds this process to `threads` threads (0 = every core), the whole run and not only a query: the
+// import's loops (files read at once, parts meshed at once, lazy tessellation) through
+// omp_set_num_threads, and BRepMesh's own through limit_mesher_threads when `threads` is below the
+// machine's cores (OCCT's pool meshes slower than TBB's, so only then). Call before importing.
+void hold_threads(int threads);
+
 // The tessellation the switches ask for: --deflection, --relative and --angular, or the preset's
 // values when --preset is given (it overrides them). The one place a preset is resolved: the import
 // and the report's settings both read this.

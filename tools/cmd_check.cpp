@@ -8,7 +8,6 @@
 #include "progress_line.h"
 
 #include "cadclash/report.h"
-#include "cadclash/tessellate.h"
 
 #include <nlohmann/json.hpp>
 
@@ -23,7 +22,6 @@
 #include <span>
 #include <streambuf>
 #include <optional>
-#include <omp.h>
 #include <sstream>
 
 namespace cadclash::cli {
@@ -544,15 +542,9 @@ int run_check(const CheckOptions& o, const Launch& launch) {
 
 // `cadclash check`, in one process or as one rank of an MPI job (every rank imports, rank 0 reports).
 int run_check_launched(const CheckOptions& o) {
-  if (o.threads > 0) {
-    // --threads is the run's: the import's loops (files read at once, parts meshed at once) and
-    // BRepMesh's own follow it as the query does, so that --threads 1 (or one MPI rank per core)
-    // keeps the whole run on that many cores.
-    omp_set_num_threads(o.threads);
-    // OCCT's own pool meshes slower than TBB (as1 at 0.001 mm on 2 cores: 0.48-0.56 s against 0.39
-    // s), so it is used only to hold BRepMesh below the machine's cores.
-    if (o.threads < omp_get_num_procs()) limit_mesher_threads(o.threads);
-  }
+  // --threads is the run's, not only the query's: --threads 1 (or one MPI rank per core) keeps the
+  // import on that many cores too.
+  hold_threads(o.threads);
   const Launch launch = mpi_launch();
   if (!launch.by_mpirun) return run_check(o, launch);
 #if CADCLASH_HAS_MPI

@@ -15,6 +15,7 @@ struct InfoOptions {
   InputOptions in;
   bool json = false;
   bool surfaces = false;
+  int threads = 0;  // --threads; 0 = every core
 };
 
 // The report's surface fields (cadclash/report.h), the name, the triangle count and the repair flags.
@@ -139,9 +140,12 @@ void register_info(CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand("info", "List parts, instances, surfaces and triangle counts");
   add_input_options(*cmd, o->in);
+  cmd->add_option("--threads", o->threads, "Threads for the whole run: files read at once and meshing (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_flag("--surfaces", o->surfaces, "List every surface of every part");
   cmd->callback([o] {
+    hold_threads(o->threads);
     if (int code = run_info(*o); code != kExitOk) throw CLI::RuntimeError(code);
   });
 }

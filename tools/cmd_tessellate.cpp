@@ -14,6 +14,7 @@ namespace {
 struct TessellateOptions {
   InputOptions in;
   std::string output;
+  int threads = 0;  // --threads; 0 = every core
 };
 
 int run_tessellate(TessellateOptions& o) {
@@ -45,8 +46,11 @@ void register_tessellate(CLI::App& app) {
   auto o = std::make_shared<TessellateOptions>();
   CLI::App* cmd = app.add_subcommand("tessellate", "Write the surface-tagged model (.obj or .glb)");
   add_input_options(*cmd, o->in);
+  cmd->add_option("--threads", o->threads, "Threads for the whole run: files read at once and meshing (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("-o,--output", o->output, "Output file: .obj or .glb")->required();
   cmd->callback([o] {
+    hold_threads(o->threads);
     if (int code = run_tessellate(*o); code != kExitOk) throw CLI::RuntimeError(code);
   });
 }

@@ -96,6 +96,28 @@ TEST(CliImport, ThreadsOneReadsOneFileAtATime) {
   EXPECT_GE(j["import_timings"]["seconds"].get<double>(), sum) << "the files' reads overlapped";
 }
 
+// `tessellate` and `info` take --threads too; meshing on one thread (OCCT's own pool instead of TBB)
+// writes the same triangles, eager and lazy.
+TEST(CliImport, ThreadsChangeNoTriangle) {
+  const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
+  for (const std::string& f : {as1, screw})
+    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  const std::string files = "'" + as1 + "' '" + screw + "'";
+  const std::string dir = cadclash::testing::scratch_dir();
+  for (const std::string lazy : {"", " --lazy"}) {
+    SCOPED_TRACE(lazy);
+    const std::string all = dir + "/threads-all.obj", one = dir + "/threads-one.obj";
+    ASSERT_EQ(cadclash("tessellate " + files + lazy + " --deflection 0.01 -o '" + all + "'").code, 0);
+    const CliRun r = cadclash("tessellate " + files + lazy + " --deflection 0.01 --threads 1 -o '" + one + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(cadclash::testing::slurp(one), cadclash::testing::slurp(all));
+  }
+  const CliRun info_all = cadclash("info " + files + " --json");
+  const CliRun info_one = cadclash("info " + files + " --json --threads 1");
+  ASSERT_EQ(info_one.code, 0) << info_one.err;
+  EXPECT_EQ(info_one.out, info_all.out);
+}
+
 // A damaged entry: the check says so on stderr and in the report's diagnostics, and finds the same pairs.
 TEST(CliImport, DamagedCacheEntryIsReadAgain) {
   const std::string box_a = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
