@@ -93,12 +93,19 @@ struct DecisionRun::Impl {
   }
 
   // Steps 1 to 3c of task k, on the calling thread: each task's answer depends on it alone, so
-  // the tasks may run in any order and on any threads.
-  void early(std::size_t k);
+  // the tasks may run in any order and on any threads. The task's state and counters stay on the
+  // thread's stack until it ends (as the triangle level's, stage_triangles.cpp): written once.
+  void early(std::size_t k) {
+    Pending p;
+    CollideCounters c;
+    early(k, p, c);
+    pending[k] = std::move(p);
+    task_counters[k] = c;
+  }
+  void early(std::size_t k, Pending& p, CollideCounters& c);
 };
 
-void DecisionRun::Impl::early(std::size_t k) {
-  Pending& p = pending[k];
+void DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
   const DecideTask& t = tasks[k];
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
   p = from_mesh(model, eps, t, o);
@@ -117,7 +124,6 @@ void DecisionRun::Impl::early(std::size_t k) {
   need_outline(t.sa);  // step 2b asks the outlines of both surfaces
   need_outline(t.sb);
   const FaceView a = view(t.sa), b = view(t.sb);
-  CollideCounters& c = task_counters[k];
   // Step 2b: analytic contact witnesses, on the outlines.
   analytic_contact(eps, t, a, b, p, o);
   // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing. Only

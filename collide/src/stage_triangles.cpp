@@ -62,14 +62,15 @@ class PairsThrough {
 };
 
 // `one_run`: one run_pair covers the whole pair (Version 1), so it may make its own candidates.
-// Into `out` (q.prepared[k], or Version 1's per-thread scratch); false when the task is not usable.
-bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::uint64_t>& bytes, bool one_run,
-             PreparedPair& out) {
+// Into `out` (q.prepared[k], or Version 1's per-thread scratch), counting into `counters`, the
+// survivor lists' bytes into `bytes`; false when the task is not usable.
+bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::uint64_t& bytes, bool one_run, PreparedPair& out,
+             CollideCounters& counters) {
   const Task& t = q.tasks[k];
   if (!usable(s.model, t)) return false;
   const InstancePair& ip = q.pairs[t.pair];
   prepare_pair_reach(s.model.surfaces[t.sa], s.bvh[t.sa], s.model.surfaces[t.sb], s.bvh[t.sb], ip.t_ab, ip.t_ba, q.o,
-                     task_tau(s, q, t), out, q.task_counters[k], one_run);
+                     task_tau(s, q, t), out, counters, one_run);
   // Certified: the decision's crossing step asks whether the triangles cross deeper than T, and
   // only where one face is a plane (decide_crossing.cpp); elsewhere the run need not find out.
   const Surface& a = s.model.surfaces[t.sa];
@@ -77,7 +78,7 @@ bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::vector<std::
   if (q.o.decision != DecisionMode::Fast &&
       (a.analytic.shape == SurfaceShape::Plane || b.analytic.shape == SurfaceShape::Plane))
     out.threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
-  bytes[k] = prepared_bytes(out);
+  bytes = prepared_bytes(out);
   return true;
 }
 
@@ -98,9 +99,19 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
     auto one = [&](std::size_t ku) {
       if (q.deadline.expired()) {
         q.task_cut[ku] = 1;
-      } else if (prepare(s, q, ku, bytes, /*one_run=*/true, scratch)) {
-        run_pair(s.model.surfaces[q.tasks[ku].sa], scratch, 0, scratch.la.size(), q.o, q.outcomes[ku],
-                 q.task_counters[ku], &q.deadline);
+      } else {
+        // The task's outcome and counters stay on this thread's stack until it ends, then are
+        // written once: neighbouring tasks' entries share cache lines, and another thread writing
+        // its task's entry meanwhile would take the line back and forth at every counter update
+        // (distance_tests, box tests...): on 2 threads with the vCPUs on different core complexes,
+        // part of what a path step lost (seventeenth session's closing note).
+        PairOutcome outcome;
+        CollideCounters counters;
+        if (prepare(s, q, ku, bytes[ku], /*one_run=*/true, scratch, counters))
+          run_pair(s.model.surfaces[q.tasks[ku].sa], scratch, 0, scratch.la.size(), q.o, outcome, counters,
+                   &q.deadline);
+        q.outcomes[ku] = std::move(outcome);
+        q.task_counters[ku] = counters;
       }
       if (after) after(ku);
       through.item_done(q.tasks[ku].pair);
@@ -130,7 +141,10 @@ void run_v2(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
   runtime_loop(n, q.threads, n >= kMinParallel, [&](std::ptrdiff_t k) {
     if (q.deadline.expired()) q.task_cut[static_cast<std::size_t>(k)] = 1;
-    else prepare(s, q, static_cast<std::size_t>(k), bytes, /*one_run=*/false, q.prepared[static_cast<std::size_t>(k)]);
+    else {
+      const auto ku = static_cast<std::size_t>(k);
+      prepare(s, q, ku, bytes[ku], /*one_run=*/false, q.prepared[ku], q.task_counters[ku]);
+    }
   });
   for (std::size_t k = 0; k < ntasks; ++k) q.charge[q.tasks[k].pair] += bytes[k];
   q.apply_memory_budget();
