@@ -20,6 +20,11 @@ void hold_threads(int threads) {
   if (threads < omp_get_num_procs()) limit_mesher_threads(threads);
 }
 
+void add_threads_option(CLI::App& cmd, int& threads, const std::string& what) {
+  cmd.add_option("--threads", threads, "Threads for the whole run: " + what + " (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+}
+
 void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_option("files", in.files, "Input files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF)")->required();  // a missing file is an input error (exit 1), reported by the importer
   cmd.add_option("--deflection", in.deflection, "Linear deflection of the tessellation, mm (or relative with --relative)")

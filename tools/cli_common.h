@@ -45,6 +45,8 @@ void add_input_options(CLI::App& cmd, InputOptions& in);
 // omp_set_num_threads, and BRepMesh's own through limit_mesher_threads when `threads` is below the
 // machine's cores (OCCT's pool meshes slower than TBB's, so only then). Call before importing.
 void hold_threads(int threads);
+// Adds --threads N (0 = every core) to `cmd`, bound to `threads`; `what` says what it covers.
+void add_threads_option(CLI::App& cmd, int& threads, const std::string& what);
 
 // The tessellation the switches ask for: --deflection, --relative and --angular, or the preset's
 // values when --preset is given (it overrides them). The one place a preset is resolved: the import

@@ -573,8 +573,7 @@ void register_check(CLI::App& app) {
   cmd->add_option("--tolerance", o->tolerance, "Contact tolerance t, mm (touching: distance <= t + both deflections)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--threads", o->threads,
-                  "Threads for the whole run: files read at once, meshing and the query (default: all cores)")->check(CLI::NonNegativeNumber);
+  add_threads_option(*cmd, o->threads, "files read at once, meshing and the query");
   cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz");
   cmd->add_option("--time-budget", o->time_budget,
                   "Stop after this many seconds (whole trajectory with --path) and report what was found, marked partial; exit 4")

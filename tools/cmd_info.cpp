@@ -140,8 +140,7 @@ void register_info(CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand("info", "List parts, instances, surfaces and triangle counts");
   add_input_options(*cmd, o->in);
-  cmd->add_option("--threads", o->threads, "Threads for the whole run: files read at once and meshing (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  add_threads_option(*cmd, o->threads, "files read at once and meshing");
   cmd->add_flag("--json", o->json, "Print JSON instead of text");
   cmd->add_flag("--surfaces", o->surfaces, "List every surface of every part");
   cmd->callback([o] {

@@ -46,8 +46,7 @@ void register_tessellate(CLI::App& app) {
   auto o = std::make_shared<TessellateOptions>();
   CLI::App* cmd = app.add_subcommand("tessellate", "Write the surface-tagged model (.obj or .glb)");
   add_input_options(*cmd, o->in);
-  cmd->add_option("--threads", o->threads, "Threads for the whole run: files read at once and meshing (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  add_threads_option(*cmd, o->threads, "files read at once and meshing");
   cmd->add_option("-o,--output", o->output, "Output file: .obj or .glb")->required();
   cmd->callback([o] {
     hold_threads(o->threads);

@@ -34,9 +34,10 @@ TEST(MesherThreads, OcctLoopsRunOnTheThreadsAsked) {
   EXPECT_EQ(most_at_once(), 1);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   ASSERT_EQ(cadclash::limit_mesher_threads(2), 2);  // resized after use
-  EXPECT_LE(most_at_once(), 2);
+  const int most = most_at_once();
+  EXPECT_LE(most, 2);
   if (cores >= 2) {
-    EXPECT_EQ(most_at_once(), 2);  // sleeping iterations on two threads overlap
+    EXPECT_EQ(most, 2);  // sleeping iterations on two threads overlap
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 
 namespace {
@@ -16,6 +17,13 @@ using cadclash::testing::CliRun;
 CliRun cadclash(const std::string& args) { return cadclash::testing::run_cadclash(args); }
 
 const std::string kExternal = std::string(CADCLASH_DATA_DIR) + "/external/";
+
+// The first of `files` that is missing ("" when all are there): tests skip without the external data.
+std::string missing(std::initializer_list<std::string> files) {
+  for (const std::string& f : files)
+    if (!fs::exists(f)) return f;
+  return {};
+}
 
 // The --json report of `cadclash check FILES ARGS --json <scratch>`; fails the test on a bad exit.
 std::string report_of(const std::string& files, const std::string& args) {
@@ -29,8 +37,7 @@ std::string report_of(const std::string& files, const std::string& args) {
 TEST(CliImport, ParallelAndCachedReportsAreTheReference) {
   const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step",
                     linkrods = kExternal + "linkrods.step";
-  for (const std::string& f : {as1, screw, linkrods})
-    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  if (const std::string m = missing({as1, screw, linkrods}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
   const std::string files = "'" + as1 + "' '" + screw + "' '" + linkrods + "'";
   const std::string cache = cadclash::testing::scratch_dir() + "/cli-cache";
   fs::remove_all(cache);
@@ -46,7 +53,7 @@ TEST(CliImport, ParallelAndCachedReportsAreTheReference) {
 
 TEST(CliImport, StagesAreInTheTableAndTheJson) {
   const std::string as1 = kExternal + "as1-tu-203.stp";
-  if (!fs::exists(as1)) GTEST_SKIP() << as1 << " missing: run scripts/setup.sh";
+  if (const std::string m = missing({as1}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
   const std::string box = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
   const std::string cache = cadclash::testing::scratch_dir() + "/stage-cache";
   fs::remove_all(cache);
@@ -82,8 +89,7 @@ TEST(CliImport, StagesAreInTheTableAndTheJson) {
 TEST(CliImport, ThreadsOneReadsOneFileAtATime) {
   const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step",
                     linkrods = kExternal + "linkrods.step";
-  for (const std::string& f : {as1, screw, linkrods})
-    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  if (const std::string m = missing({as1, screw, linkrods}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
   const std::string json = cadclash::testing::scratch_dir() + "/threads-one.json";
   fs::remove(json);
   const CliRun r = cadclash("check '" + as1 + "' '" + screw + "' '" + linkrods + "' --threads 1 --json '" + json + "'");
@@ -100,8 +106,7 @@ TEST(CliImport, ThreadsOneReadsOneFileAtATime) {
 // writes the same triangles, eager and lazy.
 TEST(CliImport, ThreadsChangeNoTriangle) {
   const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
-  for (const std::string& f : {as1, screw})
-    if (!fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+  if (const std::string m = missing({as1, screw}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
   const std::string files = "'" + as1 + "' '" + screw + "'";
   const std::string dir = cadclash::testing::scratch_dir();
   for (const std::string lazy : {"", " --lazy"}) {
@@ -144,7 +149,7 @@ TEST(CliImport, DamagedCacheEntryIsReadAgain) {
 // with one whole entry per file and no temporary files.
 TEST(CliImport, ConcurrentRunsShareACache) {
   const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
-  if (!fs::exists(as1) || !fs::exists(screw)) GTEST_SKIP() << "data/external missing: run scripts/setup.sh";
+  if (const std::string m = missing({as1, screw}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
   const std::string dir = cadclash::testing::scratch_dir();
   const std::string cache = dir + "/shared-cache";
   fs::remove_all(cache);
