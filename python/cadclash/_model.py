@@ -208,12 +208,14 @@ class Model(_core.ModelCore):
         return self._triangle_count()
 
     def tessellate(self, surfaces: Optional[Iterable[Union[int, Surface]]] = None,
-                   deflection: Optional[float] = None) -> List[Diagnostic]:
+                   deflection: Optional[float] = None, threads: int = 0) -> List[Diagnostic]:
         """Gives triangles to the listed surfaces (default: all) that have none yet (lazy loads);
-        ``deflection`` defaults to the load deflection. Returns diagnostics for faces that failed."""
+        ``deflection`` defaults to the load deflection; parts are meshed on at most ``threads``
+        threads at once (0: every core). Returns diagnostics for faces that failed."""
         ids = range(len(self.surfaces)) if surfaces is None else [s.id if isinstance(s, Surface) else int(s)
                                                                     for s in surfaces]
-        return _diagnostics(self._tessellate(list(ids), 0.0 if deflection is None else float(deflection)))
+        return _diagnostics(self._tessellate(list(ids), 0.0 if deflection is None else float(deflection),
+                                             int(threads)))
 
     def __repr__(self) -> str:
         return (f"Model({len(self.parts)} parts, {len(self.instances)} instances, {len(self.surfaces)} surfaces, "
@@ -241,7 +243,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
          relative: bool = False, preset: Optional[str] = None, lazy: bool = False, repair: bool = False,
          fill_holes: bool = False, segment: bool = False, sharp_angle: float = 60.0, planar: bool = False,
          isolate: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
-         cache: Optional[PathLike] = None, strict: bool = False) -> Model:
+         cache: Optional[PathLike] = None, threads: int = 0, strict: bool = False) -> Model:
     """Reads one or more files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF) into one ``Model``.
 
     The arguments mirror ``cadclash check``'s input switches: ``deflection`` (mm, or a fraction of
@@ -258,7 +260,10 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     (a directory; the CLI's ``--cache``) keeps every file as imported, keyed by a SHA-256 of its bytes,
     path and these settings: a file loaded again unchanged comes back from it, the same model; a
     damaged entry is read again and named in a warning diagnostic. Several files form one scene,
-    read in parallel; each file's instance paths are then prefixed with "/<file name>".
+    read in parallel; each file's instance paths are then prefixed with "/<file name>". ``threads``
+    (the CLI's ``--threads``; 0 = every core) holds the whole load to that many threads: files read at
+    once, parts meshed at once, and OCCT's meshing of a part's faces (its thread pool is
+    process-wide: each load sets it). The model does not depend on it.
 
     Returns the model with ``diagnostics`` and ``complete`` set: a partly bad file keeps its good
     parts. Raises ``InputError`` (naming each file and line or STEP ``#id``) when no instance could
@@ -272,7 +277,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     raw, complete = model._load(files, float(deflection), bool(relative), float(angular), preset or "",
                                 bool(lazy), bool(repair), bool(fill_holes), bool(segment), float(sharp_angle),
                                 bool(planar), bool(isolate), float(time_limit), float(model_tolerance),
-                                os.fspath(cache) if cache is not None else "")
+                                os.fspath(cache) if cache is not None else "", int(threads))
     model.files = files
     model.diagnostics = _diagnostics(raw)
     model.complete = complete

@@ -1,7 +1,11 @@
 // cadclash._cadclash.ModelCore: loading files, reading the model, NumPy views of its triangles.
 #include "convert.h"
 
+#include "cadclash/tessellate.h"
+
 #include <pybind11/stl.h>
+
+#include <omp.h>
 
 #include <mutex>
 #include <stdexcept>
@@ -14,6 +18,29 @@ static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(std::uint32_t),
 
 // OCCT's readers keep process-wide settings (Interface_Static): loads run one at a time.
 std::mutex g_import_mutex;
+
+// A call's OpenMP thread count: omp_set_num_threads holds for the thread that sets it, so it is set
+// for the call and put back after, leaving other Python threads and later calls as they were.
+class CallThreads {
+ public:
+  explicit CallThreads(int threads) : saved_(omp_get_max_threads()), set_(threads > 0) {
+    if (set_) omp_set_num_threads(threads);
+  }
+  ~CallThreads() {
+    if (set_) omp_set_num_threads(saved_);
+  }
+  CallThreads(const CallThreads&) = delete;
+  CallThreads& operator=(const CallThreads&) = delete;
+
+ private:
+  int saved_;
+  bool set_;
+};
+
+int checked_threads(int threads) {
+  if (threads < 0) throw pyb::value_error("threads must be >= 0 (0: every core)");
+  return threads;
+}
 
 const Surface& surface_at(const ModelState& s, pyb::ssize_t id) {
   if (id < 0 || static_cast<std::size_t>(id) >= s.model.surfaces.size()) throw pyb::index_error("surface id out of range");
@@ -36,6 +63,7 @@ struct LoadArgs {
   double time_limit = 0.0;
   double model_tolerance = 0.0;
   std::string cache;  // ImportOptions::cache_dir; empty: none
+  int threads = 0;    // the whole load on at most this many threads; 0: every core
 };
 
 // Same steps and defaults as the CLI's import_inputs(), without printing: (diagnostics, complete).
@@ -61,6 +89,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   if (!(a.model_tolerance >= 0.0)) throw pyb::value_error("model_tolerance must be >= 0 mm (0: from the coordinates)");
   options.model_tolerance = a.model_tolerance;
   options.cache_dir = a.cache;
+  options.parallel_files = checked_threads(a.threads);
 
   ModelState& s = *core.state;
   std::vector<Diagnostic> diagnostics;
@@ -70,6 +99,11 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
     std::lock_guard<std::mutex> import_lock(g_import_mutex);
     std::lock_guard<std::mutex> model_lock(s.mutex);
     if (s.loaded) throw std::logic_error("this model is already loaded; call cadclash.load() for a new one");
+    // As `cadclash check --threads N`: cadclash's loops on N threads, OCCT's (BRepMesh meshing a
+    // part's faces at once) on a pool of N. That pool is process-wide, so every load sets it, under
+    // the import lock: only loads mesh on it (lazy tessellation meshes a face on the calling thread).
+    const CallThreads call_threads(a.threads);
+    limit_mesher_threads(a.threads > 0 && a.threads < omp_get_num_procs() ? a.threads : 0);
     ImportResult r = import_files(a.paths, options);
     diagnostics = std::move(r.diagnostics);
     complete = r.complete;
@@ -147,15 +181,15 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate, double time_limit, double model_tolerance, std::string cache) {
+             bool planar, bool isolate, double time_limit, double model_tolerance, std::string cache, int threads) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
                                fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance,
-                               std::move(cache)});
+                               std::move(cache), threads});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
           pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"),
-          pyb::arg("cache"))
+          pyb::arg("cache"), pyb::arg("threads"))
       .def("_counts",
            [](const ModelCore& c) {
              const Model& md = c.state->model;  // sizes never change after load
@@ -224,8 +258,9 @@ void bind_model(pyb::module_& m) {
           },
           pyb::arg("id"), pyb::arg("tessellate") = true)
       .def("_tessellate",
-           [](ModelCore& c, std::vector<std::int64_t> ids, double deflection) {
+           [](ModelCore& c, std::vector<std::int64_t> ids, double deflection, int threads) {
              ModelState& st = *c.state;
+             checked_threads(threads);
              std::vector<SurfaceId> list;
              for (std::int64_t id : ids) {
                surface_at(st, id);
@@ -234,7 +269,7 @@ void bind_model(pyb::module_& m) {
              std::vector<Diagnostic> ds;
              {
                ModelLock lock(st);
-               ds = require_triangles(st.model, list, deflection);
+               ds = require_triangles(st.model, list, deflection, threads);
              }
              return diagnostics_to_list(ds);
            })

@@ -39,6 +39,10 @@ TEST(MesherThreads, OcctLoopsRunOnTheThreadsAsked) {
   if (cores >= 2) {
     EXPECT_EQ(most, 2);  // sleeping iterations on two threads overlap
   }
+  // 0: back on OCCT's default, TBB's scheduler on every core.
+  EXPECT_EQ(cadclash::limit_mesher_threads(0), OSD_Parallel::NbLogicalProcessors());
+  EXPECT_FALSE(OSD_Parallel::ToUseOcctThreads());
+  EXPECT_EQ(most_at_once(), std::min(OSD_Parallel::NbLogicalProcessors(), 32));
 }
 
 }  // namespace

@@ -52,10 +52,11 @@ struct TessellationOptions {
 
 // Caps the threads OCCT's own parallel loops use in this process (BRepMesh meshing a part's faces
 // at once: TessellationOptions::parallel) at `threads`: they then run on OCCT's thread pool of that
-// size instead of TBB's, which takes every core. Process-wide, like omp_set_num_threads, which caps
-// cadclash's own loops (files read at once, parts meshed at once, lazy tessellation); a program that
-// wants a whole run on N cores calls both, before importing and from one thread (`cadclash check
-// --threads N` does). Returns the pool's thread count. Precondition: threads >= 1; no meshing runs.
+// size instead of TBB's, which takes every core. Process-wide; cadclash's own loops (files read at
+// once, parts meshed at once, lazy tessellation) follow omp_set_num_threads of the thread that starts
+// them. A program that wants a whole run on N cores calls both, before importing and from the thread
+// that imports (`cadclash check --threads N` does; so does the Python load(threads=N)). threads == 0 puts them back on OCCT's default (TBB, every core). Returns the
+// threads they now run on. Precondition: threads >= 0; no meshing runs.
 int limit_mesher_threads(int threads);
 
 // Named settings a user understands, like Mayo's and FreeCAD's mesh quality choices.
