@@ -38,7 +38,9 @@ Share share(const Core& core, const std::array<Vec3, 3>& t) {
   const Vec3 n = normal_of(t[0], t[1], t[2]);
   const double len = n.norm();
   const Vec3 r0 = core.rho(t[0]), r1 = core.rho(t[1]), r2 = core.rho(t[2]);
-  s.hi = std::max({r0.norm(), r1.norm(), r2.norm()});
+  // The largest norm, with one square root: sqrt is correctly rounded, so monotone, and this is the
+  // value of max(r0.norm(), r1.norm(), r2.norm()) to the bit.
+  s.hi = std::sqrt(std::max({r0.squaredNorm(), r1.squaredNorm(), r2.squaredNorm()}));
   if (len > 0.0 && s.hi > 0.0) {
     // u·ρ is linear over the triangle, so on a side where it stays positive it bounds |ρ| = r from
     // below there too: r's minimum without a point–triangle distance.
@@ -77,6 +79,21 @@ double over_curved(const Share& y, double lo_x, double hi_x, double slack) {
   return std::min(outward, inward);
 }
 
+// Triangles per side a plane core's shell is first sampled with (bound_for).
+constexpr std::size_t kSampleShell = 32;
+
+// The range of the heights over a plane core of the vertices of every `stride`-th triangle.
+std::pair<double, double> height_range(const Core& core, const std::vector<std::array<Vec3, 3>>& ts,
+                                       std::size_t stride) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;  // in registers, not an array's slots
+  for (std::size_t i = 0; i < ts.size(); i += stride)
+    for (const Vec3& v : ts[i]) {
+      const double h = core.dir.dot(v) - core.offset;
+      lo = std::min(lo, h), hi = std::max(hi, h);
+    }
+  return {lo, hi};
+}
+
 // c of a triangle for a plane core, as share() computes it.
 double plane_c(const Core& core, const std::array<Vec3, 3>& t) {
   const Vec3 n = normal_of(t[0], t[1], t[2]);
@@ -105,17 +122,17 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
   if (core.kind == Core::Plane) {
     // The shell of a plane is its vertices' heights (r of share()): a shell too thick for the level
     // (the common case for a plane that is not a contact's) is known without the triangles' normals.
-    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    double hi[2] = {-lo[0], -lo[1]};
-    for (int side = 0; side < 2; ++side)
-      for (const auto& t : side == 0 ? ta : tb)
-        for (const Vec3& v : t) {
-          const double h = core.dir.dot(v) - core.offset;
-          lo[side] = std::min(lo[side], h), hi[side] = std::max(hi[side], h);
-        }
-    const double d = std::min(std::max(0.0, hi[0] - lo[1]), std::max(0.0, hi[1] - lo[0])) + 2.0 * slack;
-    const double kappa = d / room * grow;  // a triangle is steep below this
-    if (!(kappa < 1.0)) return std::nullopt;
+    // kappa only grows with the triangles taken (their heights' range widens), so when a sample of
+    // both sides already gives kappa >= 1 so do all of them: that answer costs the sample alone.
+    double kappa = 0.0;
+    for (const std::size_t stride : {std::max<std::size_t>(1, std::max(ta.size(), tb.size()) / kSampleShell), std::size_t{1}}) {
+      const auto [lo_a, hi_a] = height_range(core, ta, stride);
+      const auto [lo_b, hi_b] = height_range(core, tb, stride);
+      const double d = std::min(std::max(0.0, hi_a - lo_b), std::max(0.0, hi_b - lo_a)) + 2.0 * slack;
+      kappa = d / room * grow;  // a triangle is steep below this
+      if (!(kappa < 1.0)) return std::nullopt;
+      if (stride == 1) break;
+    }
     for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(plane_c(core, ta[i]) >= kappa)) != 0;
     if (!any_a) return certified();
     b.steep_b.resize(tb.size());
