@@ -124,15 +124,16 @@ std::optional<CrossingBound> bound_for(const Core& core, const std::vector<std::
     // (the common case for a plane that is not a contact's) is known without the triangles' normals.
     // kappa only grows with the triangles taken (their heights' range widens), so when a sample of
     // both sides already gives kappa >= 1 so do all of them: that answer costs the sample alone.
-    double kappa = 0.0;
-    for (const std::size_t stride : {std::max<std::size_t>(1, std::max(ta.size(), tb.size()) / kSampleShell), std::size_t{1}}) {
+    auto kappa_of = [&](std::size_t stride) {  // a triangle is steep below this
       const auto [lo_a, hi_a] = height_range(core, ta, stride);
       const auto [lo_b, hi_b] = height_range(core, tb, stride);
       const double d = std::min(std::max(0.0, hi_a - lo_b), std::max(0.0, hi_b - lo_a)) + 2.0 * slack;
-      kappa = d / room * grow;  // a triangle is steep below this
-      if (!(kappa < 1.0)) return std::nullopt;
-      if (stride == 1) break;
-    }
+      return d / room * grow;
+    };
+    const std::size_t sample = std::max(ta.size(), tb.size()) / kSampleShell;
+    if (sample > 1 && !(kappa_of(sample) < 1.0)) return std::nullopt;
+    const double kappa = kappa_of(1);
+    if (!(kappa < 1.0)) return std::nullopt;
     for (std::size_t i = 0; i < ta.size(); ++i) any_a |= (b.steep_a[i] = !(plane_c(core, ta[i]) >= kappa)) != 0;
     if (!any_a) return certified();
     b.steep_b.resize(tb.size());
