@@ -16,8 +16,7 @@ namespace cadclash::cli {
 void hold_threads(int threads) {
   if (threads <= 0) return;
   omp_set_num_threads(threads);
-  // As1 at 0.001 mm on 2 cores: BRepMesh on OCCT's pool of 2 in 0.48-0.56 s, on TBB's in 0.39 s.
-  if (threads < omp_get_num_procs()) limit_mesher_threads(threads);
+  hold_mesher_threads(threads);
 }
 
 void add_threads_option(CLI::App& cmd, int& threads, const std::string& what) {

@@ -42,8 +42,8 @@ void add_input_options(CLI::App& cmd, InputOptions& in);
 
 // Holds this process to `threads` threads (0 = every core), the whole run and not only a query: the
 // import's loops (files read at once, parts meshed at once, lazy tessellation) through
-// omp_set_num_threads, and BRepMesh's own through limit_mesher_threads when `threads` is below the
-// machine's cores (OCCT's pool meshes slower than TBB's, so only then). Call before importing.
+// omp_set_num_threads, and BRepMesh's own through hold_mesher_threads (tessellate.h). Call before
+// importing.
 void hold_threads(int threads);
 // Adds --threads N (0 = every core) to `cmd`, bound to `threads`; `what` says what it covers.
 void add_threads_option(CLI::App& cmd, int& threads, const std::string& what);

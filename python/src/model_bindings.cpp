@@ -100,10 +100,11 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
     std::lock_guard<std::mutex> model_lock(s.mutex);
     if (s.loaded) throw std::logic_error("this model is already loaded; call cadclash.load() for a new one");
     // As `cadclash check --threads N`: cadclash's loops on N threads, OCCT's (BRepMesh meshing a
-    // part's faces at once) on a pool of N. That pool is process-wide, so every load sets it, under
-    // the import lock: only loads mesh on it (lazy tessellation meshes a face on the calling thread).
+    // part's faces at once) held to N. That setting is process-wide, so every load makes it, under
+    // the import lock: only loads mesh on OCCT's threads (lazy tessellation meshes a face on the
+    // calling thread).
     const CallThreads call_threads(a.threads);
-    limit_mesher_threads(a.threads > 0 && a.threads < omp_get_num_procs() ? a.threads : 0);
+    hold_mesher_threads(a.threads);
     ImportResult r = import_files(a.paths, options);
     diagnostics = std::move(r.diagnostics);
     complete = r.complete;

@@ -1,4 +1,5 @@
-// limit_mesher_threads: OCCT's parallel loops on a pool of a given size, or back on every core (tessellate.h).
+// limit_mesher_threads, hold_mesher_threads: OCCT's parallel loops on a pool of a given size, or on
+// every core (tessellate.h).
 #include "cadclash/tessellate.h"
 
 #include <OSD_Parallel.hxx>
@@ -22,6 +23,11 @@ int limit_mesher_threads(int threads) {
   if (pool->NbThreads() != threads) pool->Init(threads);
   pool->SetNbDefaultThreadsToLaunch(threads);
   return pool->NbThreads();
+}
+
+int hold_mesher_threads(int threads) {
+  assert(threads >= 0);
+  return limit_mesher_threads(threads < OSD_Parallel::NbLogicalProcessors() ? threads : 0);
 }
 
 }  // namespace cadclash

@@ -45,4 +45,15 @@ TEST(MesherThreads, OcctLoopsRunOnTheThreadsAsked) {
   EXPECT_EQ(most_at_once(), std::min(OSD_Parallel::NbLogicalProcessors(), 32));
 }
 
+// A whole run on N threads: OCCT's pool of N below the machine's cores, TBB's (every core) from there.
+TEST(MesherThreads, HoldForARunPoolsOnlyBelowTheCores) {
+  const int cores = OSD_Parallel::NbLogicalProcessors();
+  EXPECT_EQ(cadclash::hold_mesher_threads(1), 1);
+  EXPECT_EQ(OSD_Parallel::ToUseOcctThreads(), cores > 1);
+  EXPECT_EQ(cadclash::hold_mesher_threads(cores), cores);
+  EXPECT_FALSE(OSD_Parallel::ToUseOcctThreads());
+  EXPECT_EQ(cadclash::hold_mesher_threads(0), cores);
+  EXPECT_FALSE(OSD_Parallel::ToUseOcctThreads());
+}
+
 }  // namespace
