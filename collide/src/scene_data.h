@@ -10,6 +10,7 @@
 #include "refine.h"
 #include "instance_tree.h"
 #include "surface_bvh.h"
+#include "task_costs.h"
 
 #include <array>
 #include <chrono>
@@ -78,6 +79,7 @@ struct SceneData {
   // count): kept as trees are built and released, so Scene::memory() does not walk every surface.
   SceneMemory held;
   FirstNeed first_need;  // of the running query (QueryState)
+  TaskCosts task_costs;  // what the last check's triangle-level tasks took (stage_triangles.cpp)
 
   SceneData(Model& m, SceneSelection sel);
 

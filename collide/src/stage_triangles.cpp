@@ -3,6 +3,7 @@
 // remaining items are skipped and marked cut (an OpenMP loop cannot break).
 #include "decide.h"
 #include "scene_stages.h"
+#include "task_costs.h"
 #include "team_loop.h"
 
 #include "cadclash/internal/progress_meter.h"
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cassert>
+#include <chrono>
 #include <functional>
 
 namespace cadclash::detail {
@@ -82,14 +84,28 @@ bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::uint64_t& by
   return true;
 }
 
-void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes,
+void run_v1(SceneData& s, QueryState& q, std::size_t ntasks, std::vector<std::uint64_t>& bytes,
             const std::function<void(std::size_t)>& after) {
   const auto n = static_cast<std::ptrdiff_t>(ntasks);
   PairsThrough through(q, ntasks, [&](std::size_t k) { return q.tasks[k].pair; });
-  // Guided gives a thread half of the items at its first request: with a handful of items that is
-  // half the work on one thread (collide.h, Schedule), so a short loop takes them one at a time.
-  const bool few = n < kFewItems && q.o.schedule == Schedule::Guided;
   const bool team = use_team(n, q.threads, n >= kMinParallel);
+  // Guided gives a thread half of the items at its first request: with a handful of items that is
+  // half the work on one thread (collide.h, Schedule), so a short loop on a team takes them one at a
+  // time, the tasks the last check found longest first (task_costs.h), each timed for the next
+  // check. The loop's answers do not depend on the order.
+  const bool few = team && n < kFewItems && q.o.schedule == Schedule::Guided;
+  std::vector<TaskCosts::Key> keys;
+  std::vector<std::uint32_t> order;
+  std::vector<float> took;
+  if (few) {
+    keys.resize(ntasks);
+    for (std::size_t k = 0; k < ntasks; ++k) {
+      const Task& t = q.tasks[k];
+      keys[k] = TaskCosts::key(q.pairs[t.pair].a, q.pairs[t.pair].b, t.sa, t.sb);
+    }
+    order = s.task_costs.longest_first(keys);
+    took.assign(ntasks, 0.0F);
+  }
   // The region's body: for a team, or for the calling thread alone (team_loop.h: a region with a
   // false if clause still starts a team of one).
   auto run = [&] {
@@ -120,7 +136,12 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
       for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
     } else if (few) {
 #pragma omp for schedule(dynamic, 1)
-      for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
+      for (std::ptrdiff_t i = 0; i < n; ++i) {
+        const std::size_t k = order[static_cast<std::size_t>(i)];
+        const auto t0 = std::chrono::steady_clock::now();
+        one(k);
+        took[k] = std::chrono::duration<float>(std::chrono::steady_clock::now() - t0).count();
+      }
     } else {
 #pragma omp for schedule(runtime)
       for (std::ptrdiff_t k = 0; k < n; ++k) one(static_cast<std::size_t>(k));
@@ -132,6 +153,7 @@ void run_v1(const SceneData& s, QueryState& q, std::size_t ntasks, std::vector<s
   } else {
     run();
   }
+  if (few) s.task_costs.remember(keys, took);
   through.finish();
 }
 
