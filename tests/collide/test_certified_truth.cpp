@@ -482,6 +482,42 @@ TEST(CertifiedDeterminism, DecisionsRightAfterTheTrianglesEqualTheStagesInTurn) 
         }
 }
 
+// A nut moving over the plate, checked by one Scene per thread count (only the pairs with the nut):
+// each check has a handful of surface pairs, which a team starts longest first by the times of the
+// scene's last check (stage_triangles.cpp, TaskCosts). The order must never show in a report.
+TEST(CertifiedDeterminism, APathStepByStepOnOneAndTwoThreads) {
+  REQUIRE_SAMPLES();
+  ASSERT_TRUE(as1().ok());
+  Model m = as1().model;
+  InstanceId nut = kInvalidId;
+  for (InstanceId i = 0; i < m.instances.size(); ++i)
+    if (m.instances[i].path == kNut) nut = i;
+  ASSERT_NE(nut, kInvalidId);
+  SceneSelection only_nut;
+  only_nut.set_a = {nut};
+  Scene one(m, only_nut), two(m, only_nut);
+  CollideOptions o1, o2;
+  o1.threads = 1;
+  o2.threads = 2;
+  // Seated, lifted off by less and more than the tolerance, pressed in, seated again (the costs of a
+  // check then come from a different placement), then lifted clear of the plate.
+  std::size_t steps = 0;
+  for (double d : {0.0, 0.005, 0.02, -0.002, 0.0, 0.05, 0.5}) {
+    const Pose pose = d == 0.0 ? m.instances[nut].pose
+                               : truth::as1_moved(as1(), kNut, kPlate, std::abs(d)).model.instances[nut].pose;
+    Pose placed = pose;
+    if (d < 0.0) placed.translation() = 2.0 * m.instances[nut].pose.translation() - pose.translation();
+    one.set_pose(nut, placed);
+    two.set_pose(nut, placed);
+    const Report r1 = one.check(o1), r2 = two.check(o2);
+    const std::string what = "nut moved " + std::to_string(d) + " mm";
+    EXPECT_EQ(serialize(r1), serialize(r2)) << what;
+    EXPECT_FALSE(r1.pairs.empty()) << what;
+    steps += r2.counters.surface_pairs >= 4 && r2.counters.surface_pairs < 64;
+  }
+  EXPECT_GE(steps, 5u) << "the steps must hold a handful of surface pairs (the team's short loop)";
+}
+
 // OCCT 7.6's face-face distance misses the minimum of these B-spline half-cylinders: 0.0394 mm,
 // while both faces meshed at 0.0005 mm intersect. A BRepExtrema value is therefore only an upper
 // bound in the decision: the certified check reports the pair in contact (proved by a witness vertex
