@@ -157,7 +157,8 @@ const char* parallel_version_name(ParallelVersion v);
 // The OpenMP schedule of the candidate-pair loop. Guided (the paper's) hands a thread half of the
 // items left at its first request; for a loop of fewer than 64 candidate pairs, where a few items
 // may hold most of the work (a part moving through a scene), Guided runs as Dynamic with chunks of
-// one instead. The report is the same for every schedule.
+// one instead, the pairs a Scene's previous check took longest first (by their measured times).
+// The report is the same for every schedule and order.
 enum class Schedule : std::uint8_t { Guided, Dynamic, Static };
 // Returns "guided", "dynamic" or "static".
 const char* schedule_name(Schedule s);
