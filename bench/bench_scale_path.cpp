@@ -222,7 +222,12 @@ int main(int argc, char** argv) {
     std::uint32_t copies = 0;
     std::size_t instance_triangles = 0, pairs = 0;
     double seconds[2] = {0.0, 0.0};
+    double second_cpu = 0.0;  // the lower of second_cpu_share() before and after the two checks
+    int attempt = 1;
   };
+  // A size whose checks the host disturbed (it took a vCPU for a while) is timed again, at most
+  // this often (second_cpu_share, compare_workload.h).
+  constexpr int kSizeAttempts = 3;
   std::vector<OneShot> series;
   for (std::uint32_t c : {1u, 3u, 10u, 30u, 100u, copies}) {
     if (c > copies || (!series.empty() && series.back().copies >= c)) continue;
@@ -230,18 +235,27 @@ int main(int argc, char** argv) {
     OneShot row;
     row.copies = c;
     row.instance_triangles = cb::instance_triangle_count(m);
-    for (int threads : {1, 2}) {
-      Scene scene(m);
-      scene.build_hierarchies(threads);
-      CollideOptions o;
-      o.threads = threads;
-      const auto t0 = std::chrono::steady_clock::now();
-      const Report r = scene.check(o);
-      row.seconds[threads - 1] = seconds_since(t0);
-      row.pairs = r.pairs.size();
-      j["one_shot"][std::to_string(c)][std::to_string(threads)] = {
-          {"seconds", row.seconds[threads - 1]}, {"pairs", r.pairs.size()}, {"counters", counters_json(r.counters)}};
-      std::fprintf(stderr, "one-shot, %u copies, %d thread(s): %.3f s\n", c, threads, row.seconds[threads - 1]);
+    for (row.attempt = 1;; ++row.attempt) {
+      const double before = cb::second_cpu_share();
+      for (int threads : {1, 2}) {
+        Scene scene(m);
+        scene.build_hierarchies(threads);
+        CollideOptions o;
+        o.threads = threads;
+        const auto t0 = std::chrono::steady_clock::now();
+        const Report r = scene.check(o);
+        row.seconds[threads - 1] = seconds_since(t0);
+        row.pairs = r.pairs.size();
+        j["one_shot"][std::to_string(c)][std::to_string(threads)] = {
+            {"seconds", row.seconds[threads - 1]}, {"pairs", r.pairs.size()}, {"counters", counters_json(r.counters)}};
+        std::fprintf(stderr, "one-shot, %u copies, %d thread(s): %.3f s\n", c, threads, row.seconds[threads - 1]);
+      }
+      row.second_cpu = std::min(before, cb::second_cpu_share());
+      j["one_shot"][std::to_string(c)]["second_cpu_share"] = row.second_cpu;
+      j["one_shot"][std::to_string(c)]["attempt"] = row.attempt;
+      if (row.second_cpu >= cb::kFullSecondCpu || row.attempt == kSizeAttempts) break;
+      std::fprintf(stderr, "one-shot, %u copies: the host took a vCPU (second CPU share %.2f): again\n", c,
+                   row.second_cpu);
     }
     series.push_back(row);
   }
@@ -396,14 +410,17 @@ int main(int argc, char** argv) {
   line("");
 
   line("One-shot query time by scene size (the same grid with fewer copies; parallel efficiency = "
-       "time on 1 thread / (2 x time on 2 threads)):");
+       "time on 1 thread / (2 x time on 2 threads); second CPU share = the lower of second_cpu_share() before and "
+       "after the size's two checks, which are timed again, up to " + std::to_string(kSizeAttempts) +
+       " times, while it is below " + fmt("%.1f", cb::kFullSecondCpu) + "):");
   line("");
-  line("| copies | instance triangles | reported pairs | 1 thread | 2 threads | parallel efficiency |");
-  line("|---:|---:|---:|---:|---:|---:|");
+  line("| copies | instance triangles | reported pairs | 1 thread | 2 threads | parallel efficiency | second CPU share (run) |");
+  line("|---:|---:|---:|---:|---:|---:|---:|");
   for (const OneShot& r : series)
     line("| " + std::to_string(r.copies) + " | " + std::to_string(r.instance_triangles) + " | " +
          std::to_string(r.pairs) + " | " + fmt("%.3f s", r.seconds[0]) + " | " + fmt("%.3f s", r.seconds[1]) + " | " +
-         fmt("%.0f %%", 100.0 * r.seconds[0] / (2.0 * r.seconds[1])) + " |");
+         fmt("%.0f %%", 100.0 * r.seconds[0] / (2.0 * r.seconds[1])) + " | " + fmt("%.2f", r.second_cpu) + " (" +
+         std::to_string(r.attempt) + ") |");
   line("");
 
   // Table 2 on the as1 assembly alone: the same path, OAABB vs brute force, every 10th step.

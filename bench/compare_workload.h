@@ -117,4 +117,15 @@ double core_round_trip_ns(int trips = 20000);
 // Round trips above this are "far" cores: this 2-vCPU machine reads 50-140 ns or 330-500 ns.
 constexpr double kFarCoresNs = 200.0;
 
+// How much of a second CPU the host gives the process now: one thread's time for a fixed compute
+// loop (~20 ms, registers only) over the slower thread's time when the OpenMP team's two threads run
+// it at once; the median of three. ~1.0 when both vCPUs are ours; the host running other work on
+// one of them for stretches (which took a 2-thread row from half of the 1-thread row to 3/4 of it
+// here) reads well below. It measures the host, not cadclash: benchmarks use it to run a table again
+// when the host took a vCPU, never to choose between their own timings.
+double second_cpu_share();
+
+// second_cpu_share() at or above this: the host gave both vCPUs.
+constexpr double kFullSecondCpu = 0.9;
+
 }  // namespace cadclash::bench
