@@ -358,7 +358,7 @@ std::string markdown(const std::vector<WorkloadResult>& results, const Settings&
                                                                                   : "were near each other")
          << "; see the parallel-efficiency notes).\n\n";
     if (r.second_cpu_before > 0.0)
-      md << (host_gave_both(r) ? "The host gave both vCPUs before and after the rows"
+      md << (host_gave_both(r) ? "A compute loop ran on both vCPUs at once at full speed before and after the rows"
                                : "**The host took one vCPU for a while: timings disturbed**")
          << " (second CPU share " << fmt("%.2f", r.second_cpu_before) << " / " << fmt("%.2f", r.second_cpu_after)
          << (r.attempt > 1 ? "; run " + std::to_string(r.attempt) + " of the table, the earlier ones disturbed" : std::string())
