@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
     double second_cpu = 0.0;  // the lower of second_cpu_share() before and after the two checks
     int attempt = 1;
   };
-  // A size whose checks the host disturbed (it took a vCPU for a while) is timed again, at most
+  // A size whose checks the host disturbed by taking a vCPU for a while is timed again, at most
   // this often (second_cpu_share, compare_workload.h).
   constexpr int kSizeAttempts = 3;
   std::vector<OneShot> series;

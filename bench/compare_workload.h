@@ -120,9 +120,10 @@ constexpr double kFarCoresNs = 200.0;
 // How much of a second CPU the host gives the process now: one thread's time for a fixed compute
 // loop (~20 ms, registers only) over the slower thread's time when the OpenMP team's two threads run
 // it at once; the median of three. ~1.0 when both vCPUs are ours; the host running other work on
-// one of them for stretches (which took a 2-thread row from half of the 1-thread row to 3/4 of it
-// here) reads well below. It measures the host, not cadclash: benchmarks use it to run a table again
-// when the host took a vCPU, never to choose between their own timings.
+// one of them reads well below. It sees only that, not other tenants' load on the shared caches and
+// memory (which slowed 1- and 2-thread rows here while this read 0.97-1.01). It measures the host,
+// not cadclash: benchmarks use it to run a table again when the host took a vCPU, never to choose
+// between their own timings.
 double second_cpu_share();
 
 // second_cpu_share() at or above this: the host gave both vCPUs.
