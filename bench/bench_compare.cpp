@@ -272,18 +272,10 @@ struct WorkloadResult {
   // Core-to-core round trip (ns) before the first row and after the last: where the host had the
   // two vCPUs while this table ran (compare_workload.h).
   double round_trip_before = 0.0, round_trip_after = 0.0;
-  // How much of a second CPU the host gave before the first row and after the last
-  // (second_cpu_share, compare_workload.h; 0: not measured), and in which run of the table.
-  double second_cpu_before = 0.0, second_cpu_after = 0.0;
-  int attempt = 1;
+  // How much of a second CPU the host gave before the first row and after the last, and in which
+  // run of the table (compare_workload.h, until_host_gave_both).
+  cb::HostCheck host;
 };
-
-// A table whose rows the host disturbed (it took a vCPU for a while) runs again, at most this often.
-constexpr int kTableAttempts = 3;
-
-bool host_gave_both(const WorkloadResult& r) {
-  return std::min(r.second_cpu_before, r.second_cpu_after) >= cb::kFullSecondCpu;
-}
 
 void finish(WorkloadResult& r) {
   // Ratios against the default row on the same subset; agreement against the whole-workload default
@@ -348,7 +340,7 @@ std::string markdown(const std::vector<WorkloadResult>& results, const Settings&
      << "[subset] rows ran on the instances named under the table. "
      << "Before and after each table a fixed compute loop runs on one thread, then on both at once: when the slower "
      << "of the two ran below " << fmt("%.1f", cb::kFullSecondCpu) << " of one thread's speed (the host was "
-     << "running other work on a vCPU), the whole table runs again, at most " << kTableAttempts << " times.\n\n";
+     << "running other work on a vCPU), the whole table runs again, at most " << cb::kHostAttempts << " times.\n\n";
   for (const WorkloadResult& r : results) {
     md << "## " << r.w.name << "\n\n" << r.description << "\n\n";
     if (r.round_trip_before > 0.0)
@@ -357,11 +349,12 @@ std::string markdown(const std::vector<WorkloadResult>& results, const Settings&
          << (std::max(r.round_trip_before, r.round_trip_after) >= cb::kFarCoresNs ? "were far apart for part of it"
                                                                                   : "were near each other")
          << "; see the parallel-efficiency notes).\n\n";
-    if (r.second_cpu_before > 0.0)
-      md << (host_gave_both(r) ? "A compute loop ran on both vCPUs at once at full speed before and after the rows"
-                               : "**The host took one vCPU for a while: timings disturbed**")
-         << " (second CPU share " << fmt("%.2f", r.second_cpu_before) << " / " << fmt("%.2f", r.second_cpu_after)
-         << (r.attempt > 1 ? "; run " + std::to_string(r.attempt) + " of the table, the earlier ones disturbed" : std::string())
+    if (r.host.attempt > 0)
+      md << (r.host.gave_both() ? "A compute loop ran on both vCPUs at once at full speed before and after the rows"
+                                : "**The host took one vCPU for a while: timings disturbed**")
+         << " (second CPU share " << fmt("%.2f", r.host.before) << " / " << fmt("%.2f", r.host.after)
+         << (r.host.attempt > 1 ? "; run " + std::to_string(r.host.attempt) + " of the table, the earlier ones disturbed"
+                                : std::string())
          << ").\n\n";
     if (!r.subset_note.empty()) md << "[subset]: " << r.subset_note << "\n\n";
     md << "| method | median time | reps | ratio | triangle tests | exact fallbacks | surface pairs | agreement (both/only cadclash/only method) | build | bytes/triangle |\n"
@@ -399,8 +392,8 @@ nlohmann::json json_of(const std::vector<WorkloadResult>& results, const Setting
     nlohmann::json w;
     w["name"] = r.w.name;
     w["round_trip_ns"] = {r.round_trip_before, r.round_trip_after};
-    w["second_cpu_share"] = {r.second_cpu_before, r.second_cpu_after};
-    w["table_attempt"] = r.attempt;
+    w["second_cpu_share"] = {r.host.before, r.host.after};
+    w["table_attempt"] = r.host.attempt;
     w["description"] = r.description;
     w["deflection"] = r.w.deflection;
     w["instances"] = r.w.model->instances.size();
@@ -550,27 +543,27 @@ int main(int argc, char** argv) {
     WorkloadResult& r = results[k];
     r.instance_triangles = cb::instance_triangle_count(*r.w.model);
     r.part_triangles = cadclash::triangle_count(*r.w.model);
-    for (r.attempt = 1;; ++r.attempt) {
-      r.rows.clear();
-      r.second_cpu_before = cb::second_cpu_share();
-      r.round_trip_before = cb::core_round_trip_ns();
-      for (Method& m : methods_for(r.w, s.threads, r.subset, slow[k])) {
-        Row row;
-        row.method = std::move(m);
-        std::fprintf(stderr, "[%s] %s ...", r.w.name.c_str(), row.method.name.c_str());
-        const auto t0 = std::chrono::steady_clock::now();
-        if (row.method.is_cadclash) run_cadclash(s, r.w, row);
-        else run_peer(s, r.w, row);
-        std::fprintf(stderr, " %.2f s (%zu reps, %zu pairs)%s%s\n", seconds_since(t0), row.times.size(),
-                     row.found.size(), row.error.empty() ? "" : " not run: ", row.error.c_str());
-        r.rows.push_back(std::move(row));
-      }
-      r.round_trip_after = cb::core_round_trip_ns();
-      r.second_cpu_after = cb::second_cpu_share();
-      if (host_gave_both(r) || r.attempt == kTableAttempts) break;
-      std::fprintf(stderr, "[%s] the host took a vCPU during the rows (second CPU share %.2f / %.2f): the table again\n",
-                   r.w.name.c_str(), r.second_cpu_before, r.second_cpu_after);
-    }
+    r.host = cb::until_host_gave_both(
+        [&] {
+          r.rows.clear();
+          r.round_trip_before = cb::core_round_trip_ns();
+          for (Method& m : methods_for(r.w, s.threads, r.subset, slow[k])) {
+            Row row;
+            row.method = std::move(m);
+            std::fprintf(stderr, "[%s] %s ...", r.w.name.c_str(), row.method.name.c_str());
+            const auto t0 = std::chrono::steady_clock::now();
+            if (row.method.is_cadclash) run_cadclash(s, r.w, row);
+            else run_peer(s, r.w, row);
+            std::fprintf(stderr, " %.2f s (%zu reps, %zu pairs)%s%s\n", seconds_since(t0), row.times.size(),
+                         row.found.size(), row.error.empty() ? "" : " not run: ", row.error.c_str());
+            r.rows.push_back(std::move(row));
+          }
+          r.round_trip_after = cb::core_round_trip_ns();
+        },
+        [&](const cb::HostCheck& h) {
+          std::fprintf(stderr, "[%s] the host took a vCPU during the rows (second CPU share %.2f / %.2f): the table again\n",
+                       r.w.name.c_str(), h.before, h.after);
+        });
     finish(r);
   }
 

@@ -222,12 +222,8 @@ int main(int argc, char** argv) {
     std::uint32_t copies = 0;
     std::size_t instance_triangles = 0, pairs = 0;
     double seconds[2] = {0.0, 0.0};
-    double second_cpu = 0.0;  // the lower of second_cpu_share() before and after the two checks
-    int attempt = 1;
+    cb::HostCheck host;  // around the two checks (compare_workload.h, until_host_gave_both)
   };
-  // A size whose checks the host disturbed by taking a vCPU for a while is timed again, at most
-  // this often (second_cpu_share, compare_workload.h).
-  constexpr int kSizeAttempts = 3;
   std::vector<OneShot> series;
   for (std::uint32_t c : {1u, 3u, 10u, 30u, 100u, copies}) {
     if (c > copies || (!series.empty() && series.back().copies >= c)) continue;
@@ -235,28 +231,28 @@ int main(int argc, char** argv) {
     OneShot row;
     row.copies = c;
     row.instance_triangles = cb::instance_triangle_count(m);
-    for (row.attempt = 1;; ++row.attempt) {
-      const double before = cb::second_cpu_share();
-      for (int threads : {1, 2}) {
-        Scene scene(m);
-        scene.build_hierarchies(threads);
-        CollideOptions o;
-        o.threads = threads;
-        const auto t0 = std::chrono::steady_clock::now();
-        const Report r = scene.check(o);
-        row.seconds[threads - 1] = seconds_since(t0);
-        row.pairs = r.pairs.size();
-        j["one_shot"][std::to_string(c)][std::to_string(threads)] = {
-            {"seconds", row.seconds[threads - 1]}, {"pairs", r.pairs.size()}, {"counters", counters_json(r.counters)}};
-        std::fprintf(stderr, "one-shot, %u copies, %d thread(s): %.3f s\n", c, threads, row.seconds[threads - 1]);
-      }
-      row.second_cpu = std::min(before, cb::second_cpu_share());
-      j["one_shot"][std::to_string(c)]["second_cpu_share"] = row.second_cpu;
-      j["one_shot"][std::to_string(c)]["attempt"] = row.attempt;
-      if (row.second_cpu >= cb::kFullSecondCpu || row.attempt == kSizeAttempts) break;
-      std::fprintf(stderr, "one-shot, %u copies: the host took a vCPU (second CPU share %.2f): again\n", c,
-                   row.second_cpu);
-    }
+    row.host = cb::until_host_gave_both(
+        [&] {
+          for (int threads : {1, 2}) {
+            Scene scene(m);
+            scene.build_hierarchies(threads);
+            CollideOptions o;
+            o.threads = threads;
+            const auto t0 = std::chrono::steady_clock::now();
+            const Report r = scene.check(o);
+            row.seconds[threads - 1] = seconds_since(t0);
+            row.pairs = r.pairs.size();
+            j["one_shot"][std::to_string(c)][std::to_string(threads)] = {
+                {"seconds", row.seconds[threads - 1]}, {"pairs", r.pairs.size()}, {"counters", counters_json(r.counters)}};
+            std::fprintf(stderr, "one-shot, %u copies, %d thread(s): %.3f s\n", c, threads, row.seconds[threads - 1]);
+          }
+        },
+        [&](const cb::HostCheck& h) {
+          std::fprintf(stderr, "one-shot, %u copies: the host took a vCPU (second CPU share %.2f / %.2f): again\n", c,
+                       h.before, h.after);
+        });
+    j["one_shot"][std::to_string(c)]["second_cpu_share"] = {row.host.before, row.host.after};
+    j["one_shot"][std::to_string(c)]["attempt"] = row.host.attempt;
     series.push_back(row);
   }
   if (!series_out.empty()) {
@@ -411,7 +407,7 @@ int main(int argc, char** argv) {
 
   line("One-shot query time by scene size (the same grid with fewer copies; parallel efficiency = "
        "time on 1 thread / (2 x time on 2 threads); second CPU share = the lower of second_cpu_share() before and "
-       "after the size's two checks, which are timed again, up to " + std::to_string(kSizeAttempts) +
+       "after the size's two checks, which are timed again, up to " + std::to_string(cb::kHostAttempts) +
        " times, while it is below " + fmt("%.1f", cb::kFullSecondCpu) + "):");
   line("");
   line("| copies | instance triangles | reported pairs | 1 thread | 2 threads | parallel efficiency | second CPU share (run) |");
@@ -419,8 +415,8 @@ int main(int argc, char** argv) {
   for (const OneShot& r : series)
     line("| " + std::to_string(r.copies) + " | " + std::to_string(r.instance_triangles) + " | " +
          std::to_string(r.pairs) + " | " + fmt("%.3f s", r.seconds[0]) + " | " + fmt("%.3f s", r.seconds[1]) + " | " +
-         fmt("%.0f %%", 100.0 * r.seconds[0] / (2.0 * r.seconds[1])) + " | " + fmt("%.2f", r.second_cpu) + " (" +
-         std::to_string(r.attempt) + ") |");
+         fmt("%.0f %%", 100.0 * r.seconds[0] / (2.0 * r.seconds[1])) + " | " + fmt("%.2f", std::min(r.host.before, r.host.after)) + " (" +
+         std::to_string(r.host.attempt) + ") |");
   line("");
 
   // Table 2 on the as1 assembly alone: the same path, OAABB vs brute force, every 10th step.

@@ -5,6 +5,7 @@
 
 #include "cadclash/collide.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -128,5 +129,27 @@ double second_cpu_share();
 
 // second_cpu_share() at or above this: the host gave both vCPUs.
 constexpr double kFullSecondCpu = 0.9;
+
+// What second_cpu_share() read before and after something timed, and in which run of it.
+struct HostCheck {
+  double before = 0.0, after = 0.0;  // 0: not measured
+  int attempt = 0;
+  bool gave_both() const { return std::min(before, after) >= kFullSecondCpu; }
+};
+// Runs of a timing the host disturbed by taking a vCPU, at most.
+constexpr int kHostAttempts = 3;
+// Runs timed() between two second_cpu_share() readings until they say the host gave both vCPUs,
+// at most kHostAttempts times; again(check) is told of each run that is thrown away.
+template <class Timed, class Again>
+HostCheck until_host_gave_both(Timed&& timed, Again&& again) {
+  HostCheck h;
+  for (h.attempt = 1;; ++h.attempt) {
+    h.before = second_cpu_share();
+    timed();
+    h.after = second_cpu_share();
+    if (h.gave_both() || h.attempt == kHostAttempts) return h;
+    again(h);
+  }
+}
 
 }  // namespace cadclash::bench
