@@ -2,6 +2,7 @@
 // "Certified decisions"). The steps (decide_steps.h) run over the pairs each leaves open, cheapest
 // first, in parallel, each answer depending on its pair alone.
 #include "decide_steps.h"
+#include "scene_data.h"  // add(CollideCounters)
 #include "team_loop.h"
 
 #include <algorithm>
@@ -12,12 +13,17 @@
 namespace cadclash::detail {
 namespace {
 
-// The tasks whose pending state satisfies `keep`, in task order.
+// What early() left of a task, one byte per task (written once by the thread that ran it).
+enum EarlyState : char { kAmbiguous = 1, kAnswered = 2 };
+
+// The tasks still open (not answered by early(), nor settled or cut since) whose pending state
+// satisfies `keep`, in task order. An answered task's pending state is never read: the thread that
+// answered it may hold its cache line.
 template <class Keep>
-std::vector<std::size_t> select(const std::vector<Pending>& pending, Keep keep) {
+std::vector<std::size_t> select(const std::vector<char>& state, const std::vector<Pending>& pending, Keep keep) {
   std::vector<std::size_t> out;
   for (std::size_t k = 0; k < pending.size(); ++k)
-    if (!pending[k].settled && !pending[k].cut && keep(k)) out.push_back(k);
+    if (!(state[k] & kAnswered) && !pending[k].settled && !pending[k].cut && keep(k)) out.push_back(k);
   return out;
 }
 
@@ -63,7 +69,8 @@ struct DecisionRun::Impl {
   const Deadline& deadline;
   std::vector<Pending> pending = std::vector<Pending>(tasks.size());
   std::vector<CollideCounters> task_counters = std::vector<CollideCounters>(tasks.size());
-  std::vector<char> ambiguous = std::vector<char>(tasks.size(), 0);  // open after steps 1 and 2
+  std::vector<char> state = std::vector<char>(tasks.size(), 0);  // EarlyState bits
+  std::vector<DecideResult> answers = std::vector<DecideResult>(tasks.size());
 
   bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
   FaceView view(SurfaceId f) const {
@@ -73,7 +80,7 @@ struct DecisionRun::Impl {
   FaceView finer(SurfaceId f) const { return finer_view(model, bvh, refined, f); }
   // The open pairs that satisfy `keep`.
   template <class Keep>
-  std::vector<std::size_t> open(Keep keep) const { return select(pending, keep); }
+  std::vector<std::size_t> open(Keep keep) const { return select(state, pending, keep); }
   template <class Step>
   void step(const std::vector<std::size_t>& ks, Step s) { run_step(ks, pending, threads, deadline, s); }
 
@@ -81,38 +88,55 @@ struct DecisionRun::Impl {
   // a thread that needs it meanwhile waits. The outline depends on the triangles alone, so which
   // thread makes it changes nothing.
   void need_outline(SurfaceId f) {
-    std::atomic_ref<char> state(outlines.ready[f]);  // 0: not made, 1: made, 2: being made
-    if (state.load(std::memory_order_acquire) == 1) return;
+    std::atomic_ref<char> ready(outlines.ready[f]);  // 0: not made, 1: made, 2: being made
+    if (ready.load(std::memory_order_acquire) == 1) return;
     char expected = 0;
-    if (state.compare_exchange_strong(expected, 2, std::memory_order_acq_rel)) {
+    if (ready.compare_exchange_strong(expected, 2, std::memory_order_acq_rel)) {
       outlines.outline[f] = make_outline(model.surfaces[f].mesh);
-      state.store(1, std::memory_order_release);
+      ready.store(1, std::memory_order_release);
       return;
     }
-    while (state.load(std::memory_order_acquire) != 1) std::this_thread::yield();
+    while (ready.load(std::memory_order_acquire) != 1) std::this_thread::yield();
   }
 
   // Steps 1 to 3c of task k, on the calling thread: each task's answer depends on it alone, so
   // the tasks may run in any order and on any threads. The task's state and counters stay on the
   // thread's stack until it ends (as the triangle level's, stage_triangles.cpp): written once.
+  // A task these steps settle (or cut) is answered here too, with its counts: steps 4 to 6 take
+  // open tasks only, and finish() then only adds the counts up (on 2 threads, reading back every
+  // task's state and result after the loop missed the cache for each task the other thread ran).
   void early(std::size_t k) {
     Pending p;
     CollideCounters c;
-    early(k, p, c);
-    pending[k] = std::move(p);
-    task_counters[k] = c;
+    const bool ambiguous = early(k, p, c);
+    char st = ambiguous ? kAmbiguous : 0;
+    if (p.settled || p.cut) {
+      CollideCounters counts;
+      counts.ambiguous_pairs = ambiguous;
+      answers[k] = answer(k, p, c, counts);
+      task_counters[k] = counts;
+      st |= kAnswered;
+    } else {
+      pending[k] = std::move(p);
+      task_counters[k] = c;
+    }
+    state[k] = st;
   }
-  void early(std::size_t k, Pending& p, CollideCounters& c);
+  // Steps 1 to 3c into p and c; whether steps 1 and 2 left the task open (ambiguous).
+  bool early(std::size_t k, Pending& p, CollideCounters& c);
+  // Task k's answer from its final state p, adding to `counts` the work its steps counted (`steps`)
+  // and what decided it.
+  DecideResult answer(std::size_t k, Pending& p, const CollideCounters& steps, CollideCounters& counts) const;
 };
 
-void DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
+bool DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
   const DecideTask& t = tasks[k];
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
   p = from_mesh(model, eps, t, o);
   const bool certified = o.decision == DecisionMode::Certified;
   if (!p.settled && certified && meshed(k)) analytic(model, eps, t, p, o);
-  ambiguous[k] = !p.settled;
-  if (!certified || p.settled || !meshed(k)) return;
+  const bool ambiguous = !p.settled;
+  if (!certified || p.settled || !meshed(k)) return ambiguous;
   // Steps 2b to 3c: witnesses of contact, each a few point queries, in order until one settles it;
   // each only while the time lasts (a step past the deadline marks the pair cut).
   auto next = [&] {
@@ -120,7 +144,7 @@ void DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
     if (deadline.expired()) p.cut = true;
     return !p.cut;
   };
-  if (!next()) return;
+  if (!next()) return ambiguous;
   need_outline(t.sa);  // step 2b asks the outlines of both surfaces
   need_outline(t.sb);
   const FaceView a = view(t.sa), b = view(t.sb);
@@ -138,6 +162,46 @@ void DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
   if (next()) edge_witness_step(model, poses, t, a, b, p, o, c);
   // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
   if (next()) edge_support_step(model, eps, t, a, b, p, o, c);
+  return ambiguous;
+}
+
+DecideResult DecisionRun::Impl::answer(std::size_t k, Pending& p, const CollideCounters& steps,
+                                       CollideCounters& counts) const {
+  const DecideTask& t = tasks[k];
+  counts.exact_queries += steps.exact_queries;
+  counts.witness_queries += steps.witness_queries;
+  counts.distance_tests += steps.distance_tests;
+  DecideResult out;
+  if (p.cut) {
+    out.cut = true;
+    return out;
+  }
+  if (!p.settled) {  // nothing could decide it: say so, with what is known
+    if (!(p.d.lo <= std::max(p.threshold, o.clearance))) return out;
+    p.cls = ContactClass::Undecided;
+    p.by = DecidedBy::Undecided;
+  }
+  if (p.dropped) {
+    // Counted (with what proved it) when the triangles' band alone, fast mode, would have called it
+    // in contact; the many pairs every mode leaves out are not.
+    if (t.outcome != nullptr) {
+      const double band = band_threshold(model.surfaces[t.sa], model.surfaces[t.sb], o.tolerance);
+      if (classify(*t.outcome, band, 0.0)) {
+        ++counts.dismissed_pairs;
+        count(counts, p.by);
+      }
+    }
+    return out;
+  }
+  if (!p.cls) return out;
+  count(counts, p.by);
+  SurfacePairResult r = make_result(t, t.outcome, *p.cls);
+  r.decided_by = p.by;
+  r.distance_lo = p.d.lo;
+  r.distance_hi = p.d.hi;
+  r.exact_distance = p.exact;
+  out.result = std::move(r);
+  return out;
 }
 
 namespace {
@@ -184,46 +248,13 @@ void exact_steps(Run& run, CollideCounters& counters) {
   });
 }
 
-// Each pair's answer from its final state, in task order, with the counters.
+// Each pair's answer in task order (early()'s, or from its final state), with the counters.
 std::vector<DecideResult> collect(Run& run, CollideCounters& counters) {
-  std::vector<DecideResult> results(run.tasks.size());
   for (std::size_t k = 0; k < run.tasks.size(); ++k) {
-    const DecideTask& t = run.tasks[k];
-    Pending& p = run.pending[k];
-    counters.exact_queries += run.task_counters[k].exact_queries;
-    counters.witness_queries += run.task_counters[k].witness_queries;
-    counters.distance_tests += run.task_counters[k].distance_tests;
-    if (p.cut) {
-      results[k].cut = true;
-      continue;
-    }
-    if (!p.settled) {  // nothing could decide it: say so, with what is known
-      if (!(p.d.lo <= std::max(p.threshold, run.o.clearance))) continue;
-      p.cls = ContactClass::Undecided;
-      p.by = DecidedBy::Undecided;
-    }
-    if (p.dropped) {
-      // Counted (with what proved it) when the triangles' band alone, fast mode, would have called it
-      // in contact; the many pairs every mode leaves out are not.
-      if (t.outcome != nullptr) {
-        const double band = band_threshold(run.model.surfaces[t.sa], run.model.surfaces[t.sb], run.o.tolerance);
-        if (classify(*t.outcome, band, 0.0)) {
-          ++counters.dismissed_pairs;
-          count(counters, p.by);
-        }
-      }
-      continue;
-    }
-    if (!p.cls) continue;
-    count(counters, p.by);
-    SurfacePairResult r = make_result(t, t.outcome, *p.cls);
-    r.decided_by = p.by;
-    r.distance_lo = p.d.lo;
-    r.distance_hi = p.d.hi;
-    r.exact_distance = p.exact;
-    results[k].result = std::move(r);
+    if (run.state[k] & kAnswered) add(counters, run.task_counters[k]);
+    else run.answers[k] = run.answer(k, run.pending[k], run.task_counters[k], counters);
   }
-  return results;
+  return std::move(run.answers);
 }
 
 }  // namespace
@@ -263,7 +294,7 @@ void DecisionRun::skip(std::size_t k) { impl_->pending[k].cut = true; }
 
 std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
   Run& run = *impl_;
-  for (char a : run.ambiguous) counters.ambiguous_pairs += a != 0;
+  for (char st : run.state) counters.ambiguous_pairs += (st & (kAmbiguous | kAnswered)) == kAmbiguous;
   if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
   exact_steps(run, counters);
   return collect(run, counters);

@@ -337,6 +337,10 @@ TEST(TangentWitness, CylinderAndSphereOnAPlaneTouchWithoutTheExactFaceDistance) 
       EXPECT_EQ(curved_contacts, lift == 0.0 ? 1 : 0) << what;
       EXPECT_EQ(rim_contacts, lift == 0.0 && !sphere ? 2 : 0) << what;
       EXPECT_EQ(r.report.counters.exact_queries, 0u) << what;
+      // Each contact is one the triangles' interval and the surfaces' parameters leave open (steps 1
+      // and 2: ambiguous, counted once, however the pair is settled after); lifted, the parameters
+      // prove every pair apart.
+      EXPECT_EQ(r.report.counters.ambiguous_pairs, lift == 0.0 ? r.report.pairs.size() : 0u) << what;
     }
   }
 }
