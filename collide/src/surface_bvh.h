@@ -75,8 +75,11 @@ struct GridBox {
 };
 GridBox grid_box(const SurfaceBvh& bvh, const Aabb& query);
 inline bool node_meets(const SurfaceBvh::Node& n, const GridBox& q) {
-  bool in = true;
-  for (int k = 0; k < 3; ++k) in &= (std::int32_t{n.lo[k]} <= q.hi[k]) & (std::int32_t{n.hi[k]} >= q.lo[k]);
+  bool in = true;  // no branch per test: a tree walk's tests are unpredictable
+  for (int k = 0; k < 3; ++k) {
+    in &= std::int32_t{n.lo[k]} <= q.hi[k];
+    in &= std::int32_t{n.hi[k]} >= q.lo[k];
+  }
   return in;
 }
 
