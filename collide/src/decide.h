@@ -154,8 +154,9 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 
 // decide_pairs in two halves (certified or exact decision), for a caller that starts each task's
 // decision as soon as its triangles are done, on the thread that did them: early(k) runs steps 1 to
-// 3c of task k (any thread, each task once, after its outcome is final; the outlines it needs are
-// made on first need), skip(k) marks a task that gets no answer (cut before its decision), and
+// 3c of task k and answers it when they settle it (any thread, each task once, after its outcome is
+// final; the outlines it needs are made on first need), skip(k) marks a task that gets no answer
+// (cut before its decision), and
 // finish() runs steps 4 to 6 over the pairs still open and returns decide_pairs' answer, once every
 // task had early() or skip(). The answers are decide_pairs': each pair's steps depend on it alone.
 // The spans and references given must outlive the run; a task's outcome pointer may be set until
