@@ -112,7 +112,6 @@ struct DecisionRun::Impl {
     char st = ambiguous ? kAmbiguous : 0;
     if (p.settled || p.cut) {
       CollideCounters counts;
-      counts.ambiguous_pairs = ambiguous;
       answers[k] = answer(k, p, c, counts);
       task_counters[k] = counts;
       st |= kAnswered;
@@ -294,7 +293,7 @@ void DecisionRun::skip(std::size_t k) { impl_->pending[k].cut = true; }
 
 std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
   Run& run = *impl_;
-  for (char st : run.state) counters.ambiguous_pairs += (st & (kAmbiguous | kAnswered)) == kAmbiguous;
+  for (char st : run.state) counters.ambiguous_pairs += (st & kAmbiguous) != 0;
   if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
   exact_steps(run, counters);
   return collect(run, counters);
