@@ -74,6 +74,8 @@ struct Row {
   Method method;
   std::vector<double> times;
   cb::PairSet found;
+  // cadclash rows: the contact class of every reported pair (containment: surfaces kInvalidId).
+  std::map<cb::PairKey, cadclash::ContactClass> classes;
   std::optional<std::uint64_t> triangle_tests, exact_fallbacks;
   double build_seconds = -1.0, bytes_per_triangle = -1.0;
   int threads = 1;
@@ -148,6 +150,7 @@ void run_cadclash(const Settings& s, const cb::Workload& w, Row& row) {
       total.triangle_tests += c.triangle_tests;
       total.exact_fallbacks += c.exact_fallbacks;
       for (const cadclash::SurfacePairResult& p : r.pairs) {
+        row.classes[{k, p.instance_a, p.instance_b, p.surface_a, p.surface_b}] = p.contact;
         if (p.surface_a == cadclash::kInvalidId) continue;  // containment: whole instances
         const bool hit = row.method.reference == Reference::WithinT ? (p.intersecting || p.distance <= o.tolerance)
                                                                      : p.intersecting;
@@ -275,6 +278,8 @@ struct WorkloadResult {
   // How much of a second CPU the host gave before the first row and after the last, and in which
   // run of the table (compare_workload.h, until_host_gave_both).
   cb::HostCheck host;
+  // The instanced scene: copies reporting copy 0's pairs with its classes / its intersecting pairs.
+  std::optional<std::array<std::uint32_t, 3>> copies_same;  // {copies, same classes, same intersecting}
 };
 
 void finish(WorkloadResult& r) {
@@ -402,6 +407,10 @@ nlohmann::json json_of(const std::vector<WorkloadResult>& results, const Setting
     w["steps"] = r.w.steps.size();
     w["moving_instances"] = r.w.moving.size();
     w["subset"] = {{"instances", r.subset.instances}, {"step_stride", r.subset.stride}, {"note", r.subset_note}};
+    if (r.copies_same)
+      w["copies"] = {{"copies", (*r.copies_same)[0]},
+                     {"same_pairs_and_classes", (*r.copies_same)[1]},
+                     {"same_intersecting_pairs", (*r.copies_same)[2]}};
     w["methods"] = nlohmann::json::array();
     for (const Row& row : r.rows) {
       nlohmann::json m;
@@ -602,17 +611,33 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     run_cadclash(s, r.w, full);
     std::fprintf(stderr, " %.2f s (%zu reps, %zu pairs)\n", seconds_since(t0), full.times.size(), full.found.size());
-    {  // Copies differ only by a translation: say how many find exactly copy 0's pairs.
-      std::vector<std::set<std::array<std::uint32_t, 4>>> per_copy_pairs(copies);
-      for (const cb::PairKey& k : full.found)
-        per_copy_pairs[k[1] / n].insert({static_cast<std::uint32_t>(k[1] % n), static_cast<std::uint32_t>(k[2] % n), k[3], k[4]});
-      std::uint32_t same = 0;
-      for (const auto& c : per_copy_pairs) same += c == per_copy_pairs[0];
-      r.description += " " + std::to_string(same) + " of " + std::to_string(copies) + " copies find exactly copy 0's " +
-                       std::to_string(per_copy_pairs[0].size()) + " intersecting surface pairs" +
-                       (same < copies ? "; in the others some faces that touch exactly (zero gap) are decided on "
-                                        "coordinates rounded differently by the shifted placement"
-                                      : "") + ".";
+    {  // Copies differ only by a translation: say how many report exactly copy 0's pairs and classes
+       // (the certified verdicts, which must not depend on the placement), and how many find exactly
+       // copy 0's intersecting triangle pairs (a fact about the triangles, whose coordinates the
+       // shifted placement rounds differently).
+      using CopyKey = std::array<std::uint32_t, 4>;
+      auto copy_key = [&](const cb::PairKey& k) {
+        return CopyKey{static_cast<std::uint32_t>(k[1] % n), static_cast<std::uint32_t>(k[2] % n), k[3], k[4]};
+      };
+      std::vector<std::map<CopyKey, cadclash::ContactClass>> per_copy_classes(copies);
+      std::vector<std::set<CopyKey>> per_copy_pairs(copies);
+      for (const auto& [k, c] : full.classes) per_copy_classes[k[1] / n][copy_key(k)] = c;
+      for (const cb::PairKey& k : full.found) per_copy_pairs[k[1] / n].insert(copy_key(k));
+      std::uint32_t same_classes = 0, same_pairs = 0;
+      for (std::uint32_t k = 0; k < copies; ++k) {
+        same_classes += per_copy_classes[k] == per_copy_classes[0];
+        same_pairs += per_copy_pairs[k] == per_copy_pairs[0];
+      }
+      r.copies_same = std::array<std::uint32_t, 3>{copies, same_classes, same_pairs};
+      r.description += " " + std::to_string(same_classes) + " of " + std::to_string(copies) +
+                       " copies report exactly copy 0's " + std::to_string(per_copy_classes[0].size()) +
+                       " surface pairs with the same contact classes (the certified verdicts); " +
+                       std::to_string(same_pairs) + " of " + std::to_string(copies) + " find exactly copy 0's " +
+                       std::to_string(per_copy_pairs[0].size()) + " pairs with intersecting triangles" +
+                       (same_pairs < copies ? " (whether two triangles of faces that touch exactly meet is decided "
+                                              "on their coordinates, which the shifted placement rounds differently" +
+                                              std::string(same_classes == copies ? "; the classes do not depend on it)" : ")")
+                                            : "") + ".";
     }
     r.rows.push_back(std::move(full));
     if (source < results.size()) {

@@ -1,6 +1,7 @@
 // Reads bench_compare's compare.json and fails unless it is complete (every workload has its
 // rows, every row ran and carries its numbers) and every method held to exact agreement found the
-// same surface pairs as cadclash, and the trajectory CSVs beside it parse with parse_trajectory.
+// same surface pairs as cadclash, every copy of the instanced scene reported copy 0's pairs with the
+// same contact classes, and the trajectory CSVs beside it parse with parse_trajectory.
 // Timings are only checked to be present, never judged.
 //   bench_compare_check compare.json      exit 0 ok, 1 a check failed (each failure printed), 77 no file
 #include "cadclash/collide.h"
@@ -65,6 +66,14 @@ int main(int argc, char** argv) {
       }
     }
     if (cadclash_rows < 8 || peer_rows < 5) fail(wn, "rows missing");
+    // Copies of one assembly differ only by their placement: the certified verdicts must not.
+    if (w.contains("copies")) {
+      const auto& c = w["copies"];
+      if (c.value("copies", 0u) < 2 || c.value("same_pairs_and_classes", 0u) != c.value("copies", 0u))
+        fail(wn, "copies report other pairs or classes than copy 0: " + c.dump());
+    } else if (wn.rfind("instanced scene", 0) == 0) {
+      fail(wn, "missing copies");
+    }
   }
   // The paths written for `cadclash check --path`: they must read back whole, one pose per moving
   // instance per step, with as many steps as the workload replayed.
