@@ -1,6 +1,7 @@
 // The steps of the certified decision (decide_steps.h): cheapest evidence first; each proves a
 // bound on the exact faces' distance, and only what it leaves open goes to the next.
 #include "decide_steps.h"
+#include "patch_gap.h"
 
 #include "cadclash/geometry.h"
 
@@ -342,6 +343,69 @@ void edge_witness_step(const Model& m, std::span<const Pose> poses, const Decide
   if (!d || !(*d + t.roundoff <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, *d + t.roundoff);
   settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+}
+
+namespace {
+
+// Whether the face's triangles (points of the face, up to its uncertainty) lie in the box of its
+// patches' control points, as they must when the patches hold the face: a check of the source's
+// conversion, not a proof of it. Faces without triangles pass.
+bool patches_hold_triangles(const Surface& s, const SurfaceSource::BezierPatches& patches, double eps) {
+  if (!s.has_triangles) return true;
+  Aabb box;
+  for (const auto& p : patches.patches)
+    for (const Vec3& q : p.points) box.extend(q);
+  const Aabb padded = pad_box(box, eps + patches.rounding + kRelativePad * (1.0 + box_magnitude(box)));
+  for (const Vec3& v : s.mesh.vertices)
+    if (!padded.contains(v)) return false;
+  return true;
+}
+
+}  // namespace
+
+bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> eps, const DecideTask& t,
+               Pending& p, const CollideOptions& o, CollideCounters& c) {
+  // A face without triangles is decided on the exact distance (its interval is [d*, d*]).
+  if (t.outcome == nullptr) return false;
+  const Surface& a = m.surfaces[t.sa];
+  const Surface& b = m.surfaces[t.sb];
+  const Part& pa = m.parts[a.part];
+  const Part& pb = m.parts[b.part];
+  if (!pa.source || !pb.source) return false;
+  const std::uint32_t local_a = t.sa - pa.first_surface, local_b = t.sb - pb.first_surface;
+  const auto patches_a = pa.source->bezier_patches(local_a);
+  if (!patches_a) return false;
+  const auto patches_b = pb.source->bezier_patches(local_b);
+  if (!patches_b) return false;
+  if (!patches_hold_triangles(a, *patches_a, eps[t.sa]) || !patches_hold_triangles(b, *patches_b, eps[t.sb]))
+    return false;
+  PatchGapOptions go;
+  // The faces are within ε of their surfaces: the surfaces must be more than T + εa + εb apart.
+  const double eps_ab = eps[t.sa] + eps[t.sb] + t.roundoff;
+  go.threshold = p.threshold + eps_ab;
+  go.pose_magnitude = poses[t.ia].translation().norm() + poses[t.ib].translation().norm();
+  const PatchGap found = patch_gap(*patches_a, *patches_b, t.t_ab(), go);
+  if (found.gap) {
+    const double lb = *found.gap - eps_ab;
+    if (!(lb > p.threshold)) return false;
+    p.d.lo = std::max(p.d.lo, lb);
+    settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);
+    return true;
+  }
+  if (!found.near) return false;
+  // Where the search stopped the surfaces come within its pieces' size of each other: any point x
+  // bounds d* <= d(x, face A) + d(x, face B), each realised by a point of that face.
+  c.witness_queries += 2;
+  const auto da = pa.source->point_distance(local_a, *found.near);
+  if (!da || !(*da + t.roundoff <= p.threshold)) return false;
+  const auto db = pb.source->point_distance(local_b, t.t_ba() * *found.near);
+  if (!db) return false;
+  const double hi = *da + *db + 2.0 * t.roundoff;
+  if (!(hi <= p.threshold)) return false;
+  p.d.hi = std::min(p.d.hi, hi);
+  p.d.lo = std::min(p.d.lo, p.d.hi);
+  settle(p, Verdict::Contact, DecidedBy::Exact, t.outcome, o.clearance);
+  return true;
 }
 
 // The exact faces' distance by BRepExtrema (SurfaceSource::exact_distance). Its value is the

@@ -108,6 +108,14 @@ FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::
 void refined_step(std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                   const CollideOptions& o, CollideCounters& c);
 
+// Step 5a (certified): the two faces' surfaces as Bézier control hulls (SurfaceSource::bezier_patches),
+// halved until every pair of pieces is farther apart than T (patch_gap.h): a lower bound on d*, so
+// "apart" (decided_by Analytic) without OCCT's search. Where the pieces do not separate, a point of
+// A's surface there, within T of both faces (SurfaceSource::point_distance), proves contact
+// (decided_by Exact). True when it settled the pair.
+bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> eps, const DecideTask& t,
+               Pending& p, const CollideOptions& o, CollideCounters& c);
+
 // Step 5: the exact faces' distance (SurfaceSource::exact_distance). False when they have none.
 bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t, Pending& p, const CollideOptions& o,
                 CollideCounters& c);

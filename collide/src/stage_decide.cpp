@@ -224,13 +224,14 @@ void refinement_step(Run& run, CollideCounters& counters) {
   });
 }
 
-// Steps 5 and 6: the exact faces for what is still open, and exact values above T corroborated (or
-// contradicted) by finer triangles.
+// Steps 5 and 6: the exact faces for what is still open (certified: their control hulls first), and
+// exact values above T corroborated (or contradicted) by finer triangles.
 void exact_steps(Run& run, CollideCounters& counters) {
   const Model& model = run.model;
   const auto& tasks = run.tasks;
   run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
     Pending& p = run.pending[k];
+    if (run.o.decision == DecisionMode::Certified && hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k])) return;
     if (exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]) || !run.meshed(k)) return;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
     const bool exact = triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb);

@@ -127,6 +127,12 @@ std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb
 // other surfaces. Reads the face only. May throw Standard_Failure.
 std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n);
 
+// The face's surface as rational Bézier patches (part-local, the face's location applied): B-spline and
+// Bézier surfaces (trimmed ones unwrapped) whole, planes, cylinders, cones, spheres and tori over the
+// face's parameter bounds (GeomConvert's exact rational form); nullopt for other surfaces, for
+// non-positive weights and for more than 1024 patches. May throw Standard_Failure.
+std::optional<SurfaceSource::BezierPatches> face_bezier_patches(const TopoDS_Face& face);
+
 // The extremum along `d` of the face's edge nearest `near` (Newton on d·C(t), clamped to the edge's
 // ends), with the evaluation's rounding. May throw Standard_Failure.
 std::optional<SurfaceSource::SurfacePoint> face_edge_support(const FaceLocator& where, const Aabb& face_box,

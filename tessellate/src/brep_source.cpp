@@ -126,6 +126,17 @@ std::optional<std::array<double, 2>> BrepSource::height_range(std::uint32_t loca
   }
 }
 
+std::optional<SurfaceSource::BezierPatches> BrepSource::bezier_patches(std::uint32_t local_index) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  std::shared_lock<std::shared_mutex> lock(a.mutex);
+  try {
+    return detail::face_bezier_patches(a.faces[local_index]);
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<SurfaceSource::SurfacePoint> BrepSource::edge_support(std::uint32_t local_index, const Vec3& direction,
                                                                     const Vec3& near) const {
   const Impl& a = *impl_;

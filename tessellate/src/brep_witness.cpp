@@ -15,7 +15,12 @@
 #include <Extrema_GenLocateExtPS.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_BezierSurface.hxx>
+#include <Geom_ElementarySurface.hxx>
 #include <Geom_RectangularTrimmedSurface.hxx>
+#include <GeomConvert.hxx>
+#include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
+#include <BRepTools.hxx>
+#include <TColGeom_Array2OfBezierSurface.hxx>
 #include <TColStd_Array2OfReal.hxx>
 #include <TColgp_Array2OfPnt.hxx>
 #include <Extrema_LocateExtCC.hxx>
@@ -362,6 +367,82 @@ std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, 
     return pole_heights(z->Poles(), place, o, n);
   }
   return std::nullopt;
+}
+
+namespace {
+
+constexpr int kMaxPatches = 1024;
+
+// The face's parameter bounds, widened by a little (never past a bounded surface's own ends): the
+// pcurves' box, which the face lies in.
+void face_bounds(const TopoDS_Face& face, const Handle(Geom_Surface)& s, double& u1, double& u2, double& v1,
+                 double& v2) {
+  BRepTools::UVBounds(face, u1, u2, v1, v2);
+  double su1 = 0.0, su2 = 0.0, sv1 = 0.0, sv2 = 0.0;
+  s->Bounds(su1, su2, sv1, sv2);
+  const double du = 1e-9 * (u2 - u1) + 1e-12, dv = 1e-9 * (v2 - v1) + 1e-12;
+  u1 -= du, u2 += du, v1 -= dv, v2 += dv;
+  // Never past a bounded surface's ends, nor over more than one period of a periodic one (a
+  // trimmed periodic surface takes its range modulo the period: a full turn widened would wrap to
+  // almost nothing).
+  if (!s->IsUPeriodic()) u1 = std::max(u1, su1), u2 = std::min(u2, su2);
+  else if (u2 - u1 >= s->UPeriod()) u2 = u1 + s->UPeriod();
+  if (!s->IsVPeriodic()) v1 = std::max(v1, sv1), v2 = std::min(v2, sv2);
+  else if (v2 - v1 >= s->VPeriod()) v2 = v1 + s->VPeriod();
+}
+
+}  // namespace
+
+std::optional<SurfaceSource::BezierPatches> face_bezier_patches(const TopoDS_Face& face) {
+  TopLoc_Location loc;
+  Handle(Geom_Surface) surface = BRep_Tool::Surface(face, loc);
+  while (!surface.IsNull()) {  // a trimmed surface lies on its basis surface
+    const Handle(Geom_RectangularTrimmedSurface) trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface);
+    if (trimmed.IsNull()) break;
+    surface = trimmed->BasisSurface();
+  }
+  if (surface.IsNull()) return std::nullopt;
+  const gp_Trsf place = loc.Transformation();
+  std::vector<Handle(Geom_BezierSurface)> beziers;
+  if (const Handle(Geom_BezierSurface) z = Handle(Geom_BezierSurface)::DownCast(surface); !z.IsNull()) {
+    beziers.push_back(z);
+  } else {
+    Handle(Geom_BSplineSurface) b = Handle(Geom_BSplineSurface)::DownCast(surface);
+    if (b.IsNull()) {
+      if (Handle(Geom_ElementarySurface)::DownCast(surface).IsNull()) return std::nullopt;
+      double u1 = 0.0, u2 = 0.0, v1 = 0.0, v2 = 0.0;
+      face_bounds(face, surface, u1, u2, v1, v2);
+      if (!(u1 < u2 && v1 < v2) || !std::isfinite(u2 - u1) || !std::isfinite(v2 - v1)) return std::nullopt;
+      b = GeomConvert::SurfaceToBSplineSurface(new Geom_RectangularTrimmedSurface(surface, u1, u2, v1, v2));
+      if (b.IsNull()) return std::nullopt;
+    }
+    GeomConvert_BSplineSurfaceToBezierSurface split(b);
+    if (split.NbUPatches() * split.NbVPatches() > kMaxPatches) return std::nullopt;
+    TColGeom_Array2OfBezierSurface patches(1, split.NbUPatches(), 1, split.NbVPatches());
+    split.Patches(patches);
+    for (int i = patches.LowerRow(); i <= patches.UpperRow(); ++i)
+      for (int j = patches.LowerCol(); j <= patches.UpperCol(); ++j) beziers.push_back(patches(i, j));
+  }
+  SurfaceSource::BezierPatches out;
+  double magnitude = 0.0;
+  for (const Handle(Geom_BezierSurface)& z : beziers) {
+    SurfaceSource::BezierPatch patch;
+    patch.degree_u = z->UDegree();
+    patch.degree_v = z->VDegree();
+    for (int i = 1; i <= z->NbUPoles(); ++i)
+      for (int j = 1; j <= z->NbVPoles(); ++j) {
+        const gp_Pnt p = z->Pole(i, j).Transformed(place);
+        const double w = z->Weight(i, j);
+        if (!(w > 0.0)) return std::nullopt;
+        patch.points.emplace_back(p.X(), p.Y(), p.Z());
+        patch.weights.push_back(w);
+        magnitude = std::max(magnitude, patch.points.back().norm());
+      }
+    out.patches.push_back(std::move(patch));
+  }
+  // Knot insertion and the conversion's sines and cosines round; far less than this.
+  out.rounding = kEvaluationRounding * magnitude;
+  return out;
 }
 
 }  // namespace cadclash::detail

@@ -270,6 +270,58 @@ TEST(CertifiedTruth, As1PlateMovedOffABracket) {
   }
 }
 
+// The L-bracket assembly withdrawn along its bolts' axis (world z) on a path that drifts sideways by
+// 1e-6 of its length, as a path planned along a rounded normal does. Each bolt shank sits in its
+// plate hole radius 5 in radius 5, both split into two half cylinders (B-spline faces): with the
+// axes a drift δ apart the two circles cross at two opposite points, each inside one half of the
+// shank and one half of the hole, so of a bolt's four half-against-half pairs two cross (contact)
+// and two stand apart by at least 0.6 δ (the drift's smaller share across the seams), thousands of
+// times less than the triangles' band. The exact B-rep distance (BRepExtrema) misses some of the
+// crossings of these near-coincident faces, so the truth is held to what it is sure of: every
+// contact it finds is reported, and the shank–hole pairs follow the two circles' geometry.
+TEST(CertifiedTruth, As1BracketWithdrawnOnADriftingPath) {
+  REQUIRE_SAMPLES();
+  const std::set<std::int64_t> shank = {673, 705};
+  const std::set<std::int64_t> hole_walls = {1906, 2002, 1954, 2050, 1970, 2066};
+  for (double lift : {2.0, 10.0}) {
+    Model m = as1().model;
+    const Vec3 step(0.6e-6 * lift, 0.8e-6 * lift, lift);
+    std::size_t moved = 0;
+    for (Instance& in : m.instances)
+      if (in.path.rfind("/as1/L-BRACKET-ASSEMBLY::1/", 0) == 0) in.pose.pretranslate(step), ++moved;
+    ASSERT_EQ(moved, 7u);
+    const std::string name = "as1, L-bracket assembly lifted " + std::to_string(lift) + " mm, drifting";
+    const GroundTruth t = truth::compute_ground_truth(m, 0.0, 0);
+    EXPECT_EQ(t.failed, 0u);
+    const Checked run = check(m, DecisionMode::Certified, 0.0);
+    std::map<PairKey, ContactClass> got;
+    for (const SurfacePairResult& p : run.report.pairs)
+      if (p.contact != ContactClass::Containment) got[{p.instance_a, p.instance_b, p.surface_a, p.surface_b}] = p.contact;
+    std::printf("[ drift    ] %s: %zu pairs, %s\n", name.c_str(), got.size(), counters_text(run.report.counters).c_str());
+    std::map<InstanceId, int> apart_by_bolt, pairs_by_bolt;
+    for (const truth::MeasuredPair& p : t.measured) {
+      const PairKey k{p.instance_a, p.instance_b, p.surface_a, p.surface_b};
+      const auto it = got.find(k);
+      const std::string what = name + ": " + label(m, k.instance_a, k.surface_a) + " x " + label(m, k.instance_b, k.surface_b);
+      if (truth::within(p)) {
+        EXPECT_TRUE(it != got.end() && is_contact(it->second)) << what << " missed";
+      }
+      const std::int64_t ia = m.surfaces[p.surface_a].provenance.step_id, ib = m.surfaces[p.surface_b].provenance.step_id;
+      const bool a_shank = shank.count(ia) && hole_walls.count(ib), b_shank = shank.count(ib) && hole_walls.count(ia);
+      if (!a_shank && !b_shank) continue;
+      const InstanceId bolt = a_shank ? p.instance_a : p.instance_b;
+      ++pairs_by_bolt[bolt];
+      if (it == got.end()) ++apart_by_bolt[bolt];
+      else EXPECT_TRUE(it->second == ContactClass::Touching || it->second == ContactClass::Undecided) << what;
+    }
+    ASSERT_EQ(pairs_by_bolt.size(), 3u) << name;
+    for (const auto& [bolt, n] : pairs_by_bolt) {
+      EXPECT_EQ(n, 4) << name << ": " << m.instances[bolt].path;
+      EXPECT_EQ(apart_by_bolt[bolt], 2) << name << ": " << m.instances[bolt].path << " (two halves cross, two stand apart)";
+    }
+  }
+}
+
 // Every instance moved by the distance in its own fixed direction (bench_accuracy's jittered scene):
 // exact contacts become small gaps and overlaps all over the assembly.
 // Disabled: two open problems this scene shows (see the session note on issue 15).

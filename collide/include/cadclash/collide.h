@@ -108,6 +108,13 @@ namespace cadclash {
 //             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
 //             cylinder or sphere of either face against the other's finer triangles; a face of those
 //             shapes is not refined when the other face is not one (its surface bounds the gap);
+//   hull      (certified) both faces' surfaces as rational Bézier patches (SurfaceSource::bezier_patches:
+//             B-spline and Bézier surfaces, planes, cylinders, cones, spheres and tori), halved where
+//             they bend until a plane puts every pair of pieces' control points more than T + εa + εb
+//             apart: a lower bound on d* (apart, decided_by Analytic) — a bolt drifting a micrometre
+//             off its hole's axis, far inside every band; where pieces will not separate, a point of
+//             A's surface there within T of both faces (SurfaceSource::point_distance) proves contact
+//             (decided_by Exact). A bounded search (at most 16,384 pairs of pieces);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with

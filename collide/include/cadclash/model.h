@@ -214,6 +214,26 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // The surface face `local_index` lies on as rational Bézier patches in this part's local frame: every
+  // point of the face lies on one of them (they may cover more of the surface than the face), up to
+  // `rounding` (mm) for the conversion's arithmetic. A patch's surface lies in the convex hull of its
+  // control points (all weights > 0), which is what lets collide bound two faces' distance from below
+  // without OCCT. nullopt when there is no exact geometry or the surface has no such form.
+  // Thread-safe like exact_distance.
+  struct BezierPatch {
+    int degree_u = 0, degree_v = 0;
+    std::vector<Vec3> points;     // (degree_u + 1) x (degree_v + 1), index i * (degree_v + 1) + j
+    std::vector<double> weights;  // the same size, each > 0
+  };
+  struct BezierPatches {
+    std::vector<BezierPatch> patches;
+    double rounding = 0.0;
+  };
+  virtual std::optional<BezierPatches> bezier_patches(std::uint32_t local_index) const {
+    (void)local_index;
+    return std::nullopt;
+  }
+
   // The point of face `local_index`'s edges farthest along `direction` (a unit vector, part-local)
   // near `near`: Newton on the edge curve nearest `near` for the extremum of direction·C(t), clamped
   // to the edge's ends; the point, its rounding (normal unused). A point of the face: where a face

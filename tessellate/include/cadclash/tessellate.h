@@ -165,6 +165,11 @@ class BrepSource final : public SurfaceSource {
   std::optional<std::array<double, 2>> height_range(std::uint32_t local_index, const Vec3& origin,
                                                     const Vec3& normal) const override;
 
+  // GeomConvert's Bézier patches of the face's B-spline or Bézier surface (trimmed ones unwrapped), or
+  // of its plane, cylinder, cone, sphere or torus over the face's parameter bounds; placed by the face's
+  // location. nullopt for other surfaces, for non-positive weights and beyond 1024 patches.
+  std::optional<BezierPatches> bezier_patches(std::uint32_t local_index) const override;
+
   // Newton (first and second derivatives of BRepAdaptor_Curve) on the edge nearest `near`.
   std::optional<SurfacePoint> edge_support(std::uint32_t local_index, const Vec3& direction,
                                            const Vec3& near) const override;
