@@ -322,6 +322,20 @@ std::optional<SurfaceSource::SurfacePoint> face_surface_point(const BRepAdaptor_
 
 namespace {
 
+// The surface the face lies on, trimmed surfaces unwrapped (a trimmed surface lies on its basis
+// surface), and the face's location in `place`.
+Handle(Geom_Surface) basis_surface(const TopoDS_Face& face, gp_Trsf& place) {
+  TopLoc_Location loc;
+  Handle(Geom_Surface) surface = BRep_Tool::Surface(face, loc);
+  while (!surface.IsNull()) {
+    const Handle(Geom_RectangularTrimmedSurface) trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface);
+    if (trimmed.IsNull()) break;
+    surface = trimmed->BasisSurface();
+  }
+  place = loc.Transformation();
+  return surface;
+}
+
 // The heights of `poles` (placed by `place`) over the plane, widened by their evaluation's rounding.
 std::array<double, 2> pole_heights(const TColgp_Array2OfPnt& poles, const gp_Trsf& place, const Vec3& o, const Vec3& n) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, magnitude = o.norm();
@@ -349,15 +363,9 @@ bool positive(const TColStd_Array2OfReal* weights) {
 }  // namespace
 
 std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n) {
-  TopLoc_Location loc;
-  Handle(Geom_Surface) surface = BRep_Tool::Surface(face, loc);
-  while (!surface.IsNull()) {  // a trimmed surface lies on its basis surface
-    const Handle(Geom_RectangularTrimmedSurface) trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface);
-    if (trimmed.IsNull()) break;
-    surface = trimmed->BasisSurface();
-  }
+  gp_Trsf place;
+  const Handle(Geom_Surface) surface = basis_surface(face, place);
   if (surface.IsNull()) return std::nullopt;
-  const gp_Trsf place = loc.Transformation();
   if (const Handle(Geom_BSplineSurface) b = Handle(Geom_BSplineSurface)::DownCast(surface); !b.IsNull()) {
     if (!positive(b->Weights())) return std::nullopt;
     return pole_heights(b->Poles(), place, o, n);
@@ -394,15 +402,9 @@ void face_bounds(const TopoDS_Face& face, const Handle(Geom_Surface)& s, double&
 }  // namespace
 
 std::optional<SurfaceSource::BezierPatches> face_bezier_patches(const TopoDS_Face& face) {
-  TopLoc_Location loc;
-  Handle(Geom_Surface) surface = BRep_Tool::Surface(face, loc);
-  while (!surface.IsNull()) {  // a trimmed surface lies on its basis surface
-    const Handle(Geom_RectangularTrimmedSurface) trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface);
-    if (trimmed.IsNull()) break;
-    surface = trimmed->BasisSurface();
-  }
+  gp_Trsf place;
+  const Handle(Geom_Surface) surface = basis_surface(face, place);
   if (surface.IsNull()) return std::nullopt;
-  const gp_Trsf place = loc.Transformation();
   std::vector<Handle(Geom_BezierSurface)> beziers;
   if (const Handle(Geom_BezierSurface) z = Handle(Geom_BezierSurface)::DownCast(surface); !z.IsNull()) {
     beziers.push_back(z);
