@@ -113,8 +113,10 @@ namespace cadclash {
 //             they bend until a plane puts every pair of pieces' control points more than T + εa + εb
 //             apart: a lower bound on d* (apart, decided_by Analytic) — a bolt drifting a micrometre
 //             off its hole's axis, far inside every band; where pieces will not separate, a point of
-//             A's surface there within T of both faces (SurfaceSource::point_distance) proves contact
-//             (decided_by Exact). A bounded search (at most 16,384 pairs of pieces);
+//             A's surface there, or where A's surface crosses B's next to it (B's signed height from
+//             SurfaceSource::surface_point, bisected on A's surface), within T of both faces
+//             (SurfaceSource::point_distance) proves contact (decided_by Exact). A bounded search (at
+//             most 16,384 pairs of pieces);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
