@@ -231,7 +231,8 @@ void exact_steps(Run& run, CollideCounters& counters) {
   const auto& tasks = run.tasks;
   run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
     Pending& p = run.pending[k];
-    if (run.o.decision == DecisionMode::Certified && hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k])) return;
+    const bool certified = run.o.decision == DecisionMode::Certified;
+    if (certified && hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k])) return;
     if (exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]) || !run.meshed(k)) return;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
     const bool exact = triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb);
