@@ -94,6 +94,9 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(static_cast<std::uint64_t>(t.kind));
   w.f64(t.declared_uncertainty);
   w.f64(t.read_seconds);
+  w.u64(t.parallel_workers);
+  w.f64(t.parallel_seconds);
+  w.u64(t.split_failed ? 1 : 0);
   if (!t.doc.IsNull()) {
     w.u64(1);
     const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
@@ -134,6 +137,9 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.kind = static_cast<SourceKind>(r.u64());
   t.declared_uncertainty = r.f64();
   t.read_seconds = r.f64();
+  t.parallel_workers = r.u64();
+  t.parallel_seconds = r.f64();
+  t.split_failed = r.u64() == 1;
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
@@ -202,6 +208,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   result.diagnostics = std::move(t.diagnostics);
   result.complete = t.complete;
   result.files.push_back(FileImport{path, CacheUse::Off, {}});
+  result.files.back().transfer_workers = t.parallel_workers;
   ImportTimings& timings = result.files.back().timings;
   timings.read = t.read_seconds;
   BrepPartTimings part_timings;

@@ -27,6 +27,13 @@ struct Transfer {
   double declared_uncertainty = 0.0;
   // Seconds the reader spent parsing the file (ImportTimings::read), measured where it ran.
   double read_seconds = 0.0;
+  // Processes that made the shapes (1: the reader alone) and the seconds they took (step_parallel_transfer.h).
+  std::size_t parallel_workers = 1;
+  double parallel_seconds = 0.0;
+  // The text was cut into pieces and a piece's worker failed: nothing else here holds; read_step
+  // reads the file again without cutting it.
+  bool split_failed = false;
+  double split_seconds = 0.0;  // from the start of reading until the pieces' workers started (not sent back)
   // Products: an XCAF document (closed by the destructor) and the entities of its faces.
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;

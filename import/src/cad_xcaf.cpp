@@ -157,12 +157,15 @@ std::unordered_map<const void*, std::array<float, 3>> part_face_colours(const TD
 
 }  // namespace
 
-FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe) {
+FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe,
+                                const std::vector<FaceTag>& extra) {
   FaceEntityMap map;
   if (process.IsNull()) return map;
   // Entities whose result is exactly one face claim it first; an entity whose result holds several
   // faces (a shell, a solid, a face split by healing) only tags faces no face entity claimed.
   for (int pass = 0; pass < 2; ++pass) {
+    for (const FaceTag& tag : extra)
+      if (tag.single == (pass == 0)) map.try_emplace(tag.tshape, tag.entity);
     for (Standard_Integer i = 1; i <= process->NbMapped(); ++i) {
       const Handle(Standard_Transient)& entity = process->Mapped(i);
       const TopoDS_Shape shape = TransferBRep::ShapeResult(process->MapItem(i));

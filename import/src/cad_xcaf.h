@@ -30,7 +30,17 @@ using FaceEntityMap = std::unordered_map<const void*, FaceEntity>;
 // Maps entity → (id, name) for an entity that is a face of the format; returns false to skip it.
 using FaceEntityFn = std::function<bool(const Handle(Standard_Transient)&, FaceEntity&)>;
 
-FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe);
+// A face's entity found elsewhere (another process's transfer): `single` when the entity's result
+// was that face alone, else it held several faces.
+struct FaceTag {
+  const void* tshape = nullptr;
+  FaceEntity entity;
+  bool single = true;
+};
+
+// `extra` tags join the process's own: single-face results claim faces first, then the others.
+FaceEntityMap map_face_entities(const Handle(Transfer_TransientProcess)& process, const FaceEntityFn& describe,
+                                const std::vector<FaceTag>& extra = {});
 
 // The label number of an entity as the file writes it (#N for STEP, DE number for IGES); -1 if none.
 using EntityLabelFn = std::function<std::int64_t(const Handle(Standard_Transient)&)>;

@@ -9,9 +9,11 @@
 #include <mutex>
 #include <shared_mutex>
 #include <sstream>
+#include <vector>
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -35,6 +37,52 @@ std::string signal_text(int sig) {
 // fuzzer's would report the crash as the whole program's and write artifacts for it).
 void default_crash_handlers() {
   for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+}
+
+// The child's side of a run: `work` with marks and its payload down `out`, then the end.
+[[noreturn]] void child_main(int out, const std::function<std::string(const Mark& mark)>& work) {
+  default_crash_handlers();
+  if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
+  std::string payload;
+  try {
+    payload = work([out](char c) { (void)!write(out, &c, 1); });
+  } catch (...) {
+    // An exception (bad_alloc, ...) is the parent's to meet again; it is not a crash.
+  }
+  (void)!write(out, &kFinished, 1);
+  for (std::size_t at = 0; at < payload.size();) {
+    const ssize_t n = write(out, payload.data() + at, payload.size() - at);
+    if (n > 0) at += static_cast<std::size_t>(n);
+    else if (errno != EINTR) break;
+  }
+  _exit(0);  // no atexit handlers or static destructors: they belong to the parent
+}
+
+// How a finished child's bytes and exit status read: the payload split off the marks, and what ended it.
+void finish_run(ChildRun& run, pid_t pid) {
+  const std::size_t end = run.marks.find(kFinished);
+  const bool finished = end != std::string::npos && !run.timed_out;
+  if (end != std::string::npos) {
+    run.payload = run.marks.substr(end + 1);
+    run.marks.resize(end);
+  }
+  int status = 0;
+  pid_t waited = -1;
+  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  }
+  if (run.timed_out) {
+    run.crashed = true;
+    run.how = "the time limit";
+  } else if (waited == pid && WIFSIGNALED(status)) {
+    run.crashed = true;
+    run.how = signal_text(WTERMSIG(status));
+  } else if (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0) {
+    run.crashed = true;  // a sanitizer's report ends the child with exit status 1
+    run.how = "exit status " + std::to_string(WEXITSTATUS(status));
+  } else if (!finished) {
+    run.crashed = true;
+    run.how = "it ended before finishing";
+  }
 }
 
 std::shared_mutex& fork_mutex() {
@@ -93,22 +141,7 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, 
   }
   if (pid == 0) {
     close(fds[0]);
-    default_crash_handlers();
-    if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
-    const int out = fds[1];
-    std::string payload;
-    try {
-      payload = work([out](char c) { (void)!write(out, &c, 1); });
-    } catch (...) {
-      // An exception (bad_alloc, ...) is the parent's to meet again; it is not a crash.
-    }
-    (void)!write(out, &kFinished, 1);
-    for (std::size_t at = 0; at < payload.size();) {
-      const ssize_t n = write(out, payload.data() + at, payload.size() - at);
-      if (n > 0) at += static_cast<std::size_t>(n);
-      else if (errno != EINTR) break;
-    }
-    _exit(0);  // no atexit handlers or static destructors: they belong to the parent
+    child_main(fds[1], work);
   }
   close(fds[1]);
   no_reader_inside.unlock();  // (the child keeps its copy locked: it never returns from here)
@@ -138,30 +171,78 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, 
     }
   }
   close(fds[0]);
-  const std::size_t end = run.marks.find(kFinished);
-  const bool finished = end != std::string::npos && !run.timed_out;
-  if (end != std::string::npos) {
-    run.payload = run.marks.substr(end + 1);
-    run.marks.resize(end);
-  }
-  int status = 0;
-  pid_t waited = -1;
-  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
-  }
-  if (run.timed_out) {
-    run.crashed = true;
-    run.how = "the time limit";
-  } else if (waited == pid && WIFSIGNALED(status)) {
-    run.crashed = true;
-    run.how = signal_text(WTERMSIG(status));
-  } else if (waited == pid && WIFEXITED(status) && WEXITSTATUS(status) != 0) {
-    run.crashed = true;  // a sanitizer's report ends the child with exit status 1
-    run.how = "exit status " + std::to_string(WEXITSTATUS(status));
-  } else if (!finished) {
-    run.crashed = true;
-    run.how = "it ended before finishing";
-  }
+  finish_run(run, pid);
   return run;
+}
+
+Children::Children(std::size_t n, const std::function<std::string(std::size_t k, const Mark& mark)>& work)
+    : runs_(n), pids_(n, -1) {
+  const pid_t self = getpid();
+  for (std::size_t k = 0; k < n; ++k) {
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0) {
+      runs_[k].isolated = false;
+      runs_[k].how = std::string("pipe: ") + std::strerror(errno);
+      continue;
+    }
+    pids_[k] = fork();
+    if (pids_[k] < 0) {
+      runs_[k].isolated = false;
+      runs_[k].how = std::string("fork: ") + std::strerror(errno);
+      close(fds[0]);
+      close(fds[1]);
+      continue;
+    }
+    if (pids_[k] == 0) {
+      // A child outlives nothing: when the process that forked it ends (an isolated reader stopped
+      // at its time limit), so does it.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != self) _exit(1);
+      for (const pollfd& p : pipes_) close(p.fd);
+      close(fds[0]);
+      child_main(fds[1], [&work, k](const Mark& mark) { return work(k, mark); });
+    }
+    close(fds[1]);
+    pipes_.push_back({fds[0], POLLIN, 0});
+    owner_.push_back(k);
+  }
+}
+
+std::vector<ChildRun> Children::wait() {
+  char buffer[1 << 16];
+  while (!pipes_.empty()) {
+    if (poll(pipes_.data(), pipes_.size(), -1) < 0 && errno != EINTR) break;
+    for (std::size_t i = pipes_.size(); i-- > 0;) {
+      if (pipes_[i].revents == 0) continue;
+      const ssize_t got = read(pipes_[i].fd, buffer, sizeof buffer);
+      if (got > 0) {
+        runs_[owner_[i]].marks.append(buffer, static_cast<std::size_t>(got));
+      } else if (got == 0 || errno != EINTR) {
+        close(pipes_[i].fd);
+        pipes_.erase(pipes_.begin() + static_cast<std::ptrdiff_t>(i));
+        owner_.erase(owner_.begin() + static_cast<std::ptrdiff_t>(i));
+      }
+    }
+  }
+  for (std::size_t k = 0; k < pids_.size(); ++k)
+    if (pids_[k] > 0) finish_run(runs_[k], pids_[k]);
+  pids_.clear();
+  return std::move(runs_);
+}
+
+Children::~Children() {
+  for (const pollfd& p : pipes_) close(p.fd);
+  for (const pid_t pid : pids_) {
+    if (pid <= 0) continue;
+    kill(pid, SIGKILL);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+}
+
+std::vector<ChildRun> run_in_children(std::size_t n, const std::function<std::string(std::size_t k, const Mark& mark)>& work) {
+  return Children(n, work).wait();
 }
 
 void mark_entity_begin(const Mark& mark, std::int64_t id) {

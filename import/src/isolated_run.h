@@ -12,6 +12,9 @@
 #include <optional>
 #include <functional>
 #include <string>
+#include <vector>
+
+#include <poll.h>
 
 namespace cadclash::detail {
 
@@ -37,6 +40,31 @@ using Mark = std::function<void(char)>;
 // itself waits until no other thread holds a CadWork. A child still running after
 // `time_limit_seconds` (> 0; 0 = none) is killed, and the run is `timed_out`.
 ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds = 0.0);
+
+// Calls `work(k, mark)` for k = 0 ... n - 1, each in a forked child, all at once; wait() waits for
+// them all and gives one ChildRun per k, as run_in_child's. The caller may work meanwhile (a child
+// that has finished waits to hand over its payload). For a process with one thread (an isolated
+// reader's child spreading its work over processes): it takes no lock. Each child dies with the
+// calling process (PR_SET_PDEATHSIG), so a reader stopped at its time limit leaves none behind; one
+// not waited for is killed by the destructor.
+// Preconditions: as run_in_child's, and the calling process has one thread.
+class Children {
+ public:
+  Children(std::size_t n, const std::function<std::string(std::size_t k, const Mark& mark)>& work);
+  ~Children();
+  Children(const Children&) = delete;
+  Children& operator=(const Children&) = delete;
+  std::vector<ChildRun> wait();  // once
+
+ private:
+  std::vector<ChildRun> runs_;
+  std::vector<int> pids_;
+  std::vector<struct pollfd> pipes_;
+  std::vector<std::size_t> owner_;  // the run each of pipes_ reads
+};
+
+// Children(n, work).wait().
+std::vector<ChildRun> run_in_children(std::size_t n, const std::function<std::string(std::size_t k, const Mark& mark)>& work);
 
 // Held by a thread while it reads a file in this process (import_file holds one throughout).
 // Forking while another thread is inside OCCT (or any library that locks) could give the child a

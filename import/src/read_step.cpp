@@ -4,7 +4,11 @@
 #include "isolated_run.h"
 #include "readers.h"
 #include "step_attempt.h"
+#include "step_parallel_transfer.h"
 
+#include <omp.h>
+
+#include <algorithm>
 #include <optional>
 #include <set>
 #include <string>
@@ -37,6 +41,14 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
     result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
     return result;
   };
+  // Workers are forked from the isolated reader's child, which has one thread; an unisolated reader
+  // runs in this process, which may have many, and never forks.
+  const std::size_t workers = !options.isolate_cad_readers ? 1
+                              : options.transfer_workers > 0 ? static_cast<std::size_t>(options.transfer_workers)
+                                                             : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+  const std::size_t min_bytes = options.transfer_workers > 0 ? 0 : kParallelReadMinBytes;
+  bool split = true;  // cut the text into pieces; off once a piece failed
+
   Attempt attempt = Attempt::Whole;
   std::set<std::int64_t> skip;  // face entities a child crashed on, each one
   constexpr std::size_t kMaxSkips = 20;
@@ -44,10 +56,14 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
   if (auto warning = unapplied_time_limit(path, options)) notes.push_back(*warning);
   for (;;) {
     IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(),
-                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip}); });
+                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip, workers, min_bytes, split}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
     read_seconds += run.transfer.read_seconds;
+    if (!child.crashed && run.transfer.split_failed) {
+      split = false;
+      continue;
+    }
     const bool parsed = child.marks.find(kParsed) != std::string::npos;
     if (!child.crashed) {
       if (child.marks.find(kShapes) != std::string::npos) return finish(std::move(run.transfer));

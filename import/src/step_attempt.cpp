@@ -3,6 +3,8 @@
 #include "step_attempt.h"
 
 #include "step_model_repairs.h"
+#include "step_parallel_transfer.h"
+#include "step_split_text.h"
 #include "step_text.h"
 #include "step_uncertainty.h"
 
@@ -17,12 +19,16 @@
 #include <TopExp_Explorer.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
+#include <XSControl_TransferReader.hxx>
 #include <XSControl_WorkSession.hxx>
+#include <TransferBRep.hxx>
+#include <Transfer_TransientProcess.hxx>
 
 #include <chrono>
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
 #include <utility>
 
 namespace cadclash::detail {
@@ -97,14 +103,45 @@ IFSelect_ReturnStatus parse(STEPCAFControl_Reader& reader, const std::string& pa
   return read_text(text, true);
 }
 
+// The pieces' shapes bound to the main text's stand-ins, by #id: the number of pieces, 0 when one
+// failed (nothing is bound then).
+std::size_t bind_pieces(Children& pieces, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
+                        const EntityLabelFn& label, ReadBindings& bound) {
+  std::string why;
+  const std::vector<ChildRun> runs = pieces.wait();
+  if (!read_bindings(runs, bound, why)) return 0;
+  std::unordered_map<std::int64_t, Handle(Standard_Transient)> by_id;
+  for (const auto& [id, shape] : bound.shapes) by_id.emplace(id, Handle(Standard_Transient)());
+  for (Standard_Integer e = 1; e <= model->NbEntities(); ++e)
+    if (const auto it = by_id.find(label(model->Value(e))); it != by_id.end()) it->second = model->Value(e);
+  std::vector<Handle(Standard_Transient)> entities;
+  for (const auto& [id, shape] : bound.shapes) entities.push_back(by_id[id]);
+  const Handle(Transfer_TransientProcess) process = ws->TransferReader()->TransientProcess();
+  return !process.IsNull() && bind_all(process, entities, bound.shapes, why) ? runs.size() : 0;
+}
+
 // The products into result.doc with the entity of each face, after the repairs that keep OCCT's
 // transfer from crashing or dropping products silently (step_model_repairs.h).
 void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
                        const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
-                       const AttemptRun& run, Transfer& result) {
+                       const AttemptRun& run, Children* pieces, Transfer& result) {
   if (run.attempt == Attempt::WithoutBrokenFaces) drop_broken_shapes(model, label, path, result);
   cut_deep_mapped_items(model, label, path, result);
   report_assembly_cycles(model, label, path, result);
+  ReadBindings bound;  // the pieces' shapes, held while their faces are tagged
+  if (pieces != nullptr) {
+    const std::size_t workers = bind_pieces(*pieces, model, ws, label, bound);
+    if (workers == 0) {
+      result.split_failed = true;
+      return;
+    }
+    // Reading ends when the slowest piece is parsed (the pieces parse while this process does).
+    result.read_seconds = std::max(result.read_seconds, result.split_seconds + bound.parse_seconds);
+    result.parallel_workers = workers;
+  } else if (run.attempt == Attempt::Whole && run.workers > 1) {
+    const ParallelTransfer parallel = transfer_shapes_in_parallel(model, ws, run.workers);
+    result.parallel_workers = parallel.used ? parallel.workers : 1;
+  }
 
   const std::optional<Handle(Transfer_TransientProcess)> process =
       transfer_document(reader, ws, model, label, path, "STEP", result);
@@ -117,15 +154,19 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
     const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
     if (!item.IsNull() && !item->Name().IsNull()) out.name = item->Name()->ToCString();
     return true;
-  });
+  }, bound.tags);
 }
 
 // The parsed model into shapes: its products, or its face entities one by one when the attempt
 // says so or the file has no product that can be transferred.
 void transfer_model(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
                     const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
-                    const AttemptRun& run, Transfer& result) {
+                    const AttemptRun& run, Children* pieces, Transfer& result) {
   STEPControl_Reader& step = reader.ChangeReader();
+  if (pieces != nullptr && (run.attempt == Attempt::LooseFaces || reader.NbRootsForTransfer() == 0)) {
+    result.split_failed = true;  // the stand-ins are no faces to recover: read the whole text
+    return;
+  }
   if (run.attempt == Attempt::LooseFaces) {
     recover_loose_faces(step, model, path, label, run, "the products could not be transferred", result);
     return;
@@ -139,13 +180,65 @@ void transfer_model(STEPCAFControl_Reader& reader, const Handle(StepData_StepMod
     result.complete = false;
     return;
   }
-  transfer_products(reader, model, ws, label, path, run, result);
+  transfer_products(reader, model, ws, label, path, run, pieces, result);
 }
 
 }  // namespace
 
-Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
+std::string read_step_piece(const std::string& path, const StepPiece& piece) {
   prepare_occt_exchange();
+  try {
+    STEPCAFControl_Reader reader;
+    configure(reader);
+    STEPControl_Reader& step = reader.ChangeReader();
+    const auto start = std::chrono::steady_clock::now();
+    std::istringstream in(piece.text);
+    if (step.ReadStream(path.c_str(), in) != IFSelect_RetDone) return {};
+    const double parse_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const Handle(StepData_StepModel) model = step.StepModel();
+    const Handle(XSControl_WorkSession) ws = step.WS();
+    if (model.IsNull() || ws.IsNull() || !ws->ModelCheckList(Standard_False).IsEmpty(Standard_True)) return {};
+    std::unordered_map<std::int64_t, Handle(Standard_Transient)> wanted;
+    for (const std::int64_t id : piece.reps) wanted.emplace(id, Handle(Standard_Transient)());
+    for (const std::int64_t id : piece.bind) wanted.emplace(id, Handle(Standard_Transient)());
+    for (Standard_Integer e = 1; e <= model->NbEntities(); ++e)
+      if (const auto it = wanted.find(model->IdentLabel(model->Value(e))); it != wanted.end()) it->second = model->Value(e);
+    const Handle(XSControl_TransferReader) transfer = ws->TransferReader();
+    for (const std::int64_t id : piece.reps) {
+      if (wanted[id].IsNull()) return {};
+      transfer->TransferOne(wanted[id], Standard_False);
+    }
+    const Handle(Transfer_TransientProcess) process = transfer->TransientProcess();
+    if (process.IsNull() || !process->CheckList(Standard_True).IsEmpty(Standard_True)) return {};
+    ShapeBindings out;
+    for (const std::int64_t id : piece.bind) {
+      const TopoDS_Shape shape = TransferBRep::ShapeResult(process, wanted[id]);
+      if (shape.IsNull()) return {};
+      out.bind(id, shape);
+    }
+    // Every face entity's faces, tagged as the main reader tags its own (transfer_products).
+    for (Standard_Integer i = 1; i <= process->NbMapped(); ++i) {
+      const Handle(Standard_Transient)& entity = process->Mapped(i);
+      if (entity.IsNull() || !entity->IsKind(STANDARD_TYPE(StepShape_Face))) continue;
+      const TopoDS_Shape shape = TransferBRep::ShapeResult(process->MapItem(i));
+      if (shape.IsNull()) continue;
+      FaceEntity tag;
+      const Standard_Integer id = model->IdentLabel(entity);
+      tag.id = id > 0 ? id : -1;
+      const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
+      if (!item.IsNull() && !item->Name().IsNull()) tag.name = item->Name()->ToCString();
+      const bool single = shape.ShapeType() == TopAbs_FACE;
+      for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next()) out.tag(f.Current(), tag, single);
+    }
+    return out.bytes(parse_seconds);
+  } catch (const Standard_Failure&) {
+    return {};
+  }
+}
+
+Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_run) {
+  prepare_occt_exchange();
+  AttemptRun run = attempt_run;
   Transfer result;
   try {
     STEPCAFControl_Reader reader;  // its constructor registers the STEP controller and its parameters
@@ -159,7 +252,24 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
       result.diagnostics.push_back(std::move(d));
       result.complete = false;
     }
-    const IFSelect_ReturnStatus status = parse(reader, path, text, readable, result);
+    if (text.size() < run.parallel_min_bytes) run.workers = 1;
+    // A large file is cut into pieces that workers parse and transfer while this process parses
+    // what is left (step_split_text.h); pieces that fail send read_step back to the whole file.
+    std::optional<StepSplit> split;
+    std::optional<Children> pieces;
+    if (run.split && run.attempt == Attempt::Whole && run.workers > 1 && readable) {
+      std::string why;
+      split = split_step_text(text, run.workers, why);
+      if (split) pieces.emplace(split->pieces.size(), [&](std::size_t k, const Mark&) { return read_step_piece(path, split->pieces[k]); });
+      result.split_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
+    }
+    IFSelect_ReturnStatus status;
+    if (split) {
+      std::istringstream main_text(split->main_text);
+      status = reader.ChangeReader().ReadStream(path.c_str(), main_text);
+    } else {
+      status = parse(reader, path, text, readable, result);
+    }
     result.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     STEPControl_Reader& step = reader.ChangeReader();
     const Handle(StepData_StepModel) model = step.StepModel();
@@ -190,7 +300,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& run) {
       result.complete = false;
       return result;
     }
-    transfer_model(reader, model, ws, label, path, run, result);
+    transfer_model(reader, model, ws, label, path, run, pieces ? &*pieces : nullptr, result);
   } catch (const Standard_Failure& e) {
     record_occt_failure(result, path, "STEP", e);
   }

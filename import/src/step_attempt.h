@@ -6,6 +6,7 @@
 #include "cad_transfer.h"
 #include "cad_xcaf.h"
 #include "isolated_run.h"
+#include "step_split_text.h"
 
 #include <STEPControl_Reader.hxx>
 #include <StepData_StepModel.hxx>
@@ -33,7 +34,19 @@ struct AttemptRun {
   Attempt attempt = Attempt::Whole;
   Mark mark = [](char) {};
   const std::set<std::int64_t>* skip = nullptr;  // LooseFaces: face entities (#id) an earlier child crashed on
+  // Whole: processes that read the file at once, for files of at least `parallel_min_bytes`; 1 =
+  // this process alone. With `split`, the text is cut into pieces that they parse and transfer
+  // (step_split_text.h); else, or when it cannot be cut, they transfer the shapes of the parsed
+  // file (step_parallel_transfer.h). Only in an isolated reader's child, which has one thread.
+  std::size_t workers = 1;
+  std::size_t parallel_min_bytes = 0;
+  bool split = true;
 };
+
+// In a piece's worker: parses `piece` (step_split_text.h), transfers its representations and
+// returns the shapes of the ids `piece.bind` names and the tags of every face, as ShapeBindings'
+// bytes; "" when anything failed or an id got no shape.
+std::string read_step_piece(const std::string& path, const StepPiece& piece);
 
 // Reads and transfers the file one way (`run.attempt`), tessellating nothing.
 Transfer read_step_attempt(const std::string& path, const AttemptRun& run);

@@ -8,22 +8,44 @@
 #include <cmath>
 #include <cstdlib>
 #include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
 
 namespace cadclash::detail {
 namespace {
 
-// The text of entity #id up to its ';' (empty when it is not found).
-std::string_view entity_text(const std::string& text, std::int64_t id) {
-  const std::string key = "#" + std::to_string(id);
-  for (std::size_t at = text.find(key); at != std::string::npos; at = text.find(key, at + 1)) {
-    std::size_t k = at + key.size();
-    if (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) continue;  // #12 is not #123
-    while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
-    if (k >= text.size() || text[k] != '=') continue;
-    const std::size_t end = text.find(';', k);
-    return std::string_view(text).substr(k + 1, end == std::string::npos ? std::string::npos : end - k - 1);
+// The text after '=' up to ';' of each entity in `ids`, found in one pass over the statements (a
+// search per entity from the top of a 40 MB file took seconds).
+std::unordered_map<std::int64_t, std::string_view> entity_texts(const std::string& text,
+                                                                 const std::unordered_set<std::int64_t>& ids) {
+  std::unordered_map<std::int64_t, std::string_view> out;
+  bool quoted = false, statement_start = true;
+  for (std::size_t i = 0; i < text.size() && out.size() < ids.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      quoted = c != '\'';
+      continue;
+    }
+    if (c == '\'') {
+      quoted = true;
+      statement_start = false;
+    } else if (c == ';') {
+      statement_start = true;
+    } else if (c == '#' && statement_start) {
+      statement_start = false;
+      std::int64_t id = 0;
+      std::size_t k = i + 1;
+      while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[k++] - '0');
+      while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+      if (k >= text.size() || text[k] != '=' || !ids.count(id)) continue;
+      const std::size_t end = text.find(';', k);
+      out.emplace(id, std::string_view(text).substr(k + 1, end == std::string::npos ? std::string::npos : end - k - 1));
+    } else if (!std::isspace(static_cast<unsigned char>(c))) {
+      statement_start = false;
+    }
   }
-  return {};
+  return out;
 }
 
 // Millimetres per unit of a LENGTH_UNIT entity; 0 when it is not understood.
@@ -51,26 +73,38 @@ double declared_length_uncertainty(const std::string& text, const std::string& p
                                    std::vector<Diagnostic>& diagnostics) {
   constexpr std::string_view kEntity = "UNCERTAINTY_MEASURE_WITH_UNIT";
   constexpr std::string_view kLength = "LENGTH_MEASURE(";
-  double worst = 0.0;
+  struct Declared {
+    std::int64_t self = -1;  // the entity's own #id, for messages
+    double value = 0.0;
+    std::int64_t unit = -1;  // the #id of its unit
+  };
+  std::vector<Declared> declared;
+  std::unordered_set<std::int64_t> units;
   for (std::size_t at = text.find(kEntity); at != std::string::npos; at = text.find(kEntity, at + 1)) {
-    // The entity's own #id, for messages: the last '#' before '=' that precedes this keyword.
+    // The entity's own #id: the last '#' before '=' that precedes this keyword.
     const std::size_t eq = text.rfind('=', at), hash = eq == std::string::npos ? eq : text.rfind('#', eq);
     const std::int64_t self = hash == std::string::npos ? -1 : std::strtoll(text.c_str() + hash + 1, nullptr, 10);
-    const std::size_t m = text.find(kLength, at);
     const std::size_t stop = text.find(';', at);
-    if (m == std::string::npos || m > stop) continue;  // not a length uncertainty
+    const std::size_t m = std::string_view(text).substr(at, stop == std::string::npos ? std::string::npos : stop - at).find(kLength);
+    if (m == std::string_view::npos) continue;  // not a length uncertainty
     char* end = nullptr;
-    const double value = std::strtod(text.c_str() + m + kLength.size(), &end);
+    const double value = std::strtod(text.c_str() + at + m + kLength.size(), &end);
     const std::size_t ref = text.find('#', static_cast<std::size_t>(end - text.c_str()));
-    double mm = 0.0;
-    if (ref != std::string::npos && ref < stop)
-      mm = millimetres_per(entity_text(text, std::strtoll(text.c_str() + ref + 1, nullptr, 10)));
-    if (!(value >= 0.0) || !std::isfinite(value) || mm == 0.0) {
-      diagnostics.push_back({Severity::Warning, path, 0, self,
+    const std::int64_t unit = ref != std::string::npos && ref < stop ? std::strtoll(text.c_str() + ref + 1, nullptr, 10) : -1;
+    declared.push_back({self, value, unit});
+    if (unit >= 0) units.insert(unit);
+  }
+  const std::unordered_map<std::int64_t, std::string_view> unit_texts = entity_texts(text, units);
+  double worst = 0.0;
+  for (const Declared& d : declared) {
+    const auto unit = unit_texts.find(d.unit);
+    const double mm = unit == unit_texts.end() ? 0.0 : millimetres_per(unit->second);
+    if (!(d.value >= 0.0) || !std::isfinite(d.value) || mm == 0.0) {
+      diagnostics.push_back({Severity::Warning, path, 0, d.self,
                              "length uncertainty with a value or unit that could not be read; ignored"});
       continue;
     }
-    worst = std::max(worst, value * mm);
+    worst = std::max(worst, d.value * mm);
   }
   return worst;
 }

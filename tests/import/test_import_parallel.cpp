@@ -56,6 +56,43 @@ TEST(ImportParallel, SameSceneForAnyNumberOfFilesAtOnce) {
   }
 }
 
+// One STEP file's shapes transferred by several processes (ImportOptions::transfer_workers): the same
+// scene, diagnostics and face #ids as the reader alone, on every sample STEP file; the files with
+// several separate shapes are really spread (a fallback to the reader alone would pass the rest).
+TEST(ImportParallel, OneFileTransferredBySeveralProcessesGivesTheSameScene) {
+  const std::vector<std::string> files{
+      kData + "external/as1-tu-203.stp",  kData + "external/linkrods.step", kData + "external/screw.step",
+      kData + "external/component8.step", kData + "external/frame.step",    kData + "external/step_boundary_colors.stp",
+      kData + "external/t20_data.step",   kData + "cad/valid_two_solids.step", kData + "cad/truncated.step",
+      kData + "cad/dangling_ref.step",    kData + "cad/mesh_fail_degenerate.step",
+  };
+  for (const std::string& f : files) {
+    SCOPED_TRACE(f);
+    if (f.find("external/") != std::string::npos && !fs::exists(f)) GTEST_SKIP() << f << " missing: run scripts/setup.sh";
+    ImportOptions options;
+    options.transfer_workers = 1;
+    const ImportResult alone = import_file(f, options);
+    ASSERT_EQ(alone.files.size(), 1u);
+    EXPECT_EQ(alone.files[0].transfer_workers, 1u);
+    for (const int workers : {2, 3}) {
+      SCOPED_TRACE(workers);
+      options.transfer_workers = workers;
+      const ImportResult spread = import_file(f, options);
+      EXPECT_EQ(messages(spread), messages(alone));
+      EXPECT_EQ(spread.complete, alone.complete);
+      EXPECT_TRUE(same_bytes(everything(spread), everything(alone)));
+      ASSERT_EQ(spread.files.size(), 1u);
+      // as1 has 7 distinct parts, valid_two_solids two unconnected solids: both must be spread.
+      if (f.find("as1-tu-203") != std::string::npos) {
+        EXPECT_EQ(spread.files[0].transfer_workers, static_cast<std::size_t>(workers));
+      }
+      if (f.find("valid_two_solids") != std::string::npos) {
+        EXPECT_EQ(spread.files[0].transfer_workers, 2u);
+      }
+    }
+  }
+}
+
 // import_files in two steps (import_each_file, merge_file_imports), and each file's result through its
 // description (what another MPI rank receives): the same scene, B-rep parts with stand-in sources
 // that know their deflection and mesh nothing.

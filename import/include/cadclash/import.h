@@ -64,6 +64,11 @@ struct ImportOptions {
   // Turn it off only for trusted files, or in a host that must not fork (fork copies only the
   // calling thread; a thread of the host holding a lock OCCT needs would hang the child).
   bool isolate_cad_readers = true;
+  // STEP with isolate_cad_readers: processes that transfer one file's shapes into B-rep at once, forked
+  // from its isolated reader after parsing (they share the parsed file; shapes whose topology meets
+  // go to one process). 0 = one per OpenMP thread (omp_get_max_threads) for files of 20,000 entities
+  // or more, else 1; 1 = the reader alone. The result does not depend on it.
+  int transfer_workers = 0;
   // STEP/IGES/BREP with isolate_cad_readers: seconds the isolated reader of one file may take over
   // all its attempts; 0 = no limit. Past it the child is killed and the file reported with an error
   // naming what it was reading (the entity #id when known); an earlier attempt's faces are kept.
@@ -116,6 +121,9 @@ struct FileImport {
   std::string path;  // as given
   CacheUse cache = CacheUse::Off;
   ImportTimings timings;
+  // STEP: processes that transferred the file's shapes (ImportOptions::transfer_workers); 1 = the
+  // reader alone, and for other formats and cache hits.
+  std::size_t transfer_workers = 1;
 };
 
 struct ImportResult {

@@ -1,0 +1,448 @@
+// A STEP file's text cut into pieces by B-rep item (step_split_text.h).
+#include "step_split_text.h"
+
+#include <algorithm>
+#include <cctype>
+#include <numeric>
+#include <span>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace cadclash::detail {
+namespace {
+
+// One "#id = ... ;" of the DATA section.
+struct Statement {
+  std::int64_t id = 0;
+  std::size_t begin = 0, end = 0;  // the statement, ';' included
+  std::size_t body = 0;            // just after '='
+  std::string_view type;           // the simple entity's type; empty for a complex entity "(A() B())"
+  std::size_t first_ref = 0, refs = 0;  // into Scan::refs: the statements it references, in order
+};
+
+struct Scan {
+  std::string_view header;  // up to and without "DATA;"
+  std::vector<Statement> statements;
+  std::vector<std::uint32_t> refs;  // statement indices
+};
+
+bool is_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+
+// Every statement of the DATA section with what it references; nullopt (and why) when the text is
+// not plain enough to cut.
+std::optional<Scan> scan(const std::string& text, std::string& why) {
+  const std::size_t data = text.find("DATA;");
+  if (data == std::string::npos || text.find("DATA;", data + 5) != std::string::npos) {
+    why = "not one DATA section";
+    return std::nullopt;
+  }
+  Scan out;
+  out.header = std::string_view(text).substr(0, data);
+  std::vector<std::int64_t> raw;  // referenced ids, resolved to statements below
+  std::size_t i = data + 5;
+  const std::size_t n = text.size();
+  for (;;) {
+    while (i < n && is_space(text[i])) ++i;
+    if (i >= n) {
+      why = "the DATA section does not end";
+      return std::nullopt;
+    }
+    if (text.compare(i, 7, "ENDSEC;") == 0) break;
+    if (text[i] != '#') {
+      why = text.compare(i, 2, "/*") == 0 ? "a comment in the DATA section" : "unexpected text in the DATA section";
+      return std::nullopt;
+    }
+    Statement s;
+    s.begin = i++;
+    while (i < n && std::isdigit(static_cast<unsigned char>(text[i])) && s.id < (std::int64_t{1} << 50)) s.id = s.id * 10 + (text[i++] - '0');
+    while (i < n && is_space(text[i])) ++i;
+    if (i >= n || text[i] != '=') {
+      why = "a statement without '='";
+      return std::nullopt;
+    }
+    s.body = ++i;
+    while (i < n && is_space(text[i])) ++i;
+    if (i < n && text[i] != '(') {
+      const std::size_t t = i;
+      while (i < n && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '_')) ++i;
+      s.type = std::string_view(text).substr(t, i - t);
+    }
+    s.first_ref = raw.size();
+    bool quoted = false;
+    for (; i < n; ++i) {
+      const char c = text[i];
+      if (quoted) {
+        quoted = c != '\'';  // '' closes and reopens: the same
+      } else if (c == '\'') {
+        quoted = true;
+      } else if (c == ';') {
+        break;
+      } else if (c == '#') {
+        std::int64_t id = 0;
+        std::size_t j = i + 1;
+        while (j < n && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
+        if (j > i + 1) raw.push_back(id);
+        i = j - 1;
+      } else if (c == '/' && i + 1 < n && text[i + 1] == '*') {
+        why = "a comment in the DATA section";
+        return std::nullopt;
+      }
+    }
+    if (i >= n) {
+      why = "a statement does not end";
+      return std::nullopt;
+    }
+    s.end = ++i;
+    s.refs = raw.size() - s.first_ref;
+    out.statements.push_back(s);
+  }
+  if (text.find("END-ISO-10303-21", i) == std::string::npos) {
+    why = "the file does not end";
+    return std::nullopt;
+  }
+  std::unordered_map<std::int64_t, std::uint32_t> index;
+  index.reserve(out.statements.size());
+  for (std::size_t k = 0; k < out.statements.size(); ++k)
+    if (!index.emplace(out.statements[k].id, static_cast<std::uint32_t>(k)).second) {
+      why = "an id defined twice";
+      return std::nullopt;
+    }
+  out.refs.resize(raw.size());
+  for (std::size_t r = 0; r < raw.size(); ++r) {
+    const auto it = index.find(raw[r]);
+    if (it == index.end()) {
+      why = "a reference to an undefined id";
+      return std::nullopt;
+    }
+    out.refs[r] = it->second;
+  }
+  return out;
+}
+
+// B-rep items: what a piece transfers.
+bool is_item(std::string_view t) {
+  return t == "MANIFOLD_SOLID_BREP" || t == "BREP_WITH_VOIDS" || t == "FACETED_BREP" || t == "SHELL_BASED_SURFACE_MODEL";
+}
+
+// Entities any number of items may share without sharing topology: OCCT makes new objects of them
+// for every use.
+bool is_leaf(std::string_view t) {
+  return t == "CARTESIAN_POINT" || t == "DIRECTION" || t == "VECTOR" || t == "AXIS2_PLACEMENT_3D" ||
+         t == "AXIS2_PLACEMENT_2D" || t == "AXIS1_PLACEMENT";
+}
+
+bool is_shape_representation(std::string_view t) {
+  return t.size() >= 20 && t.substr(t.size() - 20) == "SHAPE_REPRESENTATION";
+}
+
+// The first parameter of a simple entity (its name, for representation items): the token after
+// "TYPE(", a quoted string with its quotes, or '$' / '*'.
+std::string_view first_parameter(const std::string& text, const Statement& s) {
+  std::size_t i = text.find('(', s.body);
+  if (i == std::string::npos || i >= s.end) return "''";
+  ++i;
+  while (i < s.end && is_space(text[i])) ++i;
+  if (i < s.end && text[i] == '\'') {
+    std::size_t j = i + 1;
+    for (; j < s.end; ++j)
+      if (text[j] == '\'') {
+        if (j + 1 < s.end && text[j + 1] == '\'') ++j;
+        else break;
+      }
+    return std::string_view(text).substr(i, j + 1 - i);
+  }
+  if (i < s.end && (text[i] == '$' || text[i] == '*')) return std::string_view(text).substr(i, 1);
+  return "''";
+}
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t root(std::uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = root(a), b = root(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+std::optional<StepSplit> split_step_text(const std::string& text, std::size_t workers, std::string& why_not) {
+  if (workers < 2) {
+    why_not = "one worker";
+    return std::nullopt;
+  }
+  std::optional<Scan> scanned = scan(text, why_not);
+  if (!scanned) return std::nullopt;
+  const Scan& sc = *scanned;
+  const std::vector<Statement>& st = sc.statements;
+  const std::size_t n = st.size();
+  std::vector<std::uint32_t> items;
+  std::int64_t max_id = 0;
+  bool products = false;
+  // What items may share without being joined: leaves, and representation contexts (of the
+  // parameter curves' 2D spaces, which some exporters write once for all).
+  std::vector<char> joins_nothing(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    max_id = std::max(max_id, st[k].id);
+    products = products || st[k].type == "PRODUCT_DEFINITION";
+    joins_nothing[k] = is_leaf(st[k].type) ||
+                       (st[k].type.empty() &&
+                        std::string_view(text).substr(st[k].body, st[k].end - st[k].body).find("REPRESENTATION_CONTEXT") !=
+                            std::string_view::npos);
+    if (st[k].type == "MAPPED_ITEM" || st[k].type == "NON_MANIFOLD_SURFACE_SHAPE_REPRESENTATION") {
+      why_not = std::string(st[k].type) + " in the file";
+      return std::nullopt;
+    }
+    if (is_item(st[k].type)) items.push_back(static_cast<std::uint32_t>(k));
+  }
+  if (items.size() < 2 || !products) {
+    why_not = products ? "fewer than two B-rep items" : "no product";
+    return std::nullopt;
+  }
+  auto refs_of = [&](std::uint32_t k) {
+    return std::span<const std::uint32_t>(sc.refs.data() + st[k].first_ref, st[k].refs);
+  };
+
+  // Groups: items joined where their insides meet beyond leaves; each non-leaf inside has one owner.
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> owner(n, kNone);  // item ordinal
+  UnionFind sets(items.size());
+  std::vector<std::size_t> bytes(items.size(), 0);
+  std::vector<std::uint32_t> stack;
+  for (std::uint32_t h = 0; h < items.size(); ++h) {
+    stack.assign(1, items[h]);
+    while (!stack.empty()) {
+      const std::uint32_t e = stack.back();
+      stack.pop_back();
+      if (joins_nothing[e] != 0) continue;
+      if (owner[e] == h) continue;
+      if (owner[e] != kNone) {
+        sets.unite(owner[e], h);
+        continue;
+      }
+      owner[e] = h;
+      bytes[h] += st[e].end - st[e].begin;
+      for (const std::uint32_t r : refs_of(e)) stack.push_back(r);
+    }
+  }
+  std::vector<std::uint32_t> group_of(items.size());
+  std::vector<std::size_t> group_bytes;
+  {
+    std::vector<std::uint32_t> number(items.size(), kNone);
+    for (std::uint32_t h = 0; h < items.size(); ++h) {
+      const std::uint32_t r = sets.root(h);
+      if (number[r] == kNone) {
+        number[r] = static_cast<std::uint32_t>(group_bytes.size());
+        group_bytes.push_back(0);
+      }
+      group_of[h] = number[r];
+      group_bytes[number[r]] += bytes[h];
+    }
+  }
+  const std::size_t groups = group_bytes.size();
+  if (groups < 2) {
+    why_not = "one group of shapes";
+    return std::nullopt;
+  }
+  // Largest group first onto the least loaded worker (ties: lower index).
+  const std::size_t used = std::min(workers, groups);
+  std::vector<std::uint32_t> worker_of_group(groups);
+  {
+    std::vector<std::size_t> order(groups);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return group_bytes[a] > group_bytes[b]; });
+    std::vector<std::size_t> load(used, 0);
+    for (const std::size_t g : order) {
+      const auto w = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+      load[w] += group_bytes[g] + 1;
+      worker_of_group[g] = static_cast<std::uint32_t>(w);
+    }
+  }
+  auto worker_of = [&](std::uint32_t e) { return worker_of_group[group_of[owner[e]]]; };
+
+  // Each item's representation context: the last reference of every shape representation that lists
+  // it; they must agree (the units the item is read in).
+  std::vector<std::int64_t> context_of(items.size(), -1);
+  std::vector<char> in_items(n, 0);
+  std::vector<std::uint32_t> item_ordinal(n, kNone);
+  for (std::uint32_t h = 0; h < items.size(); ++h) item_ordinal[items[h]] = h;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const auto refs = refs_of(k);
+    bool lists_item = false;
+    for (const std::uint32_t r : refs) lists_item = lists_item || item_ordinal[r] != kNone;
+    if (!lists_item) continue;
+    if (st[k].type.empty()) {
+      why_not = "a complex entity names a B-rep item";
+      return std::nullopt;
+    }
+    if (!is_shape_representation(st[k].type) || refs.empty()) continue;
+    const std::int64_t context = st[refs.back()].id;
+    for (std::size_t r = 0; r + 1 < refs.size(); ++r) {
+      const std::uint32_t h = item_ordinal[refs[r]];
+      if (h == kNone) continue;
+      if (context_of[h] >= 0 && context_of[h] != context) {
+        why_not = "a B-rep item in representations of different contexts";
+        return std::nullopt;
+      }
+      context_of[h] = context;
+    }
+  }
+  for (std::uint32_t h = 0; h < items.size(); ++h)
+    if (context_of[h] < 0) {
+      why_not = "a B-rep item outside any shape representation";
+      return std::nullopt;
+    }
+
+  // Pieces: per worker, its items' whole insides (leaves included) and, per context, a shape
+  // representation of its items with that context and what the context reaches.
+  StepSplit out;
+  out.groups = groups;
+  out.pieces.resize(used);
+  std::vector<std::uint32_t> stamp(n, kNone);  // worker whose piece holds the statement
+  std::vector<std::vector<std::uint32_t>> members(used);
+  auto take = [&](std::uint32_t start, std::uint32_t w) {
+    stack.assign(1, start);
+    while (!stack.empty()) {
+      const std::uint32_t e = stack.back();
+      stack.pop_back();
+      if (stamp[e] == w) continue;
+      stamp[e] = w;
+      in_items[e] = 1;
+      members[w].push_back(e);
+      for (const std::uint32_t r : refs_of(e)) stack.push_back(r);
+    }
+  };
+  // A statement can be in several pieces (leaves, contexts): stamps are per worker, so each worker
+  // takes its statements in one sweep before the next.
+  std::vector<std::vector<std::uint32_t>> items_of(used);
+  for (std::uint32_t h = 0; h < items.size(); ++h) items_of[worker_of(items[h])].push_back(h);
+  std::unordered_map<std::int64_t, std::uint32_t> statement_of_id;
+  for (std::uint32_t k = 0; k < n; ++k)
+    if (st[k].type.empty() || st[k].type.find("CONTEXT") != std::string_view::npos) statement_of_id.emplace(st[k].id, k);
+  std::vector<char> context_statement(n, 0);
+  std::int64_t next_id = max_id + 1;
+  std::vector<std::string> synthetic(used);
+  for (std::uint32_t w = 0; w < used; ++w) {
+    std::fill(stamp.begin(), stamp.end(), kNone);
+    std::vector<std::pair<std::int64_t, std::vector<std::int64_t>>> by_context;
+    for (const std::uint32_t h : items_of[w]) {
+      take(items[h], w);
+      auto it = std::find_if(by_context.begin(), by_context.end(), [&](const auto& c) { return c.first == context_of[h]; });
+      if (it == by_context.end()) it = by_context.insert(by_context.end(), {context_of[h], {}});
+      it->second.push_back(st[items[h]].id);
+    }
+    for (auto& [context, ids] : by_context) {
+      const auto c = statement_of_id.find(context);
+      if (c == statement_of_id.end()) {
+        why_not = "a representation context that is not a context";
+        return std::nullopt;
+      }
+      const std::size_t before = members[w].size();
+      take(c->second, w);
+      for (std::size_t m = before; m < members[w].size(); ++m) {
+        context_statement[members[w][m]] = 1;
+        in_items[members[w][m]] = 0;  // a context stays whole in the main text too
+      }
+      std::string rep = "#";
+      rep += std::to_string(next_id) + "=SHAPE_REPRESENTATION('',(";
+      for (std::size_t k = 0; k < ids.size(); ++k) rep += (k ? ",#" : "#") + std::to_string(ids[k]);
+      rep += "),#" + std::to_string(context) + ");\n";
+      synthetic[w] += rep;
+      out.pieces[w].reps.push_back(next_id++);
+    }
+    std::sort(members[w].begin(), members[w].end());
+  }
+
+  // The main text: every statement no piece took as an item's inside, the leaves they reach, and a
+  // placeholder for each item or inside entity they name.
+  std::vector<char> keep(n, 0), stand_in(n, 0);
+  for (std::uint32_t k = 0; k < n; ++k) keep[k] = in_items[k] == 0 || context_statement[k] != 0 ? 1 : 0;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    if (keep[k] == 0 || is_leaf(st[k].type)) continue;
+    for (const std::uint32_t r : refs_of(k)) {
+      if (keep[r] != 0) continue;
+      if (!is_leaf(st[r].type)) {
+        stand_in[r] = 1;
+        continue;
+      }
+      // A leaf an item shares with the main text: kept, with the leaves below it.
+      stack.assign(1, r);
+      while (!stack.empty()) {
+        const std::uint32_t e = stack.back();
+        stack.pop_back();
+        if (keep[e] != 0) continue;
+        if (!is_leaf(st[e].type)) {
+          why_not = "a point or placement names a shape's inside";
+          return std::nullopt;
+        }
+        keep[e] = 1;
+        for (const std::uint32_t q : refs_of(e)) stack.push_back(q);
+      }
+    }
+  }
+  // Placeholders share one small valid face (never transferred: their ids are bound first).
+  const std::int64_t point = next_id++, axes = next_id++, plane = next_id++, vertex = next_id++, loop = next_id++,
+                     bound = next_id++, face = next_id++, closed = next_id++, open = next_id++, void_shell = next_id++;
+  auto ref = [](std::int64_t id) {
+    std::string r = "#";  // two steps: GCC 12 warns falsely (-Wrestrict) on "#" + string
+    r += std::to_string(id);
+    return r;
+  };
+  std::string& main = out.main_text;
+  main.reserve(text.size() / 4);
+  main.append(sc.header);
+  main += "DATA;\n";
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const Statement& s = st[k];
+    if (keep[k] != 0) {
+      main.append(text, s.begin, s.end - s.begin);
+      main += '\n';
+      continue;
+    }
+    if (stand_in[k] == 0) continue;
+    if (owner[k] == kNone) {
+      why_not = "a context inside a shape is named from outside it";
+      return std::nullopt;
+    }
+    const std::string name(first_parameter(text, s));
+    const std::string head = ref(s.id) + "=" + std::string(s.type) + "(" + name + ",";
+    if (s.type == "ADVANCED_FACE" || s.type == "FACE_SURFACE") main += head + "(" + ref(bound) + ")," + ref(plane) + ",.T.);\n";
+    else if (s.type == "MANIFOLD_SOLID_BREP" || s.type == "FACETED_BREP") main += head + ref(closed) + ");\n";
+    else if (s.type == "BREP_WITH_VOIDS") main += head + ref(closed) + ",(" + ref(void_shell) + "));\n";
+    else if (s.type == "SHELL_BASED_SURFACE_MODEL") main += head + "(" + ref(open) + "));\n";
+    else if (s.type == "CLOSED_SHELL" || s.type == "OPEN_SHELL") main += head + "(" + ref(face) + "));\n";
+    else {
+      why_not = "a " + (s.type.empty() ? std::string("complex entity") : std::string(s.type)) + " inside a shape is named from outside it";
+      return std::nullopt;
+    }
+    out.pieces[worker_of(k)].bind.push_back(s.id);
+  }
+  main += ref(point) + "=CARTESIAN_POINT('',(0.,0.,0.));\n" + ref(axes) + "=AXIS2_PLACEMENT_3D(''," + ref(point) + ",$,$);\n" +
+          ref(plane) + "=PLANE(''," + ref(axes) + ");\n" + ref(vertex) + "=VERTEX_POINT(''," + ref(point) + ");\n" + ref(loop) +
+          "=VERTEX_LOOP(''," + ref(vertex) + ");\n" + ref(bound) + "=FACE_BOUND(''," + ref(loop) + ",.T.);\n" + ref(face) +
+          "=ADVANCED_FACE('',(" + ref(bound) + ")," + ref(plane) + ",.T.);\n" + ref(closed) + "=CLOSED_SHELL('',(" + ref(face) +
+          "));\n" + ref(open) + "=OPEN_SHELL('',(" + ref(face) + "));\n" + ref(void_shell) + "=ORIENTED_CLOSED_SHELL('',*," +
+          ref(closed) + ",.F.);\n";
+  main += "ENDSEC;\nEND-ISO-10303-21;\n";
+
+  for (std::uint32_t w = 0; w < used; ++w) {
+    StepPiece& piece = out.pieces[w];
+    piece.text.append(sc.header);
+    piece.text += "DATA;\n";
+    for (const std::uint32_t k : members[w]) {
+      piece.text.append(text, st[k].begin, st[k].end - st[k].begin);
+      piece.text += '\n';
+    }
+    piece.text += synthetic[w];
+    piece.text += "ENDSEC;\nEND-ISO-10303-21;\n";
+    std::sort(piece.bind.begin(), piece.bind.end());
+  }
+  return out;
+}
+
+}  // namespace cadclash::detail
