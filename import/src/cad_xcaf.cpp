@@ -28,6 +28,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <string_view>
 
 namespace cadclash::detail {
 namespace {
@@ -42,6 +43,14 @@ std::string label_name(const TDF_Label& label) {
 std::string path_component(std::string name) {
   std::replace(name.begin(), name.end(), '/', '_');
   return name.empty() ? std::string("unnamed") : name;
+}
+
+// Names that say nothing a reader can use: empty, the label entries OCCT's XCAF writer gives an
+// unnamed occurrence ("=>[0:1:1:9]"), and the shape types it gives an unnamed product ("SOLID").
+bool generic_name(std::string_view name) {
+  if (name.empty() || name == "unnamed" || name == "SOLID" || name == "COMPOUND" || name == "COMPSOLID" || name == "SHELL")
+    return true;
+  return name.size() >= 4 && name.substr(0, 3) == "=>[" && name.back() == ']';
 }
 
 // Applies the occurrence rule to one set of siblings (see import.h): a name that occurs more than
@@ -74,10 +83,25 @@ struct Walker {
   const std::string& file;
   std::map<std::string, std::size_t> part_of_label;  // TDF entry → index in `leaves`
   std::vector<TDF_Label> leaves;
+  std::vector<std::string> leaf_names;  // the part name of each of `leaves` (see import.h)
   std::vector<Instance> instances;  // part = index into `leaves`
   std::vector<Diagnostic>& diagnostics;
+  std::vector<std::string> products{};  // the product names from the root down to the label visited
 
   void visit(const TDF_Label& label, const TopLoc_Location& location, const std::string& path, int depth) {
+    products.push_back(label_name(label));
+    visit_named(label, location, path, depth);
+    products.pop_back();
+  }
+
+  // A leaf's part name: its product's, or when that is generic the nearest ancestor's that is not.
+  std::string part_name() const {
+    for (auto it = products.rbegin(); it != products.rend(); ++it)
+      if (!generic_name(*it)) return *it;
+    return products.back();
+  }
+
+  void visit_named(const TDF_Label& label, const TopLoc_Location& location, const std::string& path, int depth) {
     if (depth > 64) {
       diagnostics.push_back({Severity::Error, file, 0, -1, "assembly nesting deeper than 64 levels at " + path + "; cut there"});
       return;
@@ -99,14 +123,18 @@ struct Walker {
       const std::vector<std::string> parts = sibling_components(names);
       for (std::size_t i = 0; i < referred.size(); ++i) {
         const TopLoc_Location child = location * XCAFDoc_ShapeTool::GetLocation(components(static_cast<Standard_Integer>(i) + 1));
-        visit(referred[i], child, path + "/" + parts[i], depth + 1);
+        // An only child with a generic name adds nothing to its parent's path, which stays unique.
+        visit(referred[i], child, referred.size() == 1 && generic_name(names[i]) ? path : path + "/" + parts[i], depth + 1);
       }
       return;
     }
     TCollection_AsciiString entry;
     TDF_Tool::Entry(label, entry);
     auto [it, inserted] = part_of_label.try_emplace(entry.ToCString(), leaves.size());
-    if (inserted) leaves.push_back(label);
+    if (inserted) {
+      leaves.push_back(label);
+      leaf_names.push_back(part_name());
+    }
     const gp_Trsf& trsf = location.Transformation();
     if (std::abs(trsf.ScaleFactor() - 1.0) > 1e-9) {
       diagnostics.push_back({Severity::Warning, file, 0, -1,
@@ -216,7 +244,7 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
                        const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
                        BrepPartTimings* timings) {
-  Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, result.diagnostics};
+  Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, {}, result.diagnostics};
   TDF_LabelSequence roots;
   walker.shapes->GetFreeShapes(roots);
   std::vector<std::string> names;
@@ -232,7 +260,7 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
     shapes[p] = XCAFDoc_ShapeTool::GetShape(label);
     BrepPartInput& in = inputs[p];
     in.shape = &shapes[p];
-    in.name = label_name(label);
+    in.name = walker.leaf_names[p];
     if (in.name.empty()) in.name = "part" + std::to_string(p);
     in.source_file = file;
     in.kind = kind;
