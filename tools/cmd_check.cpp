@@ -570,6 +570,13 @@ void register_check(CLI::App& app) {
       "(even in a partial report); 4 a --time-budget or --memory-budget ran out: the report (table, --json) was\n"
       "written, marked PARTIAL, listing the instance pairs not examined.\n");
   add_input_options(*cmd, o->in);
+  // A check meshes only the faces its queries reach (the same report as meshing every face first);
+  // --eager meshes every face at import, as `tessellate` and `info` do.
+  o->in.lazy = true;
+  CLI::Option* lazy = cmd->get_option("--lazy");
+  lazy->description("Tessellate B-rep faces only when a query needs them (the default of check)");
+  cmd->add_flag_callback("--eager", [o] { o->in.lazy = false; }, "Tessellate every B-rep face at import, not only the ones a query reaches")
+      ->excludes(lazy);
   cmd->add_option("--tolerance", o->tolerance, "Contact tolerance t, mm (touching: distance <= t + both deflections)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);

@@ -344,6 +344,7 @@ ReportImport read_import(const Json& j, const std::string& p) {
                                 {"heal", &ReportFileImport::heal}, {"tessellate", &ReportFileImport::tessellate},
                                 {"total", &ReportFileImport::total}})
       f.*member = number(field(files[k], pk, name), pk + "/" + name);
+    if (files[k].contains("processes")) f.processes = count(files[k]["processes"], pk + "/processes");  // since 2026-11
     out.files.push_back(std::move(f));
   }
   return out;

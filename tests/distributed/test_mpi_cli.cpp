@@ -1,10 +1,10 @@
 // `cadclash check` under mpirun on localhost (1, 2 and 4 ranks, oversubscribed): the JSON report
 // (--no-timings), the table on stdout and the HTML report are byte-identical to one process's; the
 // per-rank lines are printed; a rank that crashes is named with its unfinished instance pairs.
-// Without --lazy the ranks mesh whole parts where their shares need them (part meshing): still one
+// With --eager the ranks mesh whole parts where their shares need them (part meshing): still one
 // eagerly importing process's reports, with fewer triangles meshed per rank than the model holds.
 // Several files are each read on one rank, and on another only when its share reaches them (with
-// --lazy too); rank 0 reads for --volume only the files of the clashes it measures.
+// the default --lazy too); rank 0 reads for --volume only the files of the clashes it measures.
 #include "../test_temp.h"
 #include "cadclash/export.h"
 #include "cadclash/import.h"
@@ -120,18 +120,18 @@ TEST(MpiCli, As1RepeatedQuerySameReport) {
   expect_identical("check '" + as1_path() + "' --lazy --repeat 2", false);
 }
 
-// Without --lazy: each rank meshes whole parts where its share needs them (part meshing), and the
+// --eager: each rank meshes whole parts where its share needs them (part meshing), and the
 // reports, table and HTML are one eagerly importing process's.
 TEST(MpiCli, As1PartMeshingSameReportHtmlAndTable) {
   REQUIRE_AS1();
-  expect_identical("check '" + as1_path() + "' --tolerance 0.01 --clearance 1", true);
+  expect_identical("check '" + as1_path() + "' --eager --tolerance 0.01 --clearance 1", true);
 }
 
 // Eight ranks (the largest count; more ranks than as1 has parts to mesh, oversubscribed on
 // any small machine): the default check, eager and lazy, one thread each, is one process's.
 TEST(MpiCli, As1EightRanksSameReportAndTable) {
   REQUIRE_AS1();
-  for (const std::string mode : {"", " --lazy"}) {
+  for (const std::string mode : {" --eager", ""}) {
     const std::string args = "check '" + as1_path() + "'" + mode + " --no-timings --json '";
     const Outcome one = run(0, args + scratch("one8.json") + "'");
     ASSERT_EQ(one.code, 0) << one.err;
@@ -219,7 +219,7 @@ std::vector<std::array<std::uint64_t, 3>> meshed_per_rank(const std::string& err
 TEST(MpiCli, RanksMeshOnlyThePartsTheirShareReaches) {
   REQUIRE_AS1();
   const std::string step = board_step(4, true);
-  const std::string args = "check '" + step + "' --tolerance 0.01 --no-timings --threads 1 --json ";
+  const std::string args = "check '" + step + "' --eager --tolerance 0.01 --no-timings --threads 1 --json ";
   const Outcome single = run(0, args + "'" + scratch("parts_one.json") + "'");
   ASSERT_EQ(single.code, 0) << single.err;
   const std::string json = slurp(scratch("parts_one.json"));
@@ -313,8 +313,8 @@ void expect_read_where_needed(const BoardFiles& f, const std::string& tag, std::
 // of the first.
 TEST(MpiCli, RankReadsAndMeshesNothingOfAFileItsPairsDoNotReach) {
   REQUIRE_AS1();
-  const BoardFiles f = board_files("");
-  const Outcome alone = run(1, "check '" + f.first + "' --tolerance 0.01 --no-timings --threads 1");
+  const BoardFiles f = board_files(" --eager");
+  const Outcome alone = run(1, "check '" + f.first + "' --eager --tolerance 0.01 --no-timings --threads 1");
   ASSERT_EQ(alone.code, 0) << alone.err;
   const auto first_only = meshed_per_rank(alone.err, 1);
   ASSERT_EQ(first_only.size(), 1u);

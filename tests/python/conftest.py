@@ -49,8 +49,9 @@ def cli():
         pytest.skip("CADCLASH_EXE is not set to the built cadclash tool")
 
     def run(tmp_path, *args):
+        # --eager: the Python models compared with it load eagerly (load's default).
         out = tmp_path / "report.json"
-        proc = subprocess.run([exe, "check", *map(str, args), "--json", str(out), "--no-timings"],
+        proc = subprocess.run([exe, "check", *map(str, args), "--eager", "--json", str(out), "--no-timings"],
                               capture_output=True, text=True)
         assert proc.returncode in (0, 3), proc.stderr
         return json.loads(out.read_text())

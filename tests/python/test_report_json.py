@@ -17,7 +17,10 @@ def cli_text(tmp_path_factory):
 
     def run(files, *args, timings=False):
         out = tmp_path_factory.mktemp("cli") / "report.json"
-        cmd = [exe, "check", *map(str, files), *map(str, args), "--json", str(out)]
+        # --eager unless --lazy: the Python models here load eagerly (load's default) unless they ask
+        # for lazy; a check meshes lazily by default.
+        mode = [] if "--lazy" in map(str, args) else ["--eager"]
+        cmd = [exe, "check", *map(str, files), *map(str, args), *mode, "--json", str(out)]
         proc = subprocess.run(cmd + ([] if timings else ["--no-timings"]), capture_output=True, text=True)
         assert proc.returncode in (0, 3, 4), proc.stderr
         return out.read_text()

@@ -14,7 +14,7 @@ def _cli(tmp_path, *args):
     if not exe or not os.path.isfile(exe):
         pytest.skip("CADCLASH_EXE is not set to the built cadclash tool")
     out = tmp_path / f"report{len(list(tmp_path.iterdir()))}.json"
-    proc = subprocess.run([exe, "check", *map(str, args), "--json", str(out), "--no-timings"],
+    proc = subprocess.run([exe, "check", *map(str, args), "--eager", "--json", str(out), "--no-timings"],
                           capture_output=True, text=True)
     assert proc.returncode in (0, 3), proc.stderr
     return out

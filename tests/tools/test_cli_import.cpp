@@ -123,6 +123,36 @@ TEST(CliImport, ThreadsChangeNoTriangle) {
   EXPECT_EQ(info_one.out, info_all.out);
 }
 
+// One large STEP file read on several processes (its text cut into pieces, docs/import.md): the
+// board of the truth tests written with a product per instance (3 MB, 17 B-rep items) gives the
+// same report and the same surfaces (#ids, names, boxes, triangles) on 1, 2 and 3 threads, and
+// with 2 it was really read by 2 processes.
+TEST(CliImport, ThreadsDoNotChangeABoardsReport) {
+#ifndef WRITE_BOARD_STEP_EXE
+  GTEST_SKIP() << "built without the test support programs";
+#else
+  const std::string as1 = kExternal + "as1-tu-203.stp";
+  if (const std::string m = missing({as1}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
+  const std::string board = cadclash::testing::scratch_dir() + "/threads-board.step";
+  const std::string write = std::string(WRITE_BOARD_STEP_EXE) + " '" + kExternal + "' '" + board + "' 1 0 unshared > /dev/null";
+  ASSERT_EQ(std::system(write.c_str()), 0);
+  ASSERT_GT(fs::file_size(board), 1u << 20) << "smaller than the size read in parallel";
+  const std::string file = "'" + board + "'";
+  const std::string reference = report_of(file, "--no-timings --threads 1");
+  ASSERT_NE(reference.find("\"pairs\""), std::string::npos);
+  EXPECT_EQ(report_of(file, "--no-timings --threads 2"), reference);
+  EXPECT_EQ(report_of(file, "--no-timings --threads 3"), reference);
+  const CliRun info_one = cadclash("info " + file + " --json --surfaces --threads 1");
+  const CliRun info_two = cadclash("info " + file + " --json --surfaces --threads 2");
+  ASSERT_EQ(info_one.code, 0) << info_one.err;
+  EXPECT_EQ(info_two.out, info_one.out);
+  const nlohmann::json timed = nlohmann::json::parse(report_of(file, "--threads 2"));
+  EXPECT_EQ(timed["import_timings"]["files"][0]["processes"], 2);
+  const nlohmann::json alone = nlohmann::json::parse(report_of(file, "--threads 1"));
+  EXPECT_EQ(alone["import_timings"]["files"][0]["processes"], 1);
+#endif
+}
+
 // A damaged entry: the check says so on stderr and in the report's diagnostics, and finds the same pairs.
 TEST(CliImport, DamagedCacheEntryIsReadAgain) {
   const std::string box_a = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";

@@ -89,7 +89,7 @@ TEST(ProgressCli, PipedTrajectoryAndTessellateStayClean) {
 
 TEST(ProgressCli, CheckOnATerminalShowsProgressAndTheSameTable) {
   if (as1_missing()) GTEST_SKIP() << kAs1 << " missing: run scripts/setup.sh";
-  const PtyRun r = run_on_terminal({"check", kAs1, "--tolerance", "0.01", "--no-timings"});
+  const PtyRun r = run_on_terminal({"check", kAs1, "--eager", "--tolerance", "0.01", "--no-timings"});
   ASSERT_EQ(r.code, 0) << r.terminal;
   EXPECT_NE(r.terminal.find("\r\033[Kreading files 0/1"), std::string::npos) << r.terminal;
   EXPECT_NE(r.terminal.find("meshing parts"), std::string::npos) << r.terminal;
@@ -98,7 +98,7 @@ TEST(ProgressCli, CheckOnATerminalShowsProgressAndTheSameTable) {
   // The line is cleared at the end: the last thing on the terminal is the clearing sequence.
   EXPECT_TRUE(r.terminal.ends_with("\r\033[K")) << r.terminal;
   // stdout is what a pipe gets, byte for byte.
-  const CliRun piped = run_cadclash("check '" + kAs1 + "' --tolerance 0.01 --no-timings");
+  const CliRun piped = run_cadclash("check '" + kAs1 + "' --eager --tolerance 0.01 --no-timings");
   EXPECT_EQ(r.out, piped.out);
 }
 

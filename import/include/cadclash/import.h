@@ -31,6 +31,13 @@
 //   skipping any k whose result equals another sibling's name; a name that occurs once is left as is.
 //   as1-tu-203.stp: "/as1/L-BRACKET-ASSEMBLY::2/NUT-BOLT-ASSEMBLY::1/BOLT" (the "::k" there is the
 //   file's own). BREP: one part and one instance "/<file stem>".
+//   Generic names are names no one chose: empty, the label entries OCCT's XCAF writer gives unnamed
+//   occurrences ("=>[0:1:1:9]") and the shape types it gives unnamed products ("SOLID", "COMPOUND",
+//   "COMPSOLID", "SHELL"). An only child whose level name is generic adds no level: a KiCad export's
+//   "/board/D15/=>[0:1:1:9]" is "/board/D15". A leaf's part is named after its product, or when
+//   that name is generic after the nearest enclosing product whose name is not (KiCad: the model,
+//   "LED_D5.0mm_IRGrey", not "COMPOUND"), else the generic name; a part shared by several leaf
+//   occurrences takes the name from the first in file order.
 // - Pose: the composed placements of the levels, in millimetres (OCCT converts the file's length unit).
 // - Surfaces: one per face, in TopExp::MapShapes order of the part's shape (face_index). step_id is
 //   the face entity's label as written in the file (STEP #N of its ADVANCED_FACE; IGES directory entry

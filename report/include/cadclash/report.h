@@ -291,6 +291,7 @@ struct ReportFileImport {
   std::string file;           // as given
   std::string cache = "off";  // "off", "hit", "miss" or "rebuilt"
   double read = 0.0, transfer = 0.0, heal = 0.0, tessellate = 0.0, total = 0.0;
+  std::uint64_t processes = 1;  // STEP: processes that read and transferred the file at once
 };
 struct ReportImport {
   double seconds = 0.0;  // wall clock of the whole import (files are read in parallel)
