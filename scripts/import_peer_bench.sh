@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# Import of large real assemblies against the plain OCCT pipeline (issue 38; docs/import.md, "Large
+# assemblies: the KiCad board corpus"). For each of out/corpus/*.step (scripts/make_corpus.sh) and
+# data/external/as1-tu-203.stp (when there), REPEATS rounds, alternating in each round
+#   - `cadclash check FILE --json` (default settings: deflection 0.1 mm, certified decisions);
+#   - occt_pipeline_peer FILE (STEPCAFControl_Reader, Transfer, BRepMesh_IncrementalMesh at
+#     0.1 mm / 0.5 rad with its parallel flag on each distinct leaf shape: what a FreeCAD or
+#     CadQuery user's import does);
+# so that a change in the machine's load falls on both alike. Per file: the median wall time of each,
+# the stage times of the median run, MB/s, the ratio peer / cadclash, and the peak RSS (/usr/bin/time
+# %M: for cadclash the largest of its process and its isolated reader child).
+#   bash scripts/import_peer_bench.sh [BUILD_DIR] [REPEATS]
+# BUILD_DIR (default build/) must hold tools/cadclash; the peer is $OCCT_PEER when set (a build of
+# bench/ elsewhere), else BUILD_DIR/bench/occt_pipeline_peer, built there if missing. Writes out/import_peer_bench/results.md and results.json. Numbers are printed, never
+# judged; this is not a test.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+repeats=${2:-3}
+out=$root/out/import_peer_bench
+cadclash=$build/tools/cadclash
+peer=${OCCT_PEER:-$build/bench/occt_pipeline_peer}
+cd "$root"
+if [ ! -x "$cadclash" ]; then
+  echo "import_peer_bench: $cadclash is missing (build the cadclash target first)" >&2
+  exit 1
+fi
+if [ ! -x "$peer" ] && [ -z "${OCCT_PEER:-}" ]; then cmake --build "$build" --target occt_pipeline_peer >/dev/null; fi
+if [ ! -x "$peer" ]; then
+  echo "import_peer_bench: $peer is missing" >&2
+  exit 1
+fi
+if [ ! -x /usr/bin/time ]; then  # GNU time: the peak RSS of a process and its children
+  sudo_cmd=()
+  if [ "$(id -u)" != 0 ]; then sudo_cmd=(sudo); fi
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends time >/dev/null
+fi
+files=()
+for f in out/corpus/*.step data/external/as1-tu-203.stp; do
+  if [ -f "$f" ]; then files+=("$f"); fi
+done
+if [ ${#files[@]} -eq 0 ]; then
+  echo "import_peer_bench: no input (run scripts/make_corpus.sh first)" >&2
+  exit 1
+fi
+rm -rf "$out"
+mkdir -p "$out/runs"
+load=$(cut -d" " -f1-3 /proc/loadavg)
+
+# One run: wall seconds, peak RSS in KiB, exit code and the JSON in runs/. cadclash's exit 3 (clashes
+# found) is a result, and so is 1 when the report was written: an input error (a face OCCT cannot
+# mesh) is part of what real files do; its diagnostics are in the report and counted in the table.
+run() {  # run TOOL FILE K
+  local tool=$1 file=$2 k=$3 id t0 t1 rc
+  id=$(basename "$file")-$tool-$k
+  t0=$(date +%s.%N)
+  set +e
+  if [ "$tool" = cadclash ]; then
+    /usr/bin/time -f %M -o "$out/runs/$id.rss" "$cadclash" check "$file" --json "$out/runs/$id.json" \
+      >"$out/runs/$id.txt" 2>"$out/runs/$id.err"
+  else
+    /usr/bin/time -f %M -o "$out/runs/$id.rss" "$peer" "$file" >"$out/runs/$id.json" 2>"$out/runs/$id.err"
+  fi
+  rc=$?
+  set -e
+  t1=$(date +%s.%N)
+  echo $rc >"$out/runs/$id.rc"
+  if [ $rc -ne 0 ] && ! { [ "$tool" = cadclash ] && { [ $rc -eq 3 ] || { [ $rc -eq 1 ] && [ -s "$out/runs/$id.json" ]; }; }; }; then
+    echo "import_peer_bench: $tool on $file exited $rc (see $out/runs/$id.err)" >&2
+    exit 1
+  fi
+  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f\n", b - a }' >"$out/runs/$id.wall"
+}
+for f in "${files[@]}"; do
+  for ((k = 0; k < repeats; k++)); do
+    for tool in cadclash peer; do
+      echo "import_peer_bench: $f, round $((k + 1)) of $repeats, $tool" >&2
+      run "$tool" "$f" "$k"
+    done
+  done
+done
+
+python3 - "$out" "$repeats" "$(nproc)" "$load" "${files[@]}" <<'PY'
+import json, os, statistics, sys
+
+out, repeats, cores, load, files = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5:]
+
+def runs(file, tool):
+    base = os.path.join(out, "runs", os.path.basename(file) + "-" + tool)
+    rows = []
+    for k in range(repeats):
+        with open(f"{base}-{k}.wall") as w, open(f"{base}-{k}.rss") as r, open(f"{base}-{k}.json") as j:
+            rows.append({"wall": float(w.read()), "rss_mb": int(r.read().split()[-1]) / 1024, "json": json.load(j),
+                         "rc": int(open(f"{base}-{k}.rc").read())})
+    rows.sort(key=lambda row: row["wall"])
+    return rows[(repeats - 1) // 2], rows  # the median run (the lower one for an even count)
+
+results = []
+for f in files:
+    size = os.path.getsize(f)
+    (c, c_all), (p, p_all) = runs(f, "cadclash"), runs(f, "peer")
+    imp = c["json"]["import_timings"]["files"][0]
+    cad = {"wall_s": c["wall"], "walls_s": [r["wall"] for r in c_all], "peak_rss_mb": round(c["rss_mb"], 1),
+           "read_s": imp["read"], "transfer_s": imp["transfer"], "heal_s": imp["heal"],
+           "tessellate_s": imp["tessellate"], "import_s": imp["total"], "query_s": c["json"]["timings"]["total"],
+           "query_tessellation_s": c["json"]["timings"]["tessellation"],
+           "exit_code": c["rc"], "complete": c["json"]["complete"], "pairs": c["json"]["summary"]["pairs"],
+           "diagnostics": c["json"]["diagnostics"]}
+    pj = p["json"]
+    per = {"wall_s": p["wall"], "walls_s": [r["wall"] for r in p_all], "peak_rss_mb": round(p["rss_mb"], 1),
+           "read_s": pj["read_s"], "transfer_s": pj["transfer_s"], "mesh_s": pj["mesh_s"], "total_s": pj["total_s"],
+           "parts": pj["parts"], "faces": pj["faces"], "triangles": pj["triangles"]}
+    results.append({"file": f, "size_bytes": size, "cadclash": cad, "peer": per,
+                    "mb_per_s": {"cadclash": size / 1e6 / cad["wall_s"], "peer": size / 1e6 / per["wall_s"]},
+                    "peer_over_cadclash": {"wall": per["wall_s"] / cad["wall_s"], "import": per["total_s"] / cad["import_s"]}})
+
+with open(os.path.join(out, "results.json"), "w") as j:
+    json.dump({"repeats": repeats, "cores": int(cores), "load_before": load, "files": results}, j, indent=1)
+
+ms = lambda s: f"{s * 1e3:.0f}"
+with open(os.path.join(out, "results.md"), "w") as md:
+    md.write(f"{cores} cores (load average before the runs: {load}), median of {repeats} run(s) per tool, alternating. "
+             "cadclash: `cadclash check FILE` (import, healing, tessellation at 0.1 mm, certified collision query); "
+             "peer: `occt_pipeline_peer FILE` (STEPCAFControl_Reader ReadFile and Transfer, BRepMesh_IncrementalMesh "
+             "0.1 mm / 0.5 rad in parallel on each distinct leaf shape; no healing, no query). Wall time of the whole "
+             "process; stages of the median run in ms (a build that tessellates lazily meshes inside query, "
+             "`timings.tessellation` in results.json, and shows tessellate 0); MB/s is file size over wall time; peer/cadclash > 1: cadclash "
+             "is faster (wall: whole runs; import: the peer's total against cadclash's import, query left out); "
+             "RSS: /usr/bin/time peak, cadclash's includes its isolated reader child; "
+             "cadclash exit / pairs / diagnostics: its exit code (1: an input error, e.g. a face OCCT could not mesh), the "
+             "reported surface pairs and the import diagnostics.\n\n")
+    md.write("| file | MB | cadclash wall s | peer wall s | peer/cadclash wall | peer/cadclash import | cadclash read / transfer / heal / tessellate / query | "
+             "peer read / transfer / mesh | MB/s cadclash | MB/s peer | RSS MB cadclash | RSS MB peer | faces | triangles (peer) | cadclash exit / pairs / diagnostics |\n")
+    md.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    for r in results:
+        c, p = r["cadclash"], r["peer"]
+        md.write(f"| {os.path.basename(r['file'])} | {r['size_bytes'] / 1e6:.1f} | {c['wall_s']:.2f} | {p['wall_s']:.2f} | "
+                 f"{r['peer_over_cadclash']['wall']:.2f} | {r['peer_over_cadclash']['import']:.2f} | "
+                 f"{ms(c['read_s'])} / {ms(c['transfer_s'])} / {ms(c['heal_s'])} / {ms(c['tessellate_s'])} / {ms(c['query_s'])} | "
+                 f"{ms(p['read_s'])} / {ms(p['transfer_s'])} / {ms(p['mesh_s'])} | "
+                 f"{r['mb_per_s']['cadclash']:.1f} | {r['mb_per_s']['peer']:.1f} | {c['peak_rss_mb']:.0f} | {p['peak_rss_mb']:.0f} | "
+                 f"{p['faces']} | {p['triangles']} | {c['exit_code']} / {c['pairs']} / {len(c['diagnostics'])} |\n")
+PY
+cat "$out/results.md"
