@@ -129,6 +129,14 @@ while IFS= read -r line || [ -n "$line" ]; do
     @EXTREMES@) cat "$out/extremes.md" ;;
     @PREDICATES@) cat "$out/predicates.md" ;;
     @SCALE@) cat "$out/scale.md" ;;
+    @IMPORT_PEER@)
+      # Measured by scripts/import_peer_bench.sh (~20 min), not here: its last table, as it is.
+      bench=$root/out/import_peer_bench
+      if [ -f "$bench/results.md" ]; then
+        relink "$bench/results.md"
+        [ -f "$bench/import_time.svg" ] && cp "$bench/import_time.svg" "$docs/"
+      else echo "_No run of scripts/import_peer_bench.sh in this tree (out/import_peer_bench/results.md)._"; fi
+      ;;
     *) printf '%s\n' "$line" ;;
   esac
 done <"$docs/template.md" >"$page"

@@ -103,6 +103,24 @@ IFSelect_ReturnStatus parse(STEPCAFControl_Reader& reader, const std::string& pa
   return read_text(text, true);
 }
 
+// The #id of an entity of `model` as the file writes it; -1 when it has none.
+EntityLabelFn step_labels(const Handle(StepData_StepModel)& model) {
+  return [model](const Handle(Standard_Transient)& entity) -> std::int64_t {
+    if (model.IsNull()) return -1;
+    const Standard_Integer id = model->IdentLabel(entity);
+    return id > 0 ? id : -1;
+  };
+}
+
+// A face entity's #id and name; false for an entity that is no face.
+bool describe_face(const Handle(Standard_Transient)& entity, const EntityLabelFn& label, FaceEntity& out) {
+  if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
+  out.id = label(entity);
+  const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
+  if (!item.IsNull() && !item->Name().IsNull()) out.name = item->Name()->ToCString();
+  return true;
+}
+
 // The pieces' shapes bound to the main text's stand-ins, by #id: the number of pieces, 0 when one
 // failed (nothing is bound then).
 std::size_t bind_pieces(Children& pieces, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
@@ -148,13 +166,9 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
   run.mark(kTransferred);
   if (!process) return;
   if (has_faces(result.doc)) run.mark(kShapes);
-  result.faces = map_face_entities(*process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) {
-    if (!entity->IsKind(STANDARD_TYPE(StepShape_Face))) return false;
-    out.id = label(entity);
-    const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
-    if (!item.IsNull() && !item->Name().IsNull()) out.name = item->Name()->ToCString();
-    return true;
-  }, bound.tags);
+  result.faces = map_face_entities(
+      *process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) { return describe_face(entity, label, out); },
+      bound.tags);
 }
 
 // The parsed model into shapes: its products, or its face entities one by one when the attempt
@@ -217,16 +231,13 @@ std::string read_step_piece(const std::string& path, const StepPiece& piece) {
       out.bind(id, shape);
     }
     // Every face entity's faces, tagged as the main reader tags its own (transfer_products).
+    const EntityLabelFn label = step_labels(model);
     for (Standard_Integer i = 1; i <= process->NbMapped(); ++i) {
       const Handle(Standard_Transient)& entity = process->Mapped(i);
-      if (entity.IsNull() || !entity->IsKind(STANDARD_TYPE(StepShape_Face))) continue;
+      FaceEntity tag;
+      if (entity.IsNull() || !describe_face(entity, label, tag)) continue;
       const TopoDS_Shape shape = TransferBRep::ShapeResult(process->MapItem(i));
       if (shape.IsNull()) continue;
-      FaceEntity tag;
-      const Standard_Integer id = model->IdentLabel(entity);
-      tag.id = id > 0 ? id : -1;
-      const Handle(StepRepr_RepresentationItem) item = Handle(StepRepr_RepresentationItem)::DownCast(entity);
-      if (!item.IsNull() && !item->Name().IsNull()) tag.name = item->Name()->ToCString();
       const bool single = shape.ShapeType() == TopAbs_FACE;
       for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next()) out.tag(f.Current(), tag, single);
     }
@@ -273,11 +284,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     result.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     STEPControl_Reader& step = reader.ChangeReader();
     const Handle(StepData_StepModel) model = step.StepModel();
-    const EntityLabelFn label = [&model](const Handle(Standard_Transient)& entity) -> std::int64_t {
-      if (model.IsNull()) return -1;
-      const Standard_Integer id = model->IdentLabel(entity);
-      return id > 0 ? id : -1;
-    };
+    const EntityLabelFn label = step_labels(model);
     const Handle(XSControl_WorkSession) ws = step.WS();
     std::size_t load_fails = 0;
     if (!ws.IsNull() && !model.IsNull() && model->NbEntities() > 0)
