@@ -97,6 +97,14 @@ bool mesh_face_to(const TopoDS_Face& face, double target, double angular, bool v
 // tight), BRepBndLib::Add (control polygons) for the rest.
 Aabb face_aabb(const TopoDS_Face& face);
 
+// BRepCheck_Analyzer's verdict on one face (false when it throws). A face with many wires is
+// checked as pieces (the outer wire with each cluster of inner wires whose parameter boxes overlap),
+// since BRepCheck compares every wire with every other: the same verdict in linear time for a plate
+// with many holes (brep_face_check.cpp).
+bool face_is_valid(const TopoDS_Face& face);
+// Whether face_is_valid checks `face` in pieces: a BRepCheck of a whole shape holding it is slow.
+bool face_has_many_wires(const TopoDS_Face& face);
+
 // Minimum distance between two shapes (here: placed faces), equal bit for bit to
 // BRepExtrema_DistShapeShape(a, b, Extrema_ExtFlag_MIN).Value(), but it stops as soon as the distance
 // is at most `enough` (0: once it is 0), returning that distance. nullopt when OCCT finds no

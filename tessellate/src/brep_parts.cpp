@@ -30,15 +30,6 @@ namespace {
 
 constexpr double kNearMiss = 4.0;
 
-bool face_is_valid(const TopoDS_Face& face) {
-  try {
-    BRepCheck_Analyzer analyzer(face, Standard_True);
-    return analyzer.IsValid() == Standard_True;
-  } catch (const Standard_Failure&) {
-    return false;
-  }
-}
-
 // ShapeFix_Face on an invalid face; returns true and replaces `face` when the fix changed it.
 bool heal_face(TopoDS_Face& face) {
   try {
@@ -93,16 +84,23 @@ void store_plane_pcurves(const std::vector<TopoDS_Face>& faces) {
 std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& impl, std::vector<Diagnostic>& diagnostics) {
   const std::size_t n = impl.faces.size();
   std::vector<char> healed(n, 0);
+  // One check of the whole part, and the faces one by one only when it fails. A part holding a face
+  // with many wires (a board plate with its holes) is checked face by face at once: the whole
+  // part's check would compare all of that face's wires pairwise, and only faces are healed here,
+  // so the faces' verdicts decide the same.
+  const bool by_face = std::any_of(impl.faces.begin(), impl.faces.end(), detail::face_has_many_wires);
   bool whole_valid = false;
-  try {
-    whole_valid = BRepCheck_Analyzer(*in.shape, Standard_True).IsValid() == Standard_True;
-  } catch (const Standard_Failure&) {
+  if (!by_face) {
+    try {
+      whole_valid = BRepCheck_Analyzer(*in.shape, Standard_True).IsValid() == Standard_True;
+    } catch (const Standard_Failure&) {
+    }
   }
   if (whole_valid) return healed;
   for (std::size_t i = 0; i < n; ++i) {
-    if (face_is_valid(impl.faces[i])) continue;
+    if (detail::face_is_valid(impl.faces[i])) continue;
     healed[i] = heal_face(impl.faces[i]) ? 1 : 0;
-    const bool fixed = healed[i] != 0 && face_is_valid(impl.faces[i]);
+    const bool fixed = healed[i] != 0 && detail::face_is_valid(impl.faces[i]);
     diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl.entity_ids[i],
                                      heal_message(in.name, i, healed[i] != 0, fixed)});
   }
