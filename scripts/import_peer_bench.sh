@@ -37,7 +37,8 @@ if [ ! -x /usr/bin/time ]; then  # GNU time: the peak RSS of a process and its c
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends time >/dev/null
 fi
 files=()
-for f in out/corpus/*.step data/external/as1-tu-203.stp; do
+# BENCH_FILES (space-separated paths) replaces the default list.
+for f in ${BENCH_FILES:-out/corpus/*.step data/external/as1-tu-203.stp}; do
   if [ -f "$f" ]; then files+=("$f"); fi
 done
 if [ ${#files[@]} -eq 0 ]; then
@@ -61,10 +62,11 @@ run() {  # run TOOL FILE K
   if [ "$tool" = cadclash ] || [ "$tool" = cadclash1 ]; then
     local threads=()
     [ "$tool" = cadclash1 ] && threads=(--threads 1)
-    /usr/bin/time -f %M -o "$out/runs/$id.rss" "$cadclash" check "$file" "${threads[@]}" --json "$out/runs/$id.json" \
-      >"$out/runs/$id.txt" 2>"$out/runs/$id.err"
+    /usr/bin/time -f %M -o "$out/runs/$id.rss" python3 "$root/scripts/tree_memory.py" "$out/runs/$id.pss" \
+      "$cadclash" check "$file" "${threads[@]}" --json "$out/runs/$id.json" >"$out/runs/$id.txt" 2>"$out/runs/$id.err"
   else
-    /usr/bin/time -f %M -o "$out/runs/$id.rss" "$peer" "$file" >"$out/runs/$id.json" 2>"$out/runs/$id.err"
+    /usr/bin/time -f %M -o "$out/runs/$id.rss" python3 "$root/scripts/tree_memory.py" "$out/runs/$id.pss" \
+      "$peer" "$file" >"$out/runs/$id.json" 2>"$out/runs/$id.err"
   fi
   rc=$?
   set -e
@@ -101,7 +103,8 @@ def runs(file, tool):
     for k in range(repeats):
         with open(f"{base}-{k}.wall") as w, open(f"{base}-{k}.rss") as r, open(f"{base}-{k}.json") as j:
             rows.append({"wall": float(w.read()), "rss_mb": int(r.read().split()[-1]) / 1024, "json": json.load(j),
-                         "rc": int(open(f"{base}-{k}.rc").read())})
+                         "rc": int(open(f"{base}-{k}.rc").read()),
+                         "tree_mb": int(open(f"{base}-{k}.pss").read()) / 1024})
     rows.sort(key=lambda row: row["wall"])
     return rows[(repeats - 1) // 2], rows  # the median run (the lower one for an even count)
 
@@ -111,6 +114,7 @@ for f in files:
     (c, c_all), (p, p_all) = runs(f, "cadclash"), runs(f, "peer")
     imp = c["json"]["import_timings"]["files"][0]
     cad = {"wall_s": c["wall"], "walls_s": [r["wall"] for r in c_all], "peak_rss_mb": round(c["rss_mb"], 1),
+           "peak_tree_pss_mb": round(max(r["tree_mb"] for r in c_all), 1),
            "read_s": imp["read"], "transfer_s": imp["transfer"], "heal_s": imp["heal"],
            "tessellate_s": imp["tessellate"], "import_s": imp["total"], "query_s": c["json"]["timings"]["total"],
            "query_tessellation_s": c["json"]["timings"]["tessellation"],
@@ -118,6 +122,7 @@ for f in files:
            "diagnostics": c["json"]["diagnostics"]}
     pj = p["json"]
     per = {"wall_s": p["wall"], "walls_s": [r["wall"] for r in p_all], "peak_rss_mb": round(p["rss_mb"], 1),
+           "peak_tree_pss_mb": round(max(r["tree_mb"] for r in p_all), 1),
            "read_s": pj["read_s"], "transfer_s": pj["transfer_s"], "mesh_s": pj["mesh_s"], "total_s": pj["total_s"],
            "parts": pj["parts"], "faces": pj["faces"], "triangles": pj["triangles"]}
     one = None
@@ -143,12 +148,14 @@ with open(os.path.join(out, "results.md"), "w") as md:
              "process; stages of the median run in ms (a build that tessellates lazily meshes inside query, "
              "`timings.tessellation` in results.json, and shows tessellate 0); MB/s is file size over wall time; peer/cadclash > 1: cadclash "
              "is faster (wall: whole runs; import: the peer's total against cadclash's import, query left out); "
-             "RSS: /usr/bin/time peak, cadclash's includes its isolated reader child; "
+             "RSS: /usr/bin/time peak, the largest single process (cadclash's or its isolated reader's or a worker's); "
+             "memory: the peak over the run of the whole process tree's summed proportional set size (scripts/tree_memory.py, "
+             "sampled every 100 ms, the largest of the rounds), what the machine must hold; "
              "cadclash exit / pairs / diagnostics: its exit code (1: an input error, e.g. a face OCCT could not mesh), the "
              "reported surface pairs and the import diagnostics.\n\n")
     md.write("| file | MB | cadclash wall s | cadclash 1 thread wall s (efficiency) | peer wall s | peer/cadclash wall | peer/cadclash import | cadclash read / transfer / heal / tessellate / query | "
-             "peer read / transfer / mesh | MB/s cadclash | MB/s peer | RSS MB cadclash | RSS MB peer | faces | triangles (peer) | cadclash exit / pairs / diagnostics |\n")
-    md.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+             "peer read / transfer / mesh | MB/s cadclash | MB/s peer | RSS MB cadclash | RSS MB peer | memory MB cadclash / peer | faces | triangles (peer) | cadclash exit / pairs / diagnostics |\n")
+    md.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     for r in results:
         c, p = r["cadclash"], r["peer"]
         one = r["cadclash_one_thread"]
@@ -158,6 +165,7 @@ with open(os.path.join(out, "results.md"), "w") as md:
                  f"{ms(c['read_s'])} / {ms(c['transfer_s'])} / {ms(c['heal_s'])} / {ms(c['tessellate_s'])} / {ms(c['query_s'])} | "
                  f"{ms(p['read_s'])} / {ms(p['transfer_s'])} / {ms(p['mesh_s'])} | "
                  f"{r['mb_per_s']['cadclash']:.1f} | {r['mb_per_s']['peer']:.1f} | {c['peak_rss_mb']:.0f} | {p['peak_rss_mb']:.0f} | "
+                 f"{c['peak_tree_pss_mb']:.0f} / {p['peak_tree_pss_mb']:.0f} | "
                  f"{p['faces']} | {p['triangles']} | {c['exit_code']} / {c['pairs']} / {len(c['diagnostics'])} |\n")
     md.write("\nEfficiency: the 1-thread wall time over (cores x the default run's), the whole check; "
              f"time against file size: [import_time.svg](import_time.svg).\n")
