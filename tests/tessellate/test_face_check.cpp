@@ -29,11 +29,13 @@ TopoDS_Wire circle(double x, double y, double r) {
   return BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire();
 }
 
-// A 100 x 60 plate in z = 0 with a hole of radius r at each centre (inner wires reversed, as holes are).
-TopoDS_Face plate(const std::vector<std::pair<double, double>>& holes, double r) {
+// A 100 x 60 plate in z = 0 with a hole of radius r at each centre (inner wires reversed, as holes
+// are), and the `extra` wires as given.
+TopoDS_Face plate(const std::vector<std::pair<double, double>>& holes, double r, const std::vector<TopoDS_Wire>& extra = {}) {
   BRepBuilderAPI_MakePolygon outline(gp_Pnt(0, 0, 0), gp_Pnt(100, 0, 0), gp_Pnt(100, 60, 0), gp_Pnt(0, 60, 0), Standard_True);
   BRepBuilderAPI_MakeFace face(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), outline.Wire());
   for (const auto& [x, y] : holes) face.Add(TopoDS::Wire(circle(x, y, r).Reversed()));
+  for (const TopoDS_Wire& w : extra) face.Add(w);
   return face.Face();
 }
 
@@ -61,11 +63,7 @@ TEST(FaceCheck, PlateWithManyHolesIsCheckedInPiecesWithBRepChecksVerdict) {
   EXPECT_FALSE(detail::face_is_valid(crossed));
 
   // A hole inside another hole (a wire held by an inner wire).
-  BRepBuilderAPI_MakePolygon outline(gp_Pnt(0, 0, 0), gp_Pnt(100, 0, 0), gp_Pnt(100, 60, 0), gp_Pnt(0, 60, 0), Standard_True);
-  BRepBuilderAPI_MakeFace holder(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), outline.Wire());
-  for (const auto& [x, y] : holes) holder.Add(TopoDS::Wire(circle(x, y, 2.0).Reversed()));
-  holder.Add(TopoDS::Wire(circle(8.0, 8.0, 0.5).Reversed()));
-  const TopoDS_Face held = holder.Face();
+  const TopoDS_Face held = plate(holes, 2.0, {TopoDS::Wire(circle(8.0, 8.0, 0.5).Reversed())});
   EXPECT_FALSE(brepcheck(held));
   EXPECT_FALSE(detail::face_is_valid(held));
 
@@ -77,10 +75,7 @@ TEST(FaceCheck, PlateWithManyHolesIsCheckedInPiecesWithBRepChecksVerdict) {
   EXPECT_FALSE(detail::face_is_valid(out));
 
   // A hole whose wire runs the wrong way (not reversed).
-  BRepBuilderAPI_MakeFace wrong(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), outline.Wire());
-  for (const auto& [x, y] : holes) wrong.Add(TopoDS::Wire(circle(x, y, 2.0).Reversed()));
-  wrong.Add(circle(60.0, 55.0, 2.0));
-  const TopoDS_Face flipped = wrong.Face();
+  const TopoDS_Face flipped = plate(holes, 2.0, {circle(60.0, 55.0, 2.0)});
   EXPECT_EQ(detail::face_is_valid(flipped), brepcheck(flipped));
   EXPECT_FALSE(brepcheck(flipped));
 }
