@@ -43,6 +43,7 @@ std::string progress_text(const Progress& p, double seconds) {
     case ProgressStage::TessellatePart: os << "meshing parts "; break;
     case ProgressStage::CheckPairs: os << "checking instance pairs "; break;
     case ProgressStage::TrajectoryStep: os << "trajectory steps "; break;
+    case ProgressStage::CheckPart: os << "checking parts "; break;
   }
   os << p.done << '/' << p.total;
   if (p.total > 0) os << ' ' << p.done * 100 / p.total << '%';

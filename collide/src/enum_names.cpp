@@ -41,6 +41,7 @@ const char* progress_stage_name(ProgressStage s) {
     case ProgressStage::TessellatePart: return "tessellate part";
     case ProgressStage::CheckPairs: return "check instance pairs";
     case ProgressStage::TrajectoryStep: return "trajectory step";
+    case ProgressStage::CheckPart: return "check part";
   }
   return "unknown";
 }

@@ -295,9 +295,15 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   std::vector<PartWork> work(parts.size());
 
   const Clock::time_point heal_start = Clock::now();
-  for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
-    prepare_part(parts[k], options, static_cast<PartId>(first_id + k), work[k]);
-  });
+  {
+    detail::ProgressMeter meter(&options.progress, ProgressStage::CheckPart, parts.size(),
+                                parts.empty() ? std::string() : parts.front().name);
+    for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
+      prepare_part(parts[k], options, static_cast<PartId>(first_id + k), work[k]);
+      meter.add(1, parts[k].name);
+    });
+    meter.finish();
+  }
   if (timings) timings->heal += seconds_since(heal_start);
 
   const Clock::time_point mesh_start = Clock::now();

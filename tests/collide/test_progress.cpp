@@ -111,6 +111,7 @@ TEST(CollideProgress, ReplayReportsItsStepsNotTheChecksInside) {
 TEST(CollideProgress, StageNames) {
   EXPECT_STREQ(progress_stage_name(ProgressStage::ReadFile), "read file");
   EXPECT_STREQ(progress_stage_name(ProgressStage::TessellatePart), "tessellate part");
+  EXPECT_STREQ(progress_stage_name(ProgressStage::CheckPart), "check part");
   EXPECT_STREQ(progress_stage_name(ProgressStage::CheckPairs), "check instance pairs");
   EXPECT_STREQ(progress_stage_name(ProgressStage::TrajectoryStep), "trajectory step");
 }

@@ -59,6 +59,12 @@ TEST(ImportProgress, OneFileItsReadAndItsPartsMeshed) {
     EXPECT_TRUE(a_part) << parts[k].label;
   }
   EXPECT_TRUE(rec.of(ProgressStage::CheckPairs).empty());
+  // One run over the parts as they are checked and healed, before they are meshed.
+  const std::vector<Progress> checked = rec.of(ProgressStage::CheckPart);
+  ASSERT_GE(checked.size(), 2u);
+  EXPECT_EQ(checked.front().done, 0u);
+  EXPECT_EQ(checked.back().done, plain.model.parts.size());
+  EXPECT_EQ(checked.back().total, plain.model.parts.size());
 }
 
 TEST(ImportProgress, LazyImportMeshesNothingAndSaysNothingOfParts) {
@@ -69,6 +75,7 @@ TEST(ImportProgress, LazyImportMeshesNothingAndSaysNothingOfParts) {
   options.progress = rec.callback();
   import_file(kAs1, options);
   EXPECT_TRUE(rec.of(ProgressStage::TessellatePart).empty());
+  EXPECT_FALSE(rec.of(ProgressStage::CheckPart).empty());  // the faces are checked all the same
   EXPECT_EQ(rec.of(ProgressStage::ReadFile).size(), 2u);
 }
 

@@ -208,8 +208,11 @@ enum class ProgressStage : std::uint8_t {
   TrajectoryStep,  // replay_trajectory: steps checked of the trajectory's steps; label: the number of
                    // the step checked last (the first step's as it starts). The checks of the steps
                    // do not report CheckPairs.
+  CheckPart,       // B-rep import: parts of one file's (one add_brep_parts call's) whose faces were
+                   // checked (BRepCheck), healed where invalid, and boxed; label: the name of a part
+                   // checked last. Lazy or eager; none when read from the cache.
 };
-// Returns "read file", "tessellate part", "check instance pairs" or "trajectory step".
+// Returns "read file", "tessellate part", "check instance pairs", "trajectory step" or "check part".
 const char* progress_stage_name(ProgressStage s);
 
 struct Progress {

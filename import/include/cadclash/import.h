@@ -101,7 +101,8 @@ struct ImportOptions {
   // in its own process); 0 = one per OpenMP thread (omp_get_max_threads). The result does not depend on it.
   int parallel_files = 0;
   // Told how far the import is (collide.h, "Progress of long work"): ReadFile as each file starts
-  // and ends (done = files finished), and TessellatePart as each B-rep part of a file is meshed
+  // and ends (done = files finished), CheckPart as each B-rep part of a file is checked and healed,
+  // and TessellatePart as each B-rep part of a file is meshed
   // (eager import of a file not in the cache; one run per file). Calls never overlap; with
   // parallel_files > 1 they come from the threads reading files, and one file's TessellatePart run
   // may be interleaved with another's. Isolated readers' child processes never call it. Empty =

@@ -44,9 +44,9 @@ struct TessellationOptions {
   // each face left without triangles keeps its surface and gets an error naming it and the limit.
   // Lazy tessellation (triangulate, require_triangles) is not limited.
   double time_limit_seconds = 0.0;
-  // Told how far add_brep_parts' eager meshing is (TessellatePart: parts of that call meshed, label
-  // the part's name; collide.h, "Progress of long work"), on the thread that called it; empty =
-  // nothing. Import ignores it and reports through ImportOptions::progress.
+  // Told how far add_brep_parts is (CheckPart: parts of that call checked and healed; TessellatePart:
+  // parts meshed, eager only; label the part's name; collide.h, "Progress of long work"), on the
+  // thread that called it; empty = nothing. Import ignores it and reports through ImportOptions::progress.
   ProgressCallback progress;
 };
 
