@@ -352,7 +352,6 @@ ParallelTransfer transfer_shapes_in_parallel(const Handle(StepData_StepModel)& m
   if (!bind_all(process, entities, bound.shapes, out.why_not)) return out;
   out.used = true;
   out.workers = share.size();
-  out.bindings = bound.shapes.size();
   return out;
 }
 

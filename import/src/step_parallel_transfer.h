@@ -69,7 +69,6 @@ struct ParallelTransfer {
   bool used = false;          // the items were made by workers and bound; false: nothing was bound
   std::size_t workers = 0;    // processes that transferred
   std::size_t groups = 0;     // sets of representations that share no topology (the unit of work)
-  std::size_t bindings = 0;   // entities bound from the workers' results
   std::string why_not;        // when not used: why (too small, one group, a worker failed, ...)
 };
 

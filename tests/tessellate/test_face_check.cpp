@@ -55,29 +55,23 @@ TEST(FaceCheck, PlateWithManyHolesIsCheckedInPiecesWithBRepChecksVerdict) {
   EXPECT_TRUE(brepcheck(good));
   EXPECT_TRUE(detail::face_is_valid(good));
 
-  // Two holes that cross each other (BRepCheck: intersecting wires).
-  std::vector<std::pair<double, double>> crossing = holes;
-  crossing.emplace_back(11.0, 8.0);
-  const TopoDS_Face crossed = plate(crossing, 2.0);
-  EXPECT_FALSE(brepcheck(crossed));
-  EXPECT_FALSE(detail::face_is_valid(crossed));
-
-  // A hole inside another hole (a wire held by an inner wire).
-  const TopoDS_Face held = plate(holes, 2.0, {TopoDS::Wire(circle(8.0, 8.0, 0.5).Reversed())});
-  EXPECT_FALSE(brepcheck(held));
-  EXPECT_FALSE(detail::face_is_valid(held));
-
-  // A hole outside the plate.
-  std::vector<std::pair<double, double>> outside = holes;
-  outside.emplace_back(150.0, 30.0);
-  const TopoDS_Face out = plate(outside, 2.0);
-  EXPECT_FALSE(brepcheck(out));
-  EXPECT_FALSE(detail::face_is_valid(out));
-
-  // A hole whose wire runs the wrong way (not reversed).
-  const TopoDS_Face flipped = plate(holes, 2.0, {circle(60.0, 55.0, 2.0)});
-  EXPECT_EQ(detail::face_is_valid(flipped), brepcheck(flipped));
-  EXPECT_FALSE(brepcheck(flipped));
+  // Each damaged plate: BRepCheck rejects the whole face, and so do the pieces.
+  auto with_hole_at = [&](double x, double y) {
+    std::vector<std::pair<double, double>> more = holes;
+    more.emplace_back(x, y);
+    return plate(more, 2.0);
+  };
+  const std::vector<std::pair<const char*, TopoDS_Face>> damaged{
+      {"two holes that cross", with_hole_at(11.0, 8.0)},
+      {"a hole inside a hole", plate(holes, 2.0, {TopoDS::Wire(circle(8.0, 8.0, 0.5).Reversed())})},
+      {"a hole outside the plate", with_hole_at(150.0, 30.0)},
+      {"a hole wound the wrong way", plate(holes, 2.0, {circle(60.0, 55.0, 2.0)})},
+  };
+  for (const auto& [what, face] : damaged) {
+    SCOPED_TRACE(what);
+    EXPECT_FALSE(brepcheck(face));
+    EXPECT_FALSE(detail::face_is_valid(face));
+  }
 }
 
 // Below the threshold the face is checked whole, as BRepCheck does.
