@@ -139,7 +139,10 @@ ImportResult finish_inputs(const InputOptions& in, ImportResult result, MeshRepa
 }
 
 void print_diagnostics(const std::vector<Diagnostic>& ds) {
-  for (const Diagnostic& d : ds) std::cerr << format_diagnostic(d) << '\n';
+  // One write per line, newline included: under mpirun the ranks share one stderr, and a line
+  // written in two pieces lets another rank's line land between them. (std::cerr, not stderr:
+  // the MPI check silences ranks by swapping its buffer.)
+  for (const Diagnostic& d : ds) std::cerr << format_diagnostic(d) + '\n';
 }
 
 bool stderr_is_terminal() { return isatty(fileno(stderr)) != 0; }
