@@ -11,7 +11,8 @@ ReportImport import_report(const ImportResult& imported) {
   out.seconds = imported.seconds;
   for (const FileImport& f : imported.files) {
     const ImportTimings& t = f.timings;
-    out.files.push_back({f.path, cache_use_name(f.cache), t.read, t.transfer, t.heal, t.tessellate, t.total, f.transfer_workers});
+    out.files.push_back({f.path, cache_use_name(f.cache), t.read, t.transfer, t.heal, t.tessellate, t.total,
+                         f.transfer_workers, f.pieces, f.pieces_cached, f.parts_cached});
   }
   return out;
 }

@@ -97,6 +97,8 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(t.parallel_workers);
   w.f64(t.parallel_seconds);
   w.u64(t.split_failed ? 1 : 0);
+  w.u64(t.pieces);
+  w.u64(t.pieces_cached);
   if (!t.doc.IsNull()) {
     w.u64(1);
     const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
@@ -140,6 +142,8 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.parallel_workers = r.u64();
   t.parallel_seconds = r.f64();
   t.split_failed = r.u64() == 1;
+  t.pieces = r.u64();
+  t.pieces_cached = r.u64();
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
@@ -209,6 +213,8 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   result.complete = t.complete;
   result.files.push_back(FileImport{path, CacheUse::Off, {}});
   result.files.back().transfer_workers = t.parallel_workers;
+  result.files.back().pieces = t.pieces;
+  result.files.back().pieces_cached = t.pieces_cached;
   ImportTimings& timings = result.files.back().timings;
   timings.read = t.read_seconds;
   BrepPartTimings part_timings;

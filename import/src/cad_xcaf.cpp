@@ -1,6 +1,8 @@
 // XCAF document → parts and instances; transfer-process face map; OCCT check lists as diagnostics.
 #include "cad_xcaf.h"
 
+#include "brep_part_cache.h"
+
 #include <Interface_Check.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
@@ -298,8 +300,10 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
     input_of.push_back(p);
     nonempty_inputs.push_back(std::move(inputs[p]));
   }
-  const std::vector<PartId> ids = add_brep_parts(result.model, nonempty_inputs, options.tessellation, options.lazy,
-                                                 result.diagnostics, result.complete, timings);
+  std::size_t cached = 0;
+  const std::vector<PartId> ids =
+      add_brep_parts_cached(result.model, nonempty_inputs, options, result.diagnostics, result.complete, timings, &cached);
+  if (!result.files.empty()) result.files.back().parts_cached = cached;
   std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
   for (Instance& instance : walker.instances) {

@@ -184,6 +184,36 @@ bool stopped_by_time_limit(const ImportResult& r, const ImportOptions& o) {
 
 }  // namespace
 
+std::string sha256_hex(std::string_view bytes) { return hex(sha256(bytes)); }
+
+std::string cache_versions() {
+  std::ostringstream k;
+  k << "cadclash import cache " << kCacheFormat << "\n" << build_identity() << "\nocct " << OCC_VERSION_COMPLETE << '\n';
+  return k.str();
+}
+
+CacheRead read_cache_entry(const std::string& dir, const std::string& key) {
+  CacheRead out;
+  const std::filesystem::path entry = std::filesystem::path(dir) / entry_name(key);
+  out.file = entry.string();
+  const std::optional<std::string> stored = file_bytes(out.file);
+  if (!stored) return out;
+  if (const auto payload = entry_payload(*stored, key, out.damaged)) out.payload.emplace(*payload);
+  return out;
+}
+
+bool write_cache_entry(const std::string& dir, const std::string& key, const std::string& payload, std::string& why) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    why = "cannot make the directory: " + ec.message();
+    return false;
+  }
+  return write_entry(std::filesystem::path(dir) / entry_name(key), entry_bytes(key, payload), why);
+}
+
+bool is_cache_note(const Diagnostic& d) { return d.message.rfind(kCacheNote, 0) == 0; }
+
 std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options) {
   const std::optional<std::string> bytes = file_bytes(path);
   if (!bytes) return std::nullopt;
@@ -208,7 +238,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
       hit.files.back().timings.read = seconds_since(load_start);
       return hit;
     }
-    damaged = cache_warning(path, "the cache entry " + entry.string() + " is damaged (" + why +
+    damaged = cache_warning(path, std::string(kCacheNote) + entry.string() + " is damaged (" + why +
                                       "); the file was read again and the entry rewritten");
   }
 
@@ -217,7 +247,15 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
   if (stopped_by_time_limit(result, options)) return result;
   // Stored without this run's warning about the damaged entry: a later run read from it says what
   // reading the file said.
+  // Notes of this run's cache use (a damaged entry of a product, read again) are not stored either.
+  std::vector<Diagnostic> notes;
+  std::erase_if(result.diagnostics, [&](const Diagnostic& d) {
+    if (!is_cache_note(d)) return false;
+    notes.push_back(d);
+    return true;
+  });
   const std::optional<std::string> payload = save_import(result);
+  result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
   if (damaged) result.diagnostics.insert(result.diagnostics.begin(), *damaged);
   if (!payload) return result;  // a part this cache cannot store: read every time
   std::error_code ec;

@@ -29,4 +29,25 @@ std::optional<std::string> cache_entry_name(const std::string& path, const Impor
 std::optional<std::string> save_import(const ImportResult& r, bool exact_faces = true);
 bool load_import(std::string_view bytes, ImportResult& r, std::string& why, bool stand_ins = false);
 
+// The building blocks, for caches of pieces of files (step_piece_cache.h).
+//
+// The lines every key starts with: the cache format, the build of cadclash and OCCT's version.
+std::string cache_versions();
+std::string sha256_hex(std::string_view bytes);
+// An entry of `dir` for `key` (the entry file is named by the key's SHA-256 and holds the key
+// whole): its payload when the entry is whole and for this key; `damaged` says why not when the
+// file exists but is not (otherwise the entry is missing).
+struct CacheRead {
+  std::optional<std::string> payload;
+  std::string damaged;
+  std::string file;
+};
+CacheRead read_cache_entry(const std::string& dir, const std::string& key);
+// Writes the entry whole or not at all (making `dir` when missing); false and `why` when it cannot.
+bool write_cache_entry(const std::string& dir, const std::string& key, const std::string& payload, std::string& why);
+// Warnings about the cache itself start with this; they are said by the run that met the problem
+// and never stored in an entry.
+inline constexpr std::string_view kCacheNote = "the cache entry ";
+bool is_cache_note(const Diagnostic& d);
+
 }  // namespace cadclash::detail

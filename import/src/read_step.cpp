@@ -56,7 +56,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
   if (auto warning = unapplied_time_limit(path, options)) notes.push_back(*warning);
   for (;;) {
     IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(),
-                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip, workers, min_bytes, split}); });
+                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip, workers, min_bytes, split, options.cache_dir}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
     read_seconds += run.transfer.read_seconds;

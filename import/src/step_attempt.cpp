@@ -2,8 +2,11 @@
 // model repaired and transferred into an XCAF document, or its faces transferred one by one.
 #include "step_attempt.h"
 
+#include "cadclash/internal/byte_io.h"
+
 #include "step_model_repairs.h"
 #include "step_parallel_transfer.h"
+#include "step_piece_cache.h"
 #include "step_split_text.h"
 #include "step_text.h"
 #include "step_uncertainty.h"
@@ -121,13 +124,47 @@ bool describe_face(const Handle(Standard_Transient)& entity, const EntityLabelFn
   return true;
 }
 
-// The pieces' shapes bound to the main text's stand-ins, by #id: the number of pieces, 0 when one
-// failed (nothing is bound then).
-std::size_t bind_pieces(Children& pieces, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
-                        const EntityLabelFn& label, ReadBindings& bound) {
+// A cut file on its way: pieces the cache holds, and the others parsed by forked workers, a share
+// of the pieces each.
+struct SplitRead {
+  StepSplit split;
+  std::vector<std::optional<std::string>> bytes;  // per piece: its shapes, from the cache or a worker
+  std::vector<std::vector<std::size_t>> shares;   // per worker: the pieces it reads
+  std::optional<Children> workers;
+  std::string cache_dir;  // empty: no cache
+  std::size_t cached = 0;
+};
+
+// In a worker: each piece of `share` read in turn, their bytes one after another; "" when one failed.
+std::string read_step_pieces(const std::string& path, const std::vector<StepPiece>& pieces, const std::vector<std::size_t>& share) {
+  ByteWriter w;
+  for (const std::size_t p : share) {
+    const std::string bytes = read_step_piece(path, pieces[p]);
+    if (bytes.empty()) return {};
+    w.str(bytes);
+  }
+  return std::move(w.out);
+}
+
+// The pieces' shapes bound to the main text's stand-ins, by #id, the workers' stored in the cache:
+// false when a worker failed (nothing is bound then).
+bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
+                 const EntityLabelFn& label, const std::string& path, ReadBindings& bound, std::vector<Diagnostic>& notes) {
   std::string why;
-  const std::vector<ChildRun> runs = pieces.wait();
-  if (!read_bindings(runs, bound, why)) return 0;
+  const std::vector<ChildRun> runs = read.workers ? read.workers->wait() : std::vector<ChildRun>{};
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const ChildRun& run = runs[k];
+    if (!run.isolated || run.crashed || run.payload.empty()) return false;
+    ByteReader r{run.payload};
+    for (const std::size_t p : read.shares[k]) read.bytes[p] = r.str();
+    if (!r.ok || r.at != run.payload.size()) return false;
+  }
+  for (std::size_t p = 0; p < read.bytes.size(); ++p) {
+    if (!read.bytes[p] || !read_binding_bytes(*read.bytes[p], bound, why)) return false;
+  }
+  if (!read.cache_dir.empty())
+    for (const auto& share : read.shares)
+      for (const std::size_t p : share) store_cached_piece(read.cache_dir, read.split.pieces[p], *read.bytes[p], path, notes);
   std::unordered_map<std::int64_t, Handle(Standard_Transient)> by_id;
   for (const auto& [id, shape] : bound.shapes) by_id.emplace(id, Handle(Standard_Transient)());
   for (Standard_Integer e = 1; e <= model->NbEntities(); ++e)
@@ -135,27 +172,28 @@ std::size_t bind_pieces(Children& pieces, const Handle(StepData_StepModel)& mode
   std::vector<Handle(Standard_Transient)> entities;
   for (const auto& [id, shape] : bound.shapes) entities.push_back(by_id[id]);
   const Handle(Transfer_TransientProcess) process = ws->TransferReader()->TransientProcess();
-  return !process.IsNull() && bind_all(process, entities, bound.shapes, why) ? runs.size() : 0;
+  return !process.IsNull() && bind_all(process, entities, bound.shapes, why);
 }
 
 // The products into result.doc with the entity of each face, after the repairs that keep OCCT's
 // transfer from crashing or dropping products silently (step_model_repairs.h).
 void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
                        const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
-                       const AttemptRun& run, Children* pieces, Transfer& result) {
+                       const AttemptRun& run, SplitRead* pieces, Transfer& result) {
   if (run.attempt == Attempt::WithoutBrokenFaces) drop_broken_shapes(model, label, path, result);
   cut_deep_mapped_items(model, label, path, result);
   report_assembly_cycles(model, label, path, result);
   ReadBindings bound;  // the pieces' shapes, held while their faces are tagged
   if (pieces != nullptr) {
-    const std::size_t workers = bind_pieces(*pieces, model, ws, label, bound);
-    if (workers == 0) {
+    if (!bind_pieces(*pieces, model, ws, label, path, bound, result.diagnostics)) {
       result.split_failed = true;
       return;
     }
     // Reading ends when the slowest piece is parsed (the pieces parse while this process does).
     result.read_seconds = std::max(result.read_seconds, result.split_seconds + bound.parse_seconds);
-    result.parallel_workers = workers;
+    result.parallel_workers = std::max<std::size_t>(1, pieces->shares.size());
+    result.pieces = pieces->split.pieces.size();
+    result.pieces_cached = pieces->cached;
   } else if (run.attempt == Attempt::Whole && run.workers > 1) {
     const ParallelTransfer parallel = transfer_shapes_in_parallel(model, ws, run.workers);
     result.parallel_workers = parallel.used ? parallel.workers : 1;
@@ -175,7 +213,7 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
 // says so or the file has no product that can be transferred.
 void transfer_model(STEPCAFControl_Reader& reader, const Handle(StepData_StepModel)& model,
                     const Handle(XSControl_WorkSession)& ws, const EntityLabelFn& label, const std::string& path,
-                    const AttemptRun& run, Children* pieces, Transfer& result) {
+                    const AttemptRun& run, SplitRead* pieces, Transfer& result) {
   STEPControl_Reader& step = reader.ChangeReader();
   if (pieces != nullptr && (run.attempt == Attempt::LooseFaces || reader.NbRootsForTransfer() == 0)) {
     result.split_failed = true;  // the stand-ins are no faces to recover: read the whole text
@@ -265,18 +303,34 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     }
     if (text.size() < run.parallel_min_bytes) run.workers = 1;
     // A large file is cut into pieces that workers parse and transfer while this process parses
-    // what is left (step_split_text.h); pieces that fail send read_step back to the whole file.
-    std::optional<StepSplit> split;
-    std::optional<Children> pieces;
-    if (run.split && run.attempt == Attempt::Whole && run.workers > 1 && readable) {
+    // what is left (step_split_text.h), pieces the cache holds taken from it (step_piece_cache.h);
+    // pieces that fail send read_step back to the whole file.
+    std::optional<SplitRead> pieces;
+    const bool cached = !run.cache_dir.empty();
+    if (run.split && run.attempt == Attempt::Whole && (run.workers > 1 || (cached && text.size() >= run.parallel_min_bytes)) && readable) {
       std::string why;
-      split = split_step_text(text, run.workers, why);
-      if (split) pieces.emplace(split->pieces.size(), [&](std::size_t k, const Mark&) { return read_step_piece(path, split->pieces[k]); });
+      if (std::optional<StepSplit> split = split_step_text(text, cached, why)) {
+        SplitRead& read = pieces.emplace();
+        read.split = std::move(*split);
+        read.cache_dir = run.cache_dir;
+        read.bytes.resize(read.split.pieces.size());
+        std::vector<std::size_t> missing;
+        for (std::size_t p = 0; p < read.split.pieces.size(); ++p) {
+          if (cached) read.bytes[p] = load_cached_piece(run.cache_dir, read.split.pieces[p], path, result.diagnostics);
+          if (read.bytes[p]) ++read.cached;
+          else missing.push_back(p);
+        }
+        read.shares = share_pieces(read.split.pieces, missing, run.workers);
+        if (!read.shares.empty())
+          read.workers.emplace(read.shares.size(), [&](std::size_t k, const Mark&) {
+            return read_step_pieces(path, read.split.pieces, read.shares[k]);
+          });
+      }
       result.split_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     }
     IFSelect_ReturnStatus status;
-    if (split) {
-      std::istringstream main_text(split->main_text);
+    if (pieces) {
+      std::istringstream main_text(pieces->split.main_text);
       status = reader.ChangeReader().ReadStream(path.c_str(), main_text);
     } else {
       status = parse(reader, path, text, readable, result);

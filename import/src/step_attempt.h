@@ -41,6 +41,9 @@ struct AttemptRun {
   std::size_t workers = 1;
   std::size_t parallel_min_bytes = 0;
   bool split = true;
+  // The import cache's directory (ImportOptions::cache_dir; empty = none): a file of at least
+  // `parallel_min_bytes` is cut even for one worker, and pieces the cache holds are not read.
+  std::string cache_dir;
 };
 
 // In a piece's worker: parses `piece` (step_split_text.h), transfers its representations and

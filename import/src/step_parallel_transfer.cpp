@@ -242,63 +242,117 @@ bool read_bindings(const std::vector<ChildRun>& runs, ReadBindings& out, std::st
       why = "a worker " + (run.isolated ? "crashed (" + run.how + ")" : "could not start (" + run.how + ")");
       return false;
     }
-    const std::string& payload = run.payload;
-    if (payload.empty() || payload[0] != 'O') {
-      why = "a worker reported a failed entity";
-      return false;
-    }
-    ByteReader r{std::string_view(payload).substr(1)};
-    out.parse_seconds = std::max(out.parse_seconds, r.f64());
-    struct Raw {
-      std::int64_t key, shape;
-      std::uint64_t orientation;
-    };
-    std::vector<Raw> bindings(r.ok ? r.u64() : 0);
-    for (Raw& b : bindings) b = {r.i64(), r.i64(), r.u64()};
-    struct RawTag {
-      std::int64_t shape;
-      FaceEntity entity;
-      bool single;
-    };
-    std::vector<RawTag> tags(r.ok ? r.u64() : 0);
-    for (RawTag& t : tags) {
-      t.shape = r.i64();
-      t.entity.id = r.i64();
-      t.entity.name = r.str();
-      t.single = r.u64() == 1;
-    }
-    std::istringstream stored(r.str());
-    TopoDS_Shape all;
-    try {
-      if (r.ok && !stored.str().empty()) BinTools::Read(all, stored);
-    } catch (const Standard_Failure&) {
-      r.ok = false;
-    }
-    if (!r.ok) {
+    if (!read_binding_bytes(run.payload, out, why)) return false;
+  }
+  return true;
+}
+
+namespace {
+
+// ShapeBindings' bytes up to its shapes, and where the shapes start.
+struct BindingHead {
+  double parse_seconds = 0.0;
+  struct Raw {
+    std::int64_t key, shape;
+    std::uint64_t orientation;
+  };
+  std::vector<Raw> bindings;
+  struct RawTag {
+    std::int64_t shape;
+    FaceEntity entity;
+    bool single;
+  };
+  std::vector<RawTag> tags;
+};
+
+bool read_head(ByteReader& r, BindingHead& h) {
+  h.parse_seconds = r.f64();
+  h.bindings.resize(r.ok ? r.count(24) : 0);
+  for (BindingHead::Raw& b : h.bindings) b = {r.i64(), r.i64(), r.u64()};
+  h.tags.resize(r.ok ? r.count(32) : 0);
+  for (BindingHead::RawTag& t : h.tags) {
+    t.shape = r.i64();
+    t.entity.id = r.i64();
+    t.entity.name = r.str();
+    t.single = r.u64() == 1;
+  }
+  return r.ok;
+}
+
+}  // namespace
+
+bool read_binding_bytes(std::string_view payload, ReadBindings& out, std::string& why) {
+  if (payload.empty() || payload[0] != 'O') {
+    why = "a worker reported a failed entity";
+    return false;
+  }
+  ByteReader r{payload.substr(1)};
+  BindingHead head;
+  read_head(r, head);
+  out.parse_seconds = std::max(out.parse_seconds, head.parse_seconds);
+  std::istringstream stored(r.str());
+  TopoDS_Shape all;
+  try {
+    if (r.ok && !stored.str().empty()) BinTools::Read(all, stored);
+  } catch (const Standard_Failure&) {
+    r.ok = false;
+  }
+  if (!r.ok || r.at != payload.size() - 1) {
+    why = "a worker's shapes came back incomplete";
+    return false;
+  }
+  TopTools_IndexedMapOfShape shapes;
+  if (!all.IsNull())
+    for (TopoDS_Iterator it(all); it.More(); it.Next()) TopExp::MapShapes(it.Value(), shapes);
+  auto valid = [&](std::int64_t i) { return i >= 1 && i <= shapes.Extent(); };
+  for (const BindingHead::Raw& b : head.bindings) {
+    if (!valid(b.shape) || b.orientation > TopAbs_EXTERNAL) {
       why = "a worker's shapes came back incomplete";
       return false;
     }
-    TopTools_IndexedMapOfShape shapes;
-    if (!all.IsNull())
-      for (TopoDS_Iterator it(all); it.More(); it.Next()) TopExp::MapShapes(it.Value(), shapes);
-    auto valid = [&](std::int64_t i) { return i >= 1 && i <= shapes.Extent(); };
-    for (const Raw& b : bindings) {
-      if (!valid(b.shape) || b.orientation > TopAbs_EXTERNAL) {
-        why = "a worker's shapes came back incomplete";
-        return false;
-      }
-      out.shapes.emplace_back(b.key, shapes(static_cast<Standard_Integer>(b.shape)).Oriented(static_cast<TopAbs_Orientation>(b.orientation)));
-    }
-    for (RawTag& t : tags) {
-      if (!valid(t.shape)) {
-        why = "a worker's shapes came back incomplete";
-        return false;
-      }
-      out.tags.push_back({shapes(static_cast<Standard_Integer>(t.shape)).TShape().get(), std::move(t.entity), t.single});
-    }
-    out.keep.push_back(all);
+    out.shapes.emplace_back(b.key, shapes(static_cast<Standard_Integer>(b.shape)).Oriented(static_cast<TopAbs_Orientation>(b.orientation)));
   }
+  for (BindingHead::RawTag& t : head.tags) {
+    if (!valid(t.shape)) {
+      why = "a worker's shapes came back incomplete";
+      return false;
+    }
+    out.tags.push_back({shapes(static_cast<Standard_Integer>(t.shape)).TShape().get(), std::move(t.entity), t.single});
+  }
+  out.keep.push_back(all);
   return true;
+}
+
+std::optional<std::string> renumber_bindings(std::string_view payload, const std::function<std::optional<std::int64_t>(std::int64_t)>& id) {
+  if (payload.empty() || payload[0] != 'O') return std::nullopt;
+  ByteReader r{payload.substr(1)};
+  BindingHead head;
+  if (!read_head(r, head)) return std::nullopt;
+  const std::string shapes = r.str();
+  if (!r.ok || r.at != payload.size() - 1) return std::nullopt;
+  ByteWriter w;
+  w.f64(0.0);
+  w.u64(head.bindings.size());
+  for (const BindingHead::Raw& b : head.bindings) {
+    const std::optional<std::int64_t> key = id(b.key);
+    if (!key) return std::nullopt;
+    w.i64(*key);
+    w.i64(b.shape);
+    w.u64(b.orientation);
+  }
+  w.u64(head.tags.size());
+  for (const BindingHead::RawTag& t : head.tags) {
+    const std::optional<std::int64_t> entity = t.entity.id < 0 ? std::optional<std::int64_t>(t.entity.id) : id(t.entity.id);
+    if (!entity) return std::nullopt;
+    w.i64(t.shape);
+    w.i64(*entity);
+    w.str(t.entity.name);
+    w.u64(t.single ? 1 : 0);
+  }
+  w.str(shapes);
+  std::string out = "O";
+  out += w.out;
+  return out;
 }
 
 bool bind_all(const Handle(Transfer_TransientProcess)& process, const std::vector<Handle(Standard_Transient)>& entities,

@@ -16,6 +16,9 @@
 #include <XSControl_WorkSession.hxx>
 
 #include <cstddef>
+#include <functional>
+#include <optional>
+#include <string_view>
 #include <string>
 #include <utility>
 #include <vector>
@@ -58,6 +61,12 @@ struct ReadBindings {
   double parse_seconds = 0.0;      // the slowest worker's
 };
 bool read_bindings(const std::vector<ChildRun>& runs, ReadBindings& out, std::string& why);
+// One ShapeBindings' bytes added to `out`; false (and why) when they are a failure or not whole.
+bool read_binding_bytes(std::string_view bytes, ReadBindings& out, std::string& why);
+// ShapeBindings' bytes with every key and face entity id replaced by id(it) (ids < 0 kept) and no
+// parse time; nullopt when the bytes are not whole or `id` has no answer for one.
+std::optional<std::string> renumber_bindings(std::string_view bytes,
+                                             const std::function<std::optional<std::int64_t>(std::int64_t)>& id);
 
 // Binds entities[k] to shapes[k].second in `process`; false (nothing bound) when an entity is null,
 // repeated or already bound.

@@ -2,6 +2,7 @@
 #include "step_split_text.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cctype>
 #include <numeric>
 #include <span>
@@ -169,13 +170,43 @@ struct UnionFind {
   }
 };
 
+// The header's FILE_SCHEMA statement (which schema the entities are read in); "" when none.
+std::string_view file_schema(std::string_view header) {
+  const std::size_t at = header.find("FILE_SCHEMA");
+  if (at == std::string_view::npos) return {};
+  const std::size_t end = header.find(';', at);
+  return header.substr(at, end == std::string_view::npos ? std::string_view::npos : end + 1 - at);
+}
+
+// The statement with every id (its own and the ones it references) replaced by `number`'s, outside
+// quoted strings. Precondition: `number` holds every id the statement names.
+void renumbered(const std::string& text, const Statement& s, const std::unordered_map<std::int64_t, std::int64_t>& number,
+                std::string& out) {
+  bool quoted = false;
+  for (std::size_t i = s.begin; i < s.end; ++i) {
+    const char c = text[i];
+    if (quoted) {
+      quoted = c != '\'';
+    } else if (c == '\'') {
+      quoted = true;
+    } else if (c == '#') {
+      std::int64_t id = 0;
+      std::size_t j = i + 1;
+      while (j < s.end && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
+      if (j > i + 1) {
+        out += '#';
+        out += std::to_string(number.at(id));
+        i = j - 1;
+        continue;
+      }
+    }
+    out += c;
+  }
+}
+
 }  // namespace
 
-std::optional<StepSplit> split_step_text(const std::string& text, std::size_t workers, std::string& why_not) {
-  if (workers < 2) {
-    why_not = "one worker";
-    return std::nullopt;
-  }
+std::optional<StepSplit> split_step_text(const std::string& text, bool canonical, std::string& why_not) {
   std::optional<Scan> scanned = scan(text, why_not);
   if (!scanned) return std::nullopt;
   const Scan& sc = *scanned;
@@ -249,21 +280,9 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
     why_not = "one group of shapes";
     return std::nullopt;
   }
-  // Largest group first onto the least loaded worker (ties: lower index).
-  const std::size_t used = std::min(workers, groups);
-  std::vector<std::uint32_t> worker_of_group(groups);
-  {
-    std::vector<std::size_t> order(groups);
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return group_bytes[a] > group_bytes[b]; });
-    std::vector<std::size_t> load(used, 0);
-    for (const std::size_t g : order) {
-      const auto w = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-      load[w] += group_bytes[g] + 1;
-      worker_of_group[g] = static_cast<std::uint32_t>(w);
-    }
-  }
-  auto worker_of = [&](std::uint32_t e) { return worker_of_group[group_of[owner[e]]]; };
+  // One piece per group, so that a group's piece (and its shapes) do not depend on the rest.
+  const std::size_t used = groups;
+  auto worker_of = [&](std::uint32_t e) { return group_of[owner[e]]; };
 
   // Each item's representation context: the last reference of every shape representation that lists
   // it; they must agree (the units the item is read in).
@@ -301,8 +320,8 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
   // Pieces: per worker, its items' whole insides (leaves included) and, per context, a shape
   // representation of its items with that context and what the context reaches.
   StepSplit out;
-  out.groups = groups;
   out.pieces.resize(used);
+  for (std::size_t g = 0; g < groups; ++g) out.pieces[g].bytes = group_bytes[g];
   std::vector<std::uint32_t> stamp(n, kNone);  // worker whose piece holds the statement
   std::vector<std::vector<std::uint32_t>> members(used);
   auto take = [&](std::uint32_t start, std::uint32_t w) {
@@ -317,7 +336,7 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
       for (const std::uint32_t r : refs_of(e)) stack.push_back(r);
     }
   };
-  // A statement can be in several pieces (leaves, contexts): stamps are per worker, so each worker
+  // A statement can be in several pieces (leaves, contexts): stamps are per piece, and each piece
   // takes its statements in one sweep before the next.
   std::vector<std::vector<std::uint32_t>> items_of(used);
   for (std::uint32_t h = 0; h < items.size(); ++h) items_of[worker_of(items[h])].push_back(h);
@@ -327,8 +346,12 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
   std::vector<char> context_statement(n, 0);
   std::int64_t next_id = max_id + 1;
   std::vector<std::string> synthetic(used);
+  struct Synthetic {
+    std::int64_t id, context;
+    std::vector<std::int64_t> items;
+  };
+  std::vector<std::vector<Synthetic>> synthetic_reps(used);
   for (std::uint32_t w = 0; w < used; ++w) {
-    std::fill(stamp.begin(), stamp.end(), kNone);
     std::vector<std::pair<std::int64_t, std::vector<std::int64_t>>> by_context;
     for (const std::uint32_t h : items_of[w]) {
       take(items[h], w);
@@ -353,6 +376,7 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
       for (std::size_t k = 0; k < ids.size(); ++k) rep += (k ? ",#" : "#") + std::to_string(ids[k]);
       rep += "),#" + std::to_string(context) + ");\n";
       synthetic[w] += rep;
+      synthetic_reps[w].push_back({next_id, context, ids});
       out.pieces[w].reps.push_back(next_id++);
     }
     std::sort(members[w].begin(), members[w].end());
@@ -441,8 +465,50 @@ std::optional<StepSplit> split_step_text(const std::string& text, std::size_t wo
     piece.text += synthetic[w];
     piece.text += "ENDSEC;\nEND-ISO-10303-21;\n";
     std::sort(piece.bind.begin(), piece.bind.end());
+    if (!canonical) continue;
+    // Ids renumbered in the order the piece defines them: the same product written elsewhere in a
+    // file, or by another export that numbers the rest differently, reads the same.
+    std::unordered_map<std::int64_t, std::int64_t> number;
+    for (const std::uint32_t k : members[w]) {
+      piece.ids.push_back(st[k].id);
+      number.emplace(st[k].id, static_cast<std::int64_t>(piece.ids.size()));
+    }
+    for (const Synthetic& r : synthetic_reps[w]) {
+      piece.ids.push_back(r.id);
+      number.emplace(r.id, static_cast<std::int64_t>(piece.ids.size()));
+    }
+    std::string& c = piece.canonical;
+    c.append(file_schema(sc.header));
+    c += '\n';
+    for (const std::uint32_t k : members[w]) {
+      renumbered(text, st[k], number, c);
+      c += '\n';
+    }
+    for (const Synthetic& r : synthetic_reps[w]) {
+      c += "#" + std::to_string(number.at(r.id)) + "=SHAPE_REPRESENTATION('',(";
+      for (std::size_t k = 0; k < r.items.size(); ++k) c += (k ? ",#" : "#") + std::to_string(number.at(r.items[k]));
+      c += "),#" + std::to_string(number.at(r.context)) + ");\n";
+    }
   }
   return out;
+}
+
+std::vector<std::vector<std::size_t>> share_pieces(const std::vector<StepPiece>& pieces,
+                                                    const std::vector<std::size_t>& which, std::size_t workers) {
+  assert(workers >= 1);
+  const std::size_t used = std::min(workers, which.size());
+  std::vector<std::vector<std::size_t>> shares(used);
+  if (used == 0) return shares;
+  std::vector<std::size_t> order = which;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pieces[a].bytes > pieces[b].bytes; });
+  std::vector<std::size_t> load(used, 0);
+  for (const std::size_t p : order) {
+    const auto w = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[w] += pieces[p].bytes + 1;
+    shares[w].push_back(p);
+  }
+  for (auto& share : shares) std::sort(share.begin(), share.end());
+  return shares;
 }
 
 }  // namespace cadclash::detail

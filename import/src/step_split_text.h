@@ -19,20 +19,31 @@ struct StepPiece {
   std::string text;                // a whole STEP file: the original header, the entities, the end
   std::vector<std::int64_t> reps;  // representations to transfer, in order (ids in `text`)
   std::vector<std::int64_t> bind;  // ids whose shapes the main reader needs (its placeholders), ascending
+  std::size_t bytes = 0;           // of the statements inside its items (for sharing pieces out)
+  // With `canonical` asked: the piece's schema and statements with ids renumbered 1, 2, ... in the
+  // order the piece defines them (the same for the same product however the rest of the file is
+  // numbered), and ids[c - 1] the id in `text` of canonical id c.
+  std::string canonical;
+  std::vector<std::int64_t> ids;
 };
 
 struct StepSplit {
   std::string main_text;
-  std::vector<StepPiece> pieces;  // at least two
-  std::size_t groups = 0;         // sets of items that share topology (each in one piece)
+  std::vector<StepPiece> pieces;  // one per group of items that share topology, at least two
 };
 
-// The file cut for `workers` processes (items that reach a common entity other than a point,
-// direction, vector or placement share a piece; pieces balanced by their bytes). nullopt, with
-// `why_not`, when the text holds fewer than two such sets, or anything the cut does not handle:
-// comments, a reference to an undefined id, a truncated file, mapped items, non-manifold or
-// complex-typed shape representations, an item without a representation or in representations of
-// different contexts, or a named piece of an item that is not a face, shell or solid.
-std::optional<StepSplit> split_step_text(const std::string& text, std::size_t workers, std::string& why_not);
+// The file cut into one piece per group of items (items that reach a common entity other than a
+// point, direction, vector or placement share a group). nullopt, with `why_not`, when the text
+// holds fewer than two such groups, or anything the cut does not handle: comments, a reference to
+// an undefined id, a truncated file, mapped items, non-manifold or complex-typed shape
+// representations, an item without a representation or in representations of different contexts,
+// or a named piece of an item that is not a face, shell or solid.
+std::optional<StepSplit> split_step_text(const std::string& text, bool canonical, std::string& why_not);
+
+// The pieces listed in `which` shared out over at most `workers` processes, balanced by their bytes
+// (largest first onto the least loaded; ties: lower index); each share in ascending piece order.
+// Precondition: workers >= 1.
+std::vector<std::vector<std::size_t>> share_pieces(const std::vector<StepPiece>& pieces,
+                                                    const std::vector<std::size_t>& which, std::size_t workers);
 
 }  // namespace cadclash::detail

@@ -345,6 +345,9 @@ ReportImport read_import(const Json& j, const std::string& p) {
                                 {"total", &ReportFileImport::total}})
       f.*member = number(field(files[k], pk, name), pk + "/" + name);
     if (files[k].contains("processes")) f.processes = count(files[k]["processes"], pk + "/processes");  // since 2026-11
+    for (auto [name, member] : {std::pair{"pieces", &ReportFileImport::pieces}, {"pieces_cached", &ReportFileImport::pieces_cached},
+                                {"parts_cached", &ReportFileImport::parts_cached}})
+      if (files[k].contains(name)) f.*member = count(files[k][name], pk + "/" + name);  // since 2026-11-27
     out.files.push_back(std::move(f));
   }
   return out;

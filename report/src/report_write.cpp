@@ -338,7 +338,8 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
     nlohmann::json files = nlohmann::json::array();
     for (const ReportFileImport& f : r.import->files)
       files.push_back({{"file", f.file}, {"cache", f.cache}, {"read", f.read}, {"transfer", f.transfer},
-                       {"heal", f.heal}, {"tessellate", f.tessellate}, {"total", f.total}, {"processes", f.processes}});
+                       {"heal", f.heal}, {"tessellate", f.tessellate}, {"total", f.total}, {"processes", f.processes},
+                       {"pieces", f.pieces}, {"pieces_cached", f.pieces_cached}, {"parts_cached", f.parts_cached}});
     j["import_timings"] = {{"seconds", r.import->seconds}, {"files", std::move(files)}};
   }
   return j;

@@ -284,7 +284,8 @@ void for_each_part(std::size_t n, bool parallel, const F& f) {
 
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
-                                   std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings) {
+                                   std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
+                                   std::vector<std::size_t>* diagnostics_per_part) {
   assert(options.linear_deflection > 0.0);
   for (const BrepPartInput& in : parts) assert(in.shape != nullptr), (void)in;
   using Clock = std::chrono::steady_clock;
@@ -325,6 +326,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   for (std::size_t k = 0; k < parts.size(); ++k) {
     PartWork& w = work[k];
     diagnostics.insert(diagnostics.end(), w.diagnostics.begin(), w.diagnostics.end());
+    if (diagnostics_per_part) diagnostics_per_part->push_back(w.diagnostics.size());
     complete = complete && w.complete;
     Part part;
     part.name = parts[k].name;

@@ -12,6 +12,7 @@
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Iterator.hxx>
 
+#include <cassert>
 #include <sstream>
 
 namespace cadclash {
@@ -102,6 +103,13 @@ std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string
     return nullptr;
   }
   return std::make_shared<BrepSource>(std::move(impl));
+}
+
+void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids) {
+  BrepSource::Impl& impl = *source.impl_;
+  assert(entity_ids.size() == impl.faces.size());
+  const std::lock_guard<std::shared_mutex> lock(impl.mutex);
+  impl.entity_ids.assign(entity_ids.begin(), entity_ids.end());
 }
 
 }  // namespace cadclash

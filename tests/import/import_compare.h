@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cadclash/import.h"
+#include "cadclash/report.h"
 #include "import_cache.h"
 
 #include <gtest/gtest.h>
@@ -29,6 +30,18 @@ inline std::string everything(const ImportResult& r) {
   const std::optional<std::string> bytes = detail::save_import(plain);
   EXPECT_TRUE(bytes.has_value());
   return bytes.value_or("");
+}
+
+// The report of a certified check of the whole model, without timings: what `cadclash check` writes.
+inline std::string check_text(ImportResult r) {  // a copy: a scene tessellates lazy surfaces of its model
+  Scene scene(r.model, SceneSelection{});
+  CollideOptions options;
+  options.tolerance = 1e-4;
+  options.threads = 1;
+  CheckReport report;
+  report.query = query_report(r.model, scene.check(options));
+  for (const Diagnostic& d : r.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
+  return check_report_text(report, {.timings = false});
 }
 
 // Equal bytes; on a difference, its offset and the sizes (not the bytes: they are binary).

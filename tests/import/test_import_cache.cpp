@@ -19,6 +19,7 @@ namespace cadclash {
 namespace {
 
 namespace fs = std::filesystem;
+using testing_import::check_text;
 using testing_import::everything;
 using testing_import::same_bytes;
 
@@ -38,18 +39,6 @@ std::string fresh_cache(const std::string& name) {
   const fs::path dir = fs::path(testing::scratch_dir()) / ("cache-" + name);
   fs::remove_all(dir);
   return dir.string();
-}
-
-// The report of a certified check of the whole model, without timings: what `cadclash check` writes.
-std::string check_text(ImportResult r) {  // a copy: a scene tessellates lazy surfaces of its model
-  Scene scene(r.model, SceneSelection{});
-  CollideOptions options;
-  options.tolerance = 1e-4;
-  options.threads = 1;
-  CheckReport report;
-  report.query = query_report(r.model, scene.check(options));
-  for (const Diagnostic& d : r.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
-  return check_report_text(report, {.timings = false});
 }
 
 std::vector<std::string> messages(const ImportResult& r) {

@@ -176,7 +176,7 @@ TEST(CliImport, DamagedCacheEntryIsReadAgain) {
 
 // Runs sharing one cache directory at once: each writes its entries through a temporary file and a
 // rename, so none ever reads half an entry; all give the reference report, and the directory ends
-// with one whole entry per file and no temporary files.
+// with one whole entry per file (and per B-rep part) and no temporary files.
 TEST(CliImport, ConcurrentRunsShareACache) {
   const std::string as1 = kExternal + "as1-tu-203.stp", screw = kExternal + "screw.step";
   if (const std::string m = missing({as1, screw}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
@@ -208,7 +208,7 @@ TEST(CliImport, ConcurrentRunsShareACache) {
     EXPECT_EQ(e.path().extension(), ".entry") << e.path();
     ++entries;
   }
-  EXPECT_EQ(entries, 2);
+  EXPECT_GT(entries, 2);  // the two files' entries and their B-rep parts' (docs/import.md), no temporary left
 }
 
 }  // namespace

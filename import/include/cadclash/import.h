@@ -96,6 +96,10 @@ struct ImportOptions {
   // again from the file, rewritten, and named in a warning. Entries are written whole (temporary file,
   // then rename), so runs sharing the directory never see half an entry. A file whose reading ran into
   // a time limit is not stored. Entries are never removed: delete the directory to empty it.
+  // Besides the file's entry, a STEP file that can be cut (docs/import.md) keeps one entry per piece
+  // (a product's shapes, keyed by the piece's text with its ids renumbered canonically) and every
+  // CAD file one per checked and healed B-rep part (keyed by its transferred shape, names, tags and
+  // the tessellation options): a changed file reads and heals only the products that changed.
   std::string cache_dir;
   // import_files: how many files are read at once (each in its own thread, a CAD file's isolated reader
   // in its own process); 0 = one per OpenMP thread (omp_get_max_threads). The result does not depend on it.
@@ -132,6 +136,11 @@ struct FileImport {
   // STEP: processes that transferred the file's shapes (ImportOptions::transfer_workers); 1 = the
   // reader alone, and for other formats and cache hits.
   std::size_t transfer_workers = 1;
+  // STEP read with a cache (ImportOptions::cache_dir): the products' shapes cut into this many
+  // pieces (0: the file was not cut), of which this many came from the cache, not from the file.
+  std::size_t pieces = 0, pieces_cached = 0;
+  // CAD parts that came checked and healed from the cache (with a cache only).
+  std::size_t parts_cached = 0;
 };
 
 struct ImportResult {

@@ -118,10 +118,12 @@ struct BrepPartTimings {
   double heal = 0.0;        // BRepCheck and ShapeFix of invalid faces, plane pcurves, exact boxes and face facts
   double tessellate = 0.0;  // BRepMesh, reading and measuring the triangles (eager only)
 };
+// `diagnostics_per_part`, when given, gets how many diagnostics each part appended, in input order.
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
                                    const TessellationOptions& options, bool lazy,
                                    std::vector<Diagnostic>& diagnostics, bool& complete,
-                                   BrepPartTimings* timings = nullptr);
+                                   BrepPartTimings* timings = nullptr,
+                                   std::vector<std::size_t>* diagnostics_per_part = nullptr);
 
 // The SurfaceSource of a B-rep part. Thread-safe: each part has a shared mutex; triangulate() calls
 // on one part serialise, exact_distance() calls only read the faces and run concurrently.
@@ -199,6 +201,10 @@ class BrepSource final : public SurfaceSource {
   // Back from save_brep_source's bytes; nullptr and `why` when they are not whole. The bytes must be
   // ones save_brep_source wrote (check a cache entry's checksum first): OCCT's shape reader trusts them.
   friend std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
+  // The file's entity id of each face (what a part stored under one file's ids is in another
+  // export of the same product). Precondition: entity_ids.size() == face_count(); no other thread
+  // uses the part meanwhile.
+  friend void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids);
   friend std::size_t tessellate_parts(Model& model, std::span<const PartId> parts,
                                       std::vector<Diagnostic>& diagnostics, bool& complete);
   friend void release_part_triangles(Model& model, std::span<const PartId> parts);
@@ -210,6 +216,7 @@ class BrepSource final : public SurfaceSource {
 
 std::string save_brep_source(const BrepSource& source);
 std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
+void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids);
 
 // Whole parts meshed later (distributed checks: a rank meshes only the parts its share of the work
 // reaches, and must get the triangles one process's eager import gets).

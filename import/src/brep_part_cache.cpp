@@ -1,0 +1,204 @@
+// The cache of B-rep parts (brep_part_cache.h): entries of the import cache's directory whose
+// contents are a one-part ImportResult (save_import), keyed by the part's input and settings.
+#include "brep_part_cache.h"
+
+#include "import_cache.h"
+
+#include <BRep_Builder.hxx>
+#include <BinTools.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+
+#include <chrono>
+#include <optional>
+#include <sstream>
+#include <unordered_map>
+
+namespace cadclash::detail {
+namespace {
+
+// Everything add_brep_parts' result for one part depends on, as text (doubles in hexadecimal);
+// nullopt when OCCT cannot write the shape.
+std::optional<std::string> part_key(const BrepPartInput& in, const ImportOptions& options) {
+  std::ostringstream shape;
+  try {
+    BinTools::Write(*in.shape, shape, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  const TessellationOptions& t = options.tessellation;
+  std::ostringstream k;
+  k << std::hexfloat;
+  k << cache_versions() << "brep part\nshape sha256 " << sha256_hex(shape.str()) << "\nkind "
+    << static_cast<int>(in.kind) << "\nname " << in.name.size() << ' ' << in.name << "\nfile " << in.source_file.size()
+    << ' ' << in.source_file << "\ndeflection " << t.linear_deflection << " relative " << t.relative << " angular "
+    << t.angular_deflection << " verify " << t.verify_deflection << "\nlazy " << options.lazy << "\ntags "
+    << in.tags.size() << '\n';
+  // Entity ids by their pattern (canonical: 1, 2, ... in order of first use), so another export
+  // of the same product, numbered differently, finds the entry; load_part gives back this file's.
+  std::unordered_map<std::int64_t, std::size_t> canonical;
+  for (const BrepFaceTag& tag : in.tags) {
+    const std::int64_t id =
+        tag.entity_id < 0 ? -1 : static_cast<std::int64_t>(canonical.emplace(tag.entity_id, canonical.size() + 1).first->second);
+    k << id << ' ' << tag.name.size() << ' ' << tag.name;
+    if (tag.colour) k << ' ' << (*tag.colour)[0] << ' ' << (*tag.colour)[1] << ' ' << (*tag.colour)[2];
+    k << '\n';
+  }
+  return k.str();
+}
+
+// One part as add_brep_parts gave it: the part, its surfaces, its diagnostics and whether it is whole.
+struct OnePart {
+  Part part;
+  std::vector<Surface> surfaces;
+  std::vector<Diagnostic> diagnostics;
+  bool complete = true;
+};
+
+std::string save_part(const OnePart& p) {
+  ImportResult r;
+  r.diagnostics = p.diagnostics;
+  r.complete = p.complete;
+  r.model.parts.push_back(p.part);
+  r.model.parts.back().first_surface = 0;
+  r.model.surfaces = p.surfaces;
+  for (Surface& s : r.model.surfaces) s.part = 0;
+  return save_import(r).value_or(std::string());
+}
+
+// The part stored for `in` (another export's entity ids replaced by `in`'s).
+bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, std::string& why) {
+  ImportResult r;
+  if (!load_import(bytes, r, why)) return false;
+  auto* source = r.model.parts.size() == 1 ? dynamic_cast<BrepSource*>(r.model.parts[0].source.get()) : nullptr;
+  if (source == nullptr || !r.model.instances.empty() || r.model.parts[0].surface_count != r.model.surfaces.size() ||
+      source->face_count() != r.model.surfaces.size()) {
+    why = "it holds no single B-rep part";
+    return false;
+  }
+  std::unordered_map<std::int64_t, std::int64_t> id_of;  // stored id -> this file's
+  std::vector<std::int64_t> ids(r.model.surfaces.size(), -1);
+  for (std::size_t f = 0; f < ids.size(); ++f) {
+    Provenance& p = r.model.surfaces[f].provenance;
+    const std::int64_t now = f < in.tags.size() ? in.tags[f].entity_id : -1;
+    if ((p.step_id < 0) != (now < 0) || id_of.emplace(p.step_id, now).first->second != now) {
+      why = "its faces' entities do not match the part's";
+      return false;
+    }
+    p.step_id = ids[f] = now;
+  }
+  relabel_brep_faces(*source, ids);
+  for (Diagnostic& d : r.diagnostics)
+    if (d.step_id >= 0) {
+      const auto it = id_of.find(d.step_id);
+      if (it == id_of.end()) {
+        why = "a diagnostic names an entity that is not one of the part's faces";
+        return false;
+      }
+      d.step_id = it->second;
+    }
+  out.part = std::move(r.model.parts[0]);
+  out.surfaces = std::move(r.model.surfaces);
+  out.diagnostics = std::move(r.diagnostics);
+  out.complete = r.complete;
+  return true;
+}
+
+bool share_edges(std::span<const BrepPartInput> parts) {
+  TopTools_IndexedMapOfShape all;
+  int sum = 0;
+  for (const BrepPartInput& in : parts) {
+    TopTools_IndexedMapOfShape edges;
+    TopExp::MapShapes(*in.shape, TopAbs_EDGE, edges);
+    sum += edges.Extent();
+    for (Standard_Integer e = 1; e <= edges.Extent(); ++e) all.Add(edges(e));
+  }
+  return all.Extent() != sum;
+}
+
+}  // namespace
+
+std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
+                                          std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
+                                          std::size_t* from_cache) {
+  if (from_cache) *from_cache = 0;
+  if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() || share_edges(parts))
+    return add_brep_parts(model, parts, options.tessellation, options.lazy, diagnostics, complete, timings);
+
+  const std::size_t n = parts.size();
+  std::vector<std::optional<std::string>> keys(n);
+  std::vector<OnePart> made(n);
+  std::vector<char> held(n, 0);
+  std::vector<Diagnostic> notes;
+  std::vector<std::size_t> missing;
+  std::vector<BrepPartInput> to_make;
+  const auto load_start = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < n; ++k) {
+    keys[k] = part_key(parts[k], options);
+    if (keys[k]) {
+      const CacheRead read = read_cache_entry(options.cache_dir, *keys[k]);
+      std::string why = read.damaged;
+      if (read.payload && load_part(*read.payload, parts[k], made[k], why)) {
+        held[k] = 1;
+        continue;
+      }
+      if (!why.empty())
+        notes.push_back({Severity::Warning, parts[k].source_file, 0, -1,
+                         std::string(kCacheNote) + read.file + " is damaged (" + why + "); part '" + parts[k].name +
+                             "' was checked and healed again and the entry rewritten"});
+    }
+    missing.push_back(k);
+    to_make.push_back(parts[k]);
+  }
+  // Finding and loading the held parts stands in for checking and healing them.
+  if (timings) timings->heal += std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+
+  if (!to_make.empty()) {
+    Model fresh;
+    std::vector<Diagnostic> said;
+    std::vector<std::size_t> counts;
+    bool fresh_complete = true;
+    const std::vector<PartId> ids = add_brep_parts(fresh, to_make, options.tessellation, options.lazy, said,
+                                                   fresh_complete, timings, &counts);
+    std::size_t next = 0;
+    for (std::size_t m = 0; m < missing.size(); ++m) {
+      OnePart& p = made[missing[m]];
+      p.part = fresh.parts[ids[m]];
+      const auto first = fresh.surfaces.begin() + p.part.first_surface;
+      p.surfaces.assign(first, first + p.part.surface_count);
+      p.diagnostics.assign(said.begin() + static_cast<std::ptrdiff_t>(next),
+                           said.begin() + static_cast<std::ptrdiff_t>(next + counts[m]));
+      next += counts[m];
+      for (const Diagnostic& d : p.diagnostics) p.complete = p.complete && d.severity != Severity::Error;
+      if (!keys[missing[m]]) continue;
+      std::string why;
+      const std::string bytes = save_part(p);
+      if (bytes.empty() || !write_cache_entry(options.cache_dir, *keys[missing[m]], bytes, why))
+        notes.push_back({Severity::Warning, parts[missing[m]].source_file, 0, -1,
+                         std::string(kCacheNote) + "for part '" + parts[missing[m]].name + "' could not be written in " +
+                             options.cache_dir + " (" + (bytes.empty() ? "it cannot be stored" : why) + ")"});
+    }
+  }
+
+  diagnostics.insert(diagnostics.end(), notes.begin(), notes.end());
+  std::vector<PartId> out;
+  out.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    OnePart& p = made[k];
+    const auto id = static_cast<PartId>(model.parts.size());
+    p.part.first_surface = static_cast<SurfaceId>(model.surfaces.size());
+    for (Surface& s : p.surfaces) {
+      s.part = id;
+      model.surfaces.push_back(std::move(s));
+    }
+    model.parts.push_back(std::move(p.part));
+    diagnostics.insert(diagnostics.end(), p.diagnostics.begin(), p.diagnostics.end());
+    complete = complete && p.complete;
+    out.push_back(id);
+    if (from_cache && held[k]) ++*from_cache;
+  }
+  return out;
+}
+
+}  // namespace cadclash::detail

@@ -1,0 +1,226 @@
+// The import cache per product (ImportOptions::cache_dir on a STEP file cut into pieces): a file
+// read again after a placement was edited, its ids renumbered, or one product's geometry changed
+// takes every unchanged product's shapes and healed parts from the cache and gives what reading it
+// afresh gives; damaged entries of products are never trusted.
+#include "cadclash/import.h"
+#include "../test_temp.h"
+#include "import_compare.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace cadclash {
+namespace {
+
+namespace fs = std::filesystem;
+using testing_import::check_text;
+using testing_import::everything;
+using testing_import::same_bytes;
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::vector<std::string> messages(const ImportResult& r) {
+  std::vector<std::string> out;
+  for (const Diagnostic& d : r.diagnostics) out.push_back(format_diagnostic(d));
+  return out;
+}
+
+// The truth tests' board written as a STEP assembly by OCCT's XCAF writer (7 products, 100 items).
+std::string board(const std::string& name) {
+  const std::string out = (fs::path(testing::scratch_dir()) / name).string();
+  const std::string command = std::string("'") + CADCLASH_WRITE_BOARD_STEP + "' '" + CADCLASH_DATA_DIR + "/external' '" +
+                              out + "' 1 >/dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  return out;
+}
+
+// The statement "#id = ...;" of `text`, from '#' to ';'.
+std::pair<std::size_t, std::size_t> statement(const std::string& text, const std::string& id) {
+  const std::size_t at = text.find("\n" + id + " = ");
+  EXPECT_NE(at, std::string::npos) << id;
+  return {at + 1, text.find(';', at) + 1};
+}
+
+// The n-th reference "#k" inside statement `s` (0: the first after '=').
+std::string reference(const std::string& text, std::pair<std::size_t, std::size_t> s, int n) {
+  std::size_t at = text.find('=', s.first);
+  for (int k = 0; k <= n; ++k) at = text.find('#', at + 1);
+  std::size_t end = at + 1;
+  while (std::isdigit(static_cast<unsigned char>(text[end]))) ++end;
+  return text.substr(at, end - at);
+}
+
+// The point of the placement an occurrence is moved by, moved 0.5 mm along x: an edited placement.
+std::string with_placement_moved(std::string text) {
+  const std::size_t transformation = text.find("= ITEM_DEFINED_TRANSFORMATION(");
+  EXPECT_NE(transformation, std::string::npos);
+  const std::size_t start = text.rfind('\n', transformation) + 1;
+  const auto s = std::make_pair(start, text.find(';', start) + 1);
+  const std::string placement = reference(text, s, 1);
+  const std::string point = reference(text, statement(text, placement), 0);
+  const auto p = statement(text, point);
+  const std::string old = text.substr(p.first, p.second - p.first);
+  const std::size_t open = old.rfind('(') + 1;  // CARTESIAN_POINT(name,(x,y,z))
+  const std::size_t comma = old.find(',', open);
+  const double x = std::stod(old.substr(open, comma - open));
+  const std::string moved = old.substr(0, open) + std::to_string(x + 0.5) + old.substr(comma);
+  text.replace(p.first, p.second - p.first, moved);
+  return text;
+}
+
+// Every id plus 100000 (outside strings): another export of the same products.
+std::string renumbered(const std::string& text) {
+  std::string out;
+  bool quoted = false;
+  const std::size_t data = text.find("DATA;");
+  out.append(text, 0, data);
+  for (std::size_t i = data; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\'') quoted = !quoted;
+    if (!quoted && c == '#' && std::isdigit(static_cast<unsigned char>(text[i + 1]))) {
+      std::size_t end = i + 1;
+      while (std::isdigit(static_cast<unsigned char>(text[end]))) ++end;
+      out += '#' + std::to_string(std::stoll(text.substr(i + 1, end - i - 1)) + 100000);
+      i = end - 1;
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+// One vertex of one product moved by 1e-9 mm (within its tolerance): that product's geometry changed.
+std::string with_one_vertex_moved(std::string text) {
+  const std::size_t vertex = text.find("= VERTEX_POINT(");
+  EXPECT_NE(vertex, std::string::npos);
+  const std::size_t start = text.rfind('\n', vertex) + 1;
+  const std::string point = reference(text, std::make_pair(start, text.find(';', start) + 1), 0);
+  const auto p = statement(text, point);
+  const std::string old = text.substr(p.first, p.second - p.first);
+  const std::size_t open = old.rfind('(') + 1;  // CARTESIAN_POINT(name,(x,y,z))
+  const std::size_t comma = old.find(',', open);
+  const double x = std::stod(old.substr(open, comma - open));
+  char moved[64];
+  std::snprintf(moved, sizeof moved, "%.17g", x + 1e-9);
+  text.replace(p.first, p.second - p.first, old.substr(0, open) + moved + old.substr(comma));
+  return text;
+}
+
+// What reading the file afresh gives, compared with a read through the cache: the same scene,
+// diagnostics, completeness and answers of a certified check (which queries the exact faces).
+void expect_as_read_afresh(const std::string& path, const ImportResult& cached) {
+  ImportOptions plain;
+  plain.transfer_workers = 2;
+  const ImportResult fresh = import_file(path, plain);
+  EXPECT_EQ(messages(cached), messages(fresh));
+  EXPECT_EQ(cached.complete, fresh.complete);
+  EXPECT_TRUE(same_bytes(everything(cached), everything(fresh)));
+  EXPECT_EQ(check_text(cached), check_text(fresh));
+}
+
+TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
+  if (!fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp")) GTEST_SKIP() << "run scripts/setup.sh";
+  const std::string path = board("product_cache_board.step");
+  const std::string original = read_bytes(path);
+  ImportOptions options;
+  options.transfer_workers = 2;
+  options.cache_dir = (fs::path(testing::scratch_dir()) / "product-cache").string();
+  fs::remove_all(options.cache_dir);
+
+  const ImportResult cold = import_file(path, options);
+  ASSERT_EQ(cold.files.size(), 1u);
+  EXPECT_EQ(cold.files[0].cache, CacheUse::Miss);
+  const std::size_t pieces = cold.files[0].pieces, parts = cold.model.parts.size();
+  ASSERT_GT(pieces, 10u);
+  ASSERT_GT(parts, 5u);
+  EXPECT_EQ(cold.files[0].pieces_cached, 0u);
+  EXPECT_EQ(cold.files[0].parts_cached, 0u);
+  expect_as_read_afresh(path, cold);
+
+  struct Edit {
+    const char* what;
+    std::string text;
+    std::size_t pieces_read, parts_made;  // read from the file, made afresh
+    int workers;
+  };
+  const std::vector<Edit> edits{
+      {"a placement moved", with_placement_moved(original), 0, 0, 2},
+      {"a placement moved, one worker", with_placement_moved(with_placement_moved(original)), 0, 0, 1},
+      {"every id renumbered", renumbered(original), 0, 0, 2},
+      {"one product's vertex moved", with_one_vertex_moved(original), 1, 1, 2},
+  };
+  for (const Edit& e : edits) {
+    SCOPED_TRACE(e.what);
+    write_bytes(path, e.text);
+    options.transfer_workers = e.workers;
+    const ImportResult warm = import_file(path, options);
+    ASSERT_EQ(warm.files.size(), 1u);
+    EXPECT_EQ(warm.files[0].cache, CacheUse::Miss);  // the file changed: no whole entry
+    EXPECT_EQ(warm.files[0].pieces, pieces);
+    EXPECT_EQ(warm.files[0].pieces_cached, pieces - e.pieces_read);
+    EXPECT_EQ(warm.files[0].parts_cached, parts - e.parts_made);
+    EXPECT_EQ(warm.files[0].transfer_workers, std::max<std::size_t>(1, std::min<std::size_t>(e.pieces_read, e.workers)));
+    expect_as_read_afresh(path, warm);
+  }
+}
+
+// Every product entry damaged (a byte flipped, cut short, emptied): each is found before it is
+// used, named in a warning, made again from the file and rewritten; the next read trusts them again.
+TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
+  if (!fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp")) GTEST_SKIP() << "run scripts/setup.sh";
+  const std::string path = board("product_cache_damaged.step");
+  const std::string original = read_bytes(path);
+  ImportOptions options;
+  options.transfer_workers = 2;
+  options.cache_dir = (fs::path(testing::scratch_dir()) / "product-cache-damaged").string();
+  fs::remove_all(options.cache_dir);
+  const ImportResult cold = import_file(path, options);
+  const std::size_t entries = cold.files[0].pieces + cold.model.parts.size();
+  std::vector<std::string> files;
+  for (const auto& f : fs::directory_iterator(options.cache_dir)) files.push_back(f.path().string());
+  ASSERT_EQ(files.size(), entries + 1);  // and the whole file's
+  std::size_t k = 0;
+  for (const std::string& f : files) {
+    std::string bytes = read_bytes(f);
+    switch (k++ % 3) {
+      case 0: bytes[bytes.size() / 2] ^= 0x20; break;
+      case 1: bytes.resize(bytes.size() - 3); break;
+      default: bytes.clear();
+    }
+    write_bytes(f, bytes);
+  }
+  write_bytes(path, with_placement_moved(original));
+  const ImportResult rebuilt = import_file(path, options);
+  EXPECT_EQ(rebuilt.files[0].pieces_cached, 0u);
+  EXPECT_EQ(rebuilt.files[0].parts_cached, 0u);
+  std::size_t warnings = 0;
+  ImportResult without = rebuilt;
+  std::erase_if(without.diagnostics, [&](const Diagnostic& d) {
+    const bool damaged = d.severity == Severity::Warning && d.message.find("is damaged") != std::string::npos;
+    warnings += damaged ? 1 : 0;
+    return damaged;
+  });
+  EXPECT_EQ(warnings, entries);
+  expect_as_read_afresh(path, without);
+
+  write_bytes(path, with_placement_moved(with_placement_moved(original)));
+  const ImportResult again = import_file(path, options);
+  EXPECT_EQ(again.files[0].pieces_cached, again.files[0].pieces);
+  EXPECT_EQ(again.files[0].parts_cached, again.model.parts.size());
+  expect_as_read_afresh(path, again);
+}
+
+}  // namespace
+}  // namespace cadclash
