@@ -137,6 +137,11 @@ while IFS= read -r line || [ -n "$line" ]; do
         [ -f "$bench/import_time.svg" ] && cp "$bench/import_time.svg" "$docs/"
       else echo "_No run of scripts/import_peer_bench.sh in this tree (out/import_peer_bench/results.md)._"; fi
       ;;
+    @IMPORT_CACHE@)
+      # Measured by scripts/import_cache_bench.sh (~2 min), not here: its last table, as it is.
+      if [ -f "$root/out/import_cache_bench/results.md" ]; then relink "$root/out/import_cache_bench/results.md"
+      else echo "_No run of scripts/import_cache_bench.sh in this tree (out/import_cache_bench/results.md)._"; fi
+      ;;
     *) printf '%s\n' "$line" ;;
   esac
 done <"$docs/template.md" >"$page"

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The import cache on re-runs of a large real assembly (issue 38 item 5; docs/import.md, "A cache per
+# product"). For one board of out/corpus (scripts/make_corpus.sh; default board-40mb.step), copied
+# into out/import_cache_bench/ so that edits keep its path, `cadclash check --cache DIR --json`:
+#   cold        an empty cache;
+#   unchanged   the same file again (its whole entry);
+#   placement   one occurrence's placement moved 0.5 mm along x (the main text changed);
+#   model       one component model's vertex moved 1e-9 mm (one product's geometry changed);
+#   renumbered  every id + 1,000,000 (another export of the same products).
+# Per run: wall time, its share of the cold run, the import's stages, pieces and parts from the cache.
+#   bash scripts/import_cache_bench.sh [BUILD_DIR] [BOARD]
+# Writes out/import_cache_bench/results.md. Numbers are printed, never judged; this is not a test.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+board=${2:-$root/out/corpus/board-40mb.step}
+out=$root/out/import_cache_bench
+cadclash=$build/tools/cadclash
+[ -x "$cadclash" ] || { echo "import_cache_bench: $cadclash is missing (build the cadclash target)" >&2; exit 1; }
+[ -f "$board" ] || { echo "import_cache_bench: $board is missing (bash scripts/make_corpus.sh)" >&2; exit 1; }
+rm -rf "$out" && mkdir -p "$out"
+file=$out/board.step
+cache=$out/cache
+cp "$board" "$out/original.step"
+
+edit() {  # edit KIND: writes $file from the original
+  python3 - "$out/original.step" "$file" "$1" <<'PY'
+import re, sys
+src, dst, kind = sys.argv[1:]
+t = open(src).read()
+def point_of(ref_statement_pattern, nth):
+    m = re.search(ref_statement_pattern, t)
+    refs = re.findall(r'#(\d+)', t[m.start():t.index(';', m.start())])
+    return refs[nth]
+def move_point(pid, dx):
+    global t
+    m = re.search(r'\n#' + pid + r' = CARTESIAN_POINT\((\'[^\']*\'),\(([^)]*)\)\);', t)
+    c = m.group(2).split(',')
+    c[0] = repr(float(c[0]) + dx)
+    t = t[:m.start()] + '\n#' + pid + ' = CARTESIAN_POINT(' + m.group(1) + ',(' + ','.join(c) + '));' + t[m.end():]
+if kind == 'placement':
+    placement = point_of(r'#\d+ = ITEM_DEFINED_TRANSFORMATION\(', 2)
+    move_point(point_of(r'\n#' + placement + r' = AXIS2_PLACEMENT_3D\(', 1), 0.5)
+elif kind == 'model':
+    move_point(point_of(r'#\d+ = VERTEX_POINT\(', 1), 1e-9)
+elif kind == 'renumbered':
+    data = t.index('DATA;')
+    parts = re.split(r"('(?:[^']|'')*')", t[data:])
+    parts = [p if i % 2 else re.sub(r'#(\d+)', lambda m: '#' + str(int(m.group(1)) + 1000000), p) for i, p in enumerate(parts)]
+    t = t[:data] + ''.join(parts)
+open(dst, 'w').write(t)
+PY
+}
+
+run() {  # run NAME
+  local start end
+  start=$(date +%s.%N)
+  "$cadclash" check "$file" --cache "$cache" --json "$out/$1.json" >/dev/null 2>"$out/$1.err" || true
+  end=$(date +%s.%N)
+  echo "$1 $(echo "$end - $start" | bc)" >>"$out/walls.txt"
+}
+
+cp "$out/original.step" "$file"
+run cold
+run unchanged
+for kind in placement model renumbered; do
+  edit "$kind"
+  run "$kind"
+done
+
+python3 - "$out" "$(git -C "$root" rev-parse --short HEAD)" "$board" <<'PY'
+import json, sys
+out, commit, board = sys.argv[1:]
+walls = dict(line.split() for line in open(out + '/walls.txt'))
+cold = float(walls['cold'])
+rows = ['| run | wall s | of cold | import s (read / transfer / heal) | query s | pieces cached | parts cached |',
+        '|---|---:|---:|---|---:|---:|---:|']
+for name in ['cold', 'unchanged', 'placement', 'model', 'renumbered']:
+    j = json.load(open(f'{out}/{name}.json'))
+    f = j['import_timings']['files'][0]
+    q = j.get('timings', {}).get('total', 0.0)
+    pieces = f"{f.get('pieces_cached', 0)} / {f.get('pieces', 0)}" if f['cache'] != 'hit' else 'whole file'
+    rows.append(f"| {name} | {float(walls[name]):.2f} | {100 * float(walls[name]) / cold:.0f} % | {f['total']:.2f} ({f['read']:.2f} / "
+                f"{f['transfer']:.2f} / {f['heal']:.2f}) | {q:.2f} | {pieces} | {f.get('parts_cached', 0)} |")
+text = f"Import cache on re-runs of {board.split('/')[-1]} (cadclash {commit}, `check --cache`, default settings):\n\n" + '\n'.join(rows) + '\n'
+open(out + '/results.md', 'w').write(text)
+print(text)
+PY
