@@ -36,7 +36,7 @@ def move_point(pid, dx):
     global t
     m = re.search(r'\n#' + pid + r' = CARTESIAN_POINT\((\'[^\']*\'),\(([^)]*)\)\);', t)
     c = m.group(2).split(',')
-    c[0] = repr(float(c[0]) + dx)
+    c[0] = '%.16E' % (float(c[0]) + dx)  # a STEP real needs its '.'
     t = t[:m.start()] + '\n#' + pid + ' = CARTESIAN_POINT(' + m.group(1) + ',(' + ','.join(c) + '));' + t[m.end():]
 if kind == 'placement':
     placement = point_of(r'#\d+ = ITEM_DEFINED_TRANSFORMATION\(', 2)
