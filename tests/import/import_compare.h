@@ -9,11 +9,29 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <optional>
+#include <vector>
 #include <sstream>
 #include <string>
 
 namespace cadclash::testing_import {
+
+inline std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+inline std::vector<std::string> messages(const ImportResult& r) {
+  std::vector<std::string> out;
+  for (const Diagnostic& d : r.diagnostics) out.push_back(format_diagnostic(d));
+  return out;
+}
 
 // Every field of the result but the B-rep parts' exact faces, which stand in as their number: what the
 // faces answer is compared through the reports of checks that query them (OCCT's binary format of a

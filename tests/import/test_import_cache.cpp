@@ -21,30 +21,18 @@ namespace {
 namespace fs = std::filesystem;
 using testing_import::check_text;
 using testing_import::everything;
+using testing_import::messages;
+using testing_import::read_bytes;
+using testing_import::write_bytes;
 using testing_import::same_bytes;
 
 const std::string kExternal = std::string(CADCLASH_DATA_DIR) + "/external/";
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-}
 
 // A cache directory of its own for each test.
 std::string fresh_cache(const std::string& name) {
   const fs::path dir = fs::path(testing::scratch_dir()) / ("cache-" + name);
   fs::remove_all(dir);
   return dir.string();
-}
-
-std::vector<std::string> messages(const ImportResult& r) {
-  std::vector<std::string> out;
-  for (const Diagnostic& d : r.diagnostics) out.push_back(format_diagnostic(d));
-  return out;
 }
 
 class CacheRoundTrip : public ::testing::TestWithParam<bool> {};  // lazy or eager

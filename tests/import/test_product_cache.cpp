@@ -20,22 +20,10 @@ namespace {
 namespace fs = std::filesystem;
 using testing_import::check_text;
 using testing_import::everything;
+using testing_import::messages;
+using testing_import::read_bytes;
+using testing_import::write_bytes;
 using testing_import::same_bytes;
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-}
-
-std::vector<std::string> messages(const ImportResult& r) {
-  std::vector<std::string> out;
-  for (const Diagnostic& d : r.diagnostics) out.push_back(format_diagnostic(d));
-  return out;
-}
 
 // The truth tests' board written as a STEP assembly by OCCT's XCAF writer (7 products, 100 items).
 std::string board(const std::string& name) {
