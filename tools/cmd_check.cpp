@@ -537,7 +537,12 @@ int run_check(const CheckOptions& o, const Launch& launch) {
   std::optional<std::vector<TrajectoryRow>> rows = std::vector<TrajectoryRow>{};
   if (!o.path_csv.empty()) rows = read_trajectory(o.path_csv);
   if (!rows) return kExitInputError;
-  return check_imported(o, imported, *rows, *review, nullptr);
+  const int code = check_imported(o, imported, *rows, *review, nullptr);
+  // A lazy import through the cache: the faces this check meshed are kept for the next run.
+  std::vector<Diagnostic> stored;
+  store_triangles_in_cache(imported, stored);
+  print_diagnostics(stored);
+  return code;
 }
 
 // `cadclash check`, in one process or as one rank of an MPI job (every rank imports, rank 0 reports).

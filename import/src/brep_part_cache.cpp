@@ -56,7 +56,8 @@ struct OnePart {
   bool complete = true;
 };
 
-std::string save_part(const OnePart& p) {
+// The part as an entry holds it: a one-part import (its source shared).
+ImportResult one_part(const OnePart& p) {
   ImportResult r;
   r.diagnostics = p.diagnostics;
   r.complete = p.complete;
@@ -64,7 +65,7 @@ std::string save_part(const OnePart& p) {
   r.model.parts.back().first_surface = 0;
   r.model.surfaces = p.surfaces;
   for (Surface& s : r.model.surfaces) s.part = 0;
-  return save_import(r).value_or(std::string());
+  return r;
 }
 
 // The part stored for `in` (another export's entity ids replaced by `in`'s).
@@ -121,7 +122,7 @@ bool share_edges(std::span<const BrepPartInput> parts) {
 
 std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
                                           std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
-                                          std::size_t* from_cache) {
+                                          std::size_t* from_cache, CacheRecord* record) {
   if (from_cache) *from_cache = 0;
   if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() || share_edges(parts))
     return add_brep_parts(model, parts, options.tessellation, options.lazy, diagnostics, complete, timings);
@@ -173,7 +174,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
       for (const Diagnostic& d : p.diagnostics) p.complete = p.complete && d.severity != Severity::Error;
       if (!keys[missing[m]]) continue;
       std::string why;
-      const std::string bytes = save_part(p);
+      const std::string bytes = save_import(one_part(p)).value_or(std::string());
       if (bytes.empty() || !write_cache_entry(options.cache_dir, *keys[missing[m]], bytes, why))
         notes.push_back({Severity::Warning, parts[missing[m]].source_file, 0, -1,
                          std::string(kCacheNote) + "for part '" + parts[missing[m]].name + "' could not be written in " +
@@ -186,6 +187,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
   out.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
     OnePart& p = made[k];
+    if (record != nullptr && options.lazy && keys[k]) record->parts.push_back(record_entry(*keys[k], one_part(p)));
     const auto id = static_cast<PartId>(model.parts.size());
     p.part.first_surface = static_cast<SurfaceId>(model.surfaces.size());
     for (Surface& s : p.surfaces) {

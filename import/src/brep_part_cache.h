@@ -6,6 +6,7 @@
 
 #include "cadclash/import.h"
 #include "cadclash/tessellate.h"
+#include "import_cache.h"
 
 #include <span>
 #include <vector>
@@ -18,9 +19,10 @@ namespace cadclash::detail {
 // name, file, kind, face tags and tessellation settings; the others are made and stored. Without a
 // cache, with a tessellation time limit, or when two parts share an edge (one part's healing and
 // meshing then reach the other's), it is add_brep_parts. A damaged entry is made again, rewritten,
-// and named in a warning. `from_cache`, when given, gets how many parts came from entries.
+// and named in a warning. `from_cache`, when given, gets how many parts came from entries; `record`,
+// when given and the import is lazy, gets each part's entry (store_triangles_in_cache).
 std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
                                           std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
-                                          std::size_t* from_cache = nullptr);
+                                          std::size_t* from_cache = nullptr, CacheRecord* record = nullptr);
 
 }  // namespace cadclash::detail

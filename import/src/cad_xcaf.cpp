@@ -301,9 +301,14 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
     nonempty_inputs.push_back(std::move(inputs[p]));
   }
   std::size_t cached = 0;
-  const std::vector<PartId> ids =
-      add_brep_parts_cached(result.model, nonempty_inputs, options, result.diagnostics, result.complete, timings, &cached);
-  if (!result.files.empty()) result.files.back().parts_cached = cached;
+  auto record = std::make_shared<CacheRecord>();
+  record->dir = options.cache_dir;
+  const std::vector<PartId> ids = add_brep_parts_cached(result.model, nonempty_inputs, options, result.diagnostics,
+                                                        result.complete, timings, &cached, record.get());
+  if (!result.files.empty()) {
+    result.files.back().parts_cached = cached;
+    if (!record->parts.empty()) result.files.back().cache_record = std::move(record);
+  }
   std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
   for (Instance& instance : walker.instances) {

@@ -4,7 +4,9 @@
 
 #include "cadclash/internal/byte_io.h"
 
+#include <BRep_Tool.hxx>
 #include <Standard_Version.hxx>
+#include <TopLoc_Location.hxx>
 #include <openssl/evp.h>
 
 #include <array>
@@ -214,6 +216,24 @@ bool write_cache_entry(const std::string& dir, const std::string& key, const std
 
 bool is_cache_note(const Diagnostic& d) { return d.message.rfind(kCacheNote, 0) == 0; }
 
+std::size_t triangulated_faces(const Part& part) {
+  const auto* brep = dynamic_cast<const BrepSource*>(part.source.get());
+  if (brep == nullptr) return 0;
+  std::size_t n = 0;
+  for (std::uint32_t f = 0; f < brep->face_count(); ++f) {
+    TopLoc_Location where;
+    n += BRep_Tool::Triangulation(brep->face(f), where).IsNull() ? 0 : 1;
+  }
+  return n;
+}
+
+CacheRecord::Entry record_entry(std::string key, ImportResult stored) {
+  stored.files.clear();  // no record inside a record
+  CacheRecord::Entry e{std::move(key), std::move(stored), {}};
+  for (const Part& part : e.stored.model.parts) e.triangulated.push_back(triangulated_faces(part));
+  return e;
+}
+
 std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options) {
   const std::optional<std::string> bytes = file_bytes(path);
   if (!bytes) return std::nullopt;
@@ -236,6 +256,12 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     if (const auto payload = entry_payload(*stored, key, why); payload && load_import(*payload, hit, why)) {
       hit.files.assign(1, FileImport{path, CacheUse::Hit, {}});
       hit.files.back().timings.read = seconds_since(load_start);
+      if (options.lazy) {
+        auto record = std::make_shared<CacheRecord>();
+        record->dir = options.cache_dir;
+        record->file = record_entry(key, hit);
+        hit.files.back().cache_record = std::move(record);
+      }
       return hit;
     }
     damaged = cache_warning(path, std::string(kCacheNote) + entry.string() + " is damaged (" + why +
@@ -262,9 +288,52 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
   std::filesystem::create_directories(dir, ec);
   std::string why;
   if (ec) why = "cannot make the directory: " + ec.message();
-  if (ec || !write_entry(entry, entry_bytes(key, *payload), why))
+  if (ec || !write_entry(entry, entry_bytes(key, *payload), why)) {
     result.diagnostics.push_back(cache_warning(path, "could not store the file in the cache " + dir.string() + " (" + why + ")"));
+  } else if (options.lazy) {
+    std::shared_ptr<CacheRecord>& record = result.files.front().cache_record;
+    if (!record) record = std::make_shared<CacheRecord>();
+    record->dir = options.cache_dir;
+    ImportResult stored;
+    stored.model = result.model;
+    stored.complete = result.complete;
+    for (const Diagnostic& d : result.diagnostics)  // as the entry holds them: without this run's notes
+      if (!is_cache_note(d)) stored.diagnostics.push_back(d);
+    record->file = record_entry(key, std::move(stored));
+  }
   return result;
 }
 
 }  // namespace cadclash::detail
+
+namespace cadclash {
+
+std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<Diagnostic>& diagnostics) {
+  std::size_t written = 0;
+  for (const FileImport& f : imported.files) {
+    if (!f.cache_record) continue;
+    detail::CacheRecord& record = *f.cache_record;
+    auto store = [&](detail::CacheRecord::Entry& e) {
+      bool gained = false;
+      std::vector<std::size_t> now;
+      for (const Part& part : e.stored.model.parts) now.push_back(detail::triangulated_faces(part));
+      for (std::size_t p = 0; p < now.size(); ++p) gained = gained || now[p] > e.triangulated[p];
+      if (!gained) return;
+      std::string why = "a part cannot be stored";
+      const std::optional<std::string> payload = detail::save_import(e.stored);
+      if (payload && detail::write_cache_entry(record.dir, e.key, *payload, why)) {
+        e.triangulated = std::move(now);
+        ++written;
+        return;
+      }
+      diagnostics.push_back({Severity::Warning, f.path, 0, -1,
+                             std::string(detail::kCacheNote) + "for the triangles of '" + f.path +
+                                 "' could not be written in " + record.dir + " (" + why + ")"});
+    };
+    if (record.file) store(*record.file);
+    for (detail::CacheRecord::Entry& e : record.parts) store(e);
+  }
+  return written;
+}
+
+}  // namespace cadclash

@@ -50,4 +50,23 @@ bool write_cache_entry(const std::string& dir, const std::string& key, const std
 inline constexpr std::string_view kCacheNote = "the cache entry ";
 bool is_cache_note(const Diagnostic& d);
 
+// A lazy import through the cache, for store_triangles_in_cache: the entries its parts came from
+// or went to, each with what it holds (the parts' sources shared with the model read, so that the
+// triangles a check gives them are seen) and how many faces of each part held triangles when it
+// was last written.
+struct CacheRecord {
+  struct Entry {
+    std::string key;
+    ImportResult stored;
+    std::vector<std::size_t> triangulated;
+  };
+  std::string dir;
+  std::optional<Entry> file;  // the whole file's entry
+  std::vector<Entry> parts;   // each B-rep part's entry (brep_part_cache.h)
+};
+// Faces of the part's B-rep source that hold a triangulation; 0 for other parts.
+std::size_t triangulated_faces(const Part& part);
+// An entry of a record for `stored` (its parts' current triangulations counted).
+CacheRecord::Entry record_entry(std::string key, ImportResult stored);
+
 }  // namespace cadclash::detail

@@ -55,6 +55,7 @@
 #include "cadclash/tessellate.h"
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -129,6 +130,10 @@ enum class CacheUse : std::uint8_t { Off, Hit, Miss, Rebuilt };
 // Returns "off", "hit", "miss" or "rebuilt".
 const char* cache_use_name(CacheUse c);
 
+namespace detail {
+struct CacheRecord;  // what store_triangles_in_cache needs of a file read through the cache (import_cache.h)
+}
+
 struct FileImport {
   std::string path;  // as given
   CacheUse cache = CacheUse::Off;
@@ -141,6 +146,8 @@ struct FileImport {
   std::size_t pieces = 0, pieces_cached = 0;
   // CAD parts that came checked and healed from the cache (with a cache only).
   std::size_t parts_cached = 0;
+  // A lazy import through a cache: the entries its B-rep parts came from or went to.
+  std::shared_ptr<detail::CacheRecord> cache_record = nullptr;
 };
 
 struct ImportResult {
@@ -166,6 +173,16 @@ ImportResult import_files(std::span<const std::string> paths, const ImportOption
 // scene import_files gives (seconds: the results' largest). Precondition: each.size() == paths.size().
 std::vector<ImportResult> import_each_file(std::span<const std::string> paths, const ImportOptions& options = {});
 ImportResult merge_file_imports(std::span<const std::string> paths, std::vector<ImportResult> each);
+
+// A lazy import through a cache (ImportOptions::cache_dir, lazy), after a check meshed some of its
+// B-rep faces: writes those faces' triangles into the cache entries the parts came from (the file's
+// and each part's), so that a later run reads them instead of meshing again. The entries keep the
+// import as it was (the surfaces without triangles, as a lazy import gives them): only the exact
+// faces carry their triangulations, which BrepSource::triangulate reads when it is asked for them.
+// Does nothing for files without such an entry (no cache, eager, a time limit) or parts whose faces
+// gained no triangles. Returns how many entries it rewrote; a warning in `diagnostics` for each
+// entry it could not write. Precondition: no other thread meshes the model's parts meanwhile.
+std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<Diagnostic>& diagnostics);
 
 // One file's ImportResult (import_file's) for a process that plans a check with it but reads the
 // file only if it needs the exact faces: the bytes of an import cache entry with each B-rep part's
