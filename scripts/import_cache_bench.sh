@@ -8,12 +8,15 @@
 #   model       one component model's vertex moved 1e-9 mm (one product's geometry changed);
 #   renumbered  every id + 1,000,000 (another export of the same products).
 # Per run: wall time, its share of the cold run, the import's stages, pieces and parts from the cache.
-#   bash scripts/import_cache_bench.sh [BUILD_DIR] [BOARD]
-# Writes out/import_cache_bench/results.md. Numbers are printed, never judged; this is not a test.
+#   bash scripts/import_cache_bench.sh [BUILD_DIR] [BOARD] [ROUNDS]
+# ROUNDS (default 3) times the whole sequence from an empty cache; per run the median wall time and
+# the stages of the median round. Writes out/import_cache_bench/results.md. Numbers are printed,
+# never judged; this is not a test.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
 board=${2:-$root/out/corpus/board-40mb.step}
+rounds=${3:-3}
 out=$root/out/import_cache_bench
 cadclash=$build/tools/cadclash
 [ -x "$cadclash" ] || { echo "import_cache_bench: $cadclash is missing (build the cadclash target)" >&2; exit 1; }
@@ -52,37 +55,46 @@ open(dst, 'w').write(t)
 PY
 }
 
-run() {  # run NAME
+run() {  # run NAME ROUND
   local start end
   start=$(date +%s.%N)
-  "$cadclash" check "$file" --cache "$cache" --json "$out/$1.json" >/dev/null 2>"$out/$1.err" || true
+  "$cadclash" check "$file" --cache "$cache" --json "$out/$1.$2.json" >/dev/null 2>"$out/$1.$2.err" || true
   end=$(date +%s.%N)
-  echo "$1 $(echo "$end - $start" | bc)" >>"$out/walls.txt"
+  echo "$1 $2 $(echo "$end - $start" | bc)" >>"$out/walls.txt"
 }
 
-cp "$out/original.step" "$file"
-run cold
-run unchanged
-for kind in placement model renumbered; do
-  edit "$kind"
-  run "$kind"
+for round in $(seq 1 "$rounds"); do
+  rm -rf "$cache"
+  cp "$out/original.step" "$file"
+  run cold "$round"
+  run unchanged "$round"
+  for kind in placement model renumbered; do
+    edit "$kind"
+    run "$kind" "$round"
+  done
 done
 
 python3 - "$out" "$(git -C "$root" rev-parse --short HEAD)" "$board" <<'PY'
 import json, sys
 out, commit, board = sys.argv[1:]
-walls = dict(line.split() for line in open(out + '/walls.txt'))
-cold = float(walls['cold'])
+runs = {}
+for line in open(out + '/walls.txt'):
+    name, round_, wall = line.split()
+    runs.setdefault(name, []).append((float(wall), round_))
+median = {name: sorted(v)[len(v) // 2] for name, v in runs.items()}  # (wall, round)
+cold = median['cold'][0]
 rows = ['| run | wall s | of cold | import s (read / transfer / heal) | query s | pieces cached | parts cached |',
         '|---|---:|---:|---|---:|---:|---:|']
 for name in ['cold', 'unchanged', 'placement', 'model', 'renumbered']:
-    j = json.load(open(f'{out}/{name}.json'))
+    wall, round_ = median[name]
+    j = json.load(open(f'{out}/{name}.{round_}.json'))
     f = j['import_timings']['files'][0]
     q = j.get('timings', {}).get('total', 0.0)
     pieces = f"{f.get('pieces_cached', 0)} / {f.get('pieces', 0)}" if f['cache'] != 'hit' else 'whole file'
-    rows.append(f"| {name} | {float(walls[name]):.2f} | {100 * float(walls[name]) / cold:.0f} % | {f['total']:.2f} ({f['read']:.2f} / "
+    rows.append(f"| {name} | {wall:.2f} | {100 * wall / cold:.0f} % | {f['total']:.2f} ({f['read']:.2f} / "
                 f"{f['transfer']:.2f} / {f['heal']:.2f}) | {q:.2f} | {pieces} | {f.get('parts_cached', 0)} |")
-text = f"Import cache on re-runs of {board.split('/')[-1]} (cadclash {commit}, `check --cache`, default settings):\n\n" + '\n'.join(rows) + '\n'
+text = (f"Import cache on re-runs of {board.split('/')[-1]} (cadclash {commit}, `check --cache`, default settings; "
+        f"median of {len(runs['cold'])} rounds, each from an empty cache):\n\n") + '\n'.join(rows) + '\n'
 open(out + '/results.md', 'w').write(text)
 print(text)
 PY

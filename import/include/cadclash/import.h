@@ -141,8 +141,8 @@ struct FileImport {
   // STEP: processes that transferred the file's shapes (ImportOptions::transfer_workers); 1 = the
   // reader alone, and for other formats and cache hits.
   std::size_t transfer_workers = 1;
-  // STEP read with a cache (ImportOptions::cache_dir): the products' shapes cut into this many
-  // pieces (0: the file was not cut), of which this many came from the cache, not from the file.
+  // STEP: the pieces its products' shapes were cut into (0: the file was not cut; step_split_text),
+  // of which this many came from the cache (ImportOptions::cache_dir), not from the file.
   std::size_t pieces = 0, pieces_cached = 0;
   // CAD parts that came checked and healed from the cache (with a cache only).
   std::size_t parts_cached = 0;

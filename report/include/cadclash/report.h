@@ -292,8 +292,8 @@ struct ReportFileImport {
   std::string cache = "off";  // "off", "hit", "miss" or "rebuilt"
   double read = 0.0, transfer = 0.0, heal = 0.0, tessellate = 0.0, total = 0.0;
   std::uint64_t processes = 1;  // STEP: processes that read and transferred the file at once
-  // With a cache: the STEP file's pieces (products' shapes) and how many came from the cache; CAD
-  // parts that came checked and healed from it (FileImport).
+  // STEP: the pieces its products' shapes were cut into and how many came from the cache; CAD parts
+  // that came checked and healed from the cache (FileImport).
   std::uint64_t pieces = 0, pieces_cached = 0, parts_cached = 0;
 };
 struct ReportImport {
