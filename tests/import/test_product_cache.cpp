@@ -119,14 +119,27 @@ void expect_as_read_afresh(const std::string& path, const ImportResult& cached) 
   EXPECT_EQ(check_text(cached), check_text(fresh));
 }
 
-TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
-  if (!fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp")) GTEST_SKIP() << "run scripts/setup.sh";
-  const std::string path = board("product_cache_board.step");
-  const std::string original = read_bytes(path);
+// A test's board, its text, and import options with a cache of its own (empty) read on two workers.
+struct CachedBoard {
+  std::string path, original;
   ImportOptions options;
-  options.transfer_workers = 2;
-  options.cache_dir = (fs::path(testing::scratch_dir()) / "product-cache").string();
-  fs::remove_all(options.cache_dir);
+};
+CachedBoard cached_board(const std::string& name, bool lazy) {
+  CachedBoard b;
+  b.path = board(name + ".step");
+  b.original = read_bytes(b.path);
+  b.options.lazy = lazy;
+  b.options.transfer_workers = 2;
+  b.options.cache_dir = (fs::path(testing::scratch_dir()) / (name + "-cache")).string();
+  fs::remove_all(b.options.cache_dir);
+  return b;
+}
+
+bool have_data() { return fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp"); }
+
+TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  auto [path, original, options] = cached_board("product_cache_board", false);
 
   const ImportResult cold = import_file(path, options);
   ASSERT_EQ(cold.files.size(), 1u);
@@ -168,13 +181,8 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
 // Every product entry damaged (a byte flipped, cut short, emptied): each is found before it is
 // used, named in a warning, made again from the file and rewritten; the next read trusts them again.
 TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
-  if (!fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp")) GTEST_SKIP() << "run scripts/setup.sh";
-  const std::string path = board("product_cache_damaged.step");
-  const std::string original = read_bytes(path);
-  ImportOptions options;
-  options.transfer_workers = 2;
-  options.cache_dir = (fs::path(testing::scratch_dir()) / "product-cache-damaged").string();
-  fs::remove_all(options.cache_dir);
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  const auto [path, original, options] = cached_board("product_cache_damaged", false);
   const ImportResult cold = import_file(path, options);
   const std::size_t entries = cold.files[0].pieces + cold.model.parts.size();
   std::vector<std::string> files;
@@ -216,14 +224,8 @@ TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
 // left to store after its check), with the same report; and a run whose check reaches other faces
 // (a placement moved) still gives what reading afresh gives.
 TEST(ProductCache, TrianglesAChecksMadeAreKeptForTheNextRun) {
-  if (!fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp")) GTEST_SKIP() << "run scripts/setup.sh";
-  const std::string path = board("product_cache_triangles.step");
-  const std::string original = read_bytes(path);
-  ImportOptions options;
-  options.lazy = true;
-  options.transfer_workers = 2;
-  options.cache_dir = (fs::path(testing::scratch_dir()) / "product-cache-triangles").string();
-  fs::remove_all(options.cache_dir);
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  const auto [path, original, options] = cached_board("product_cache_triangles", true);
   ImportOptions plain = options;
   plain.cache_dir.clear();
 
