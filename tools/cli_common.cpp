@@ -40,7 +40,8 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
       ->check(CLI::NonNegativeNumber);
   cmd.add_option("--cache", in.cache,
                  "Directory of a persistent cache of imported files: a file read again with the same bytes and "
-                 "settings comes back from it, the same as when it was read (made when missing)");
+                 "settings comes back from it, the same as when it was read; a changed STEP file reads again only "
+                 "the products that changed (made when missing)");
   cmd.add_option("--parallel-files", in.parallel_files, "Files read at once (default: one per core)")
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("-q,--quiet", in.quiet,
