@@ -10,14 +10,14 @@
 # Per run: wall time, its share of the cold run, the import's stages, pieces and parts from the cache.
 #   bash scripts/import_cache_bench.sh [BUILD_DIR] [BOARD] [ROUNDS]
 # ROUNDS (default 3) times the whole sequence from an empty cache; per run the median wall time and
-# the stages of the median round. Writes out/import_cache_bench/results.md. Numbers are printed,
-# never judged; this is not a test.
+# the stages of the median round. Writes out/import_cache_bench/results.md (IMPORT_CACHE_BENCH_OUT
+# names another folder). Numbers are printed, never judged; this is not a test.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
 board=${2:-$root/out/corpus/board-40mb.step}
 rounds=${3:-3}
-out=$root/out/import_cache_bench
+out=${IMPORT_CACHE_BENCH_OUT:-$root/out/import_cache_bench}
 cadclash=$build/tools/cadclash
 [ -x "$cadclash" ] || { echo "import_cache_bench: $cadclash is missing (build the cadclash target)" >&2; exit 1; }
 [ -f "$board" ] || { echo "import_cache_bench: $board is missing (bash scripts/make_corpus.sh)" >&2; exit 1; }
