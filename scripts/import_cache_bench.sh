@@ -4,7 +4,7 @@
 # into out/import_cache_bench/ so that edits keep its path, `cadclash check --cache DIR --json`:
 #   cold        an empty cache;
 #   unchanged   the same file again (its whole entry);
-#   placement   one occurrence's placement moved 0.5 mm along x (the main text changed);
+#   placement   the last occurrence's placement lifted 0.5 mm along z (the main text changed);
 #   model       one component model's vertex moved 1e-9 mm (one product's geometry changed);
 #   renumbered  every id + 1,000,000 (another export of the same products).
 # Per run: wall time, its share of the cold run, the import's stages, pieces and parts from the cache.
@@ -31,21 +31,22 @@ edit() {  # edit KIND: writes $file from the original
 import re, sys
 src, dst, kind = sys.argv[1:]
 t = open(src).read()
-def point_of(ref_statement_pattern, nth):
-    m = re.search(ref_statement_pattern, t)
+def point_of(ref_statement_pattern, nth, last=False):
+    ms = list(re.finditer(ref_statement_pattern, t))
+    m = ms[-1] if last else ms[0]
     refs = re.findall(r'#(\d+)', t[m.start():t.index(';', m.start())])
     return refs[nth]
-def move_point(pid, dx):
+def move_point(pid, axis, d):
     global t
     m = re.search(r'\n#' + pid + r' = CARTESIAN_POINT\((\'[^\']*\'),\(([^)]*)\)\);', t)
     c = m.group(2).split(',')
-    c[0] = '%.16E' % (float(c[0]) + dx)  # a STEP real needs its '.'
+    c[axis] = '%.16E' % (float(c[axis]) + d)  # a STEP real needs its '.'
     t = t[:m.start()] + '\n#' + pid + ' = CARTESIAN_POINT(' + m.group(1) + ',(' + ','.join(c) + '));' + t[m.end():]
-if kind == 'placement':
-    placement = point_of(r'#\d+ = ITEM_DEFINED_TRANSFORMATION\(', 2)
-    move_point(point_of(r'\n#' + placement + r' = AXIS2_PLACEMENT_3D\(', 1), 0.5)
+if kind == 'placement':  # the last occurrence lifted 0.5 mm (away from the board: no new contact)
+    placement = point_of(r'#\d+ = ITEM_DEFINED_TRANSFORMATION\(', 2, last=True)
+    move_point(point_of(r'\n#' + placement + r' = AXIS2_PLACEMENT_3D\(', 1), 2, 0.5)
 elif kind == 'model':
-    move_point(point_of(r'#\d+ = VERTEX_POINT\(', 1), 1e-9)
+    move_point(point_of(r'#\d+ = VERTEX_POINT\(', 1), 0, 1e-9)
 elif kind == 'renumbered':
     data = t.index('DATA;')
     parts = re.split(r"('(?:[^']|'')*')", t[data:])

@@ -141,6 +141,8 @@ while IFS= read -r line || [ -n "$line" ]; do
       # Measured by scripts/import_cache_bench.sh (~2 min), not here: its last table, as it is.
       if [ -f "$root/out/import_cache_bench/results.md" ]; then relink "$root/out/import_cache_bench/results.md"
       else echo "_No run of scripts/import_cache_bench.sh in this tree (out/import_cache_bench/results.md)._"; fi
+      # The 174 MB board, when it was measured too (IMPORT_CACHE_BENCH_OUT=out/import_cache_bench_174).
+      if [ -f "$root/out/import_cache_bench_174/results.md" ]; then echo; relink "$root/out/import_cache_bench_174/results.md"; fi
       ;;
     *) printf '%s\n' "$line" ;;
   esac

@@ -163,6 +163,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
     const std::vector<PartId> ids = add_brep_parts(fresh, to_make, options.tessellation, options.lazy, said,
                                                    fresh_complete, timings, &counts);
     std::size_t next = 0;
+    bool unwritable = false;
     for (std::size_t m = 0; m < missing.size(); ++m) {
       OnePart& p = made[missing[m]];
       p.part = fresh.parts[ids[m]];
@@ -172,10 +173,11 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
                            said.begin() + static_cast<std::ptrdiff_t>(next + counts[m]));
       next += counts[m];
       for (const Diagnostic& d : p.diagnostics) p.complete = p.complete && d.severity != Severity::Error;
-      if (!keys[missing[m]]) continue;
+      if (!keys[missing[m]] || unwritable) continue;
       std::string why;
       const std::string bytes = save_import(one_part(p)).value_or(std::string());
-      if (bytes.empty() || !write_cache_entry(options.cache_dir, *keys[missing[m]], bytes, why))
+      unwritable = bytes.empty() || !write_cache_entry(options.cache_dir, *keys[missing[m]], bytes, why);
+      if (unwritable)  // one warning, not one per part
         notes.push_back({Severity::Warning, parts[missing[m]].source_file, 0, -1,
                          std::string(kCacheNote) + "for part '" + parts[missing[m]].name + "' could not be written in " +
                              options.cache_dir + " (" + (bytes.empty() ? "it cannot be stored" : why) + ")"});

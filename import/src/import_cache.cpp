@@ -313,7 +313,9 @@ std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<D
   for (const FileImport& f : imported.files) {
     if (!f.cache_record) continue;
     detail::CacheRecord& record = *f.cache_record;
+    bool unwritable = false;  // one warning per file, not one per entry
     auto store = [&](detail::CacheRecord::Entry& e) {
+      if (unwritable) return;
       bool gained = false;
       std::vector<std::size_t> now;
       for (const Part& part : e.stored.model.parts) now.push_back(detail::triangulated_faces(part));
@@ -326,6 +328,7 @@ std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<D
         ++written;
         return;
       }
+      unwritable = true;
       diagnostics.push_back({Severity::Warning, f.path, 0, -1,
                              std::string(detail::kCacheNote) + "for the triangles of '" + f.path +
                                  "' could not be written in " + record.dir + " (" + why + ")"});

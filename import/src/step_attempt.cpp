@@ -27,6 +27,7 @@
 #include <TransferBRep.hxx>
 #include <Transfer_TransientProcess.hxx>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <optional>
@@ -162,9 +163,14 @@ bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const
   for (std::size_t p = 0; p < read.bytes.size(); ++p) {
     if (!read.bytes[p] || !read_binding_bytes(*read.bytes[p], bound, why)) return false;
   }
-  if (!read.cache_dir.empty())
-    for (const auto& share : read.shares)
-      for (const std::size_t p : share) store_cached_piece(read.cache_dir, read.split.pieces[p], *read.bytes[p], path, notes);
+  // Stored in piece order until one cannot be (one warning says so, not one per piece).
+  if (!read.cache_dir.empty()) {
+    std::vector<std::size_t> made;
+    for (const auto& share : read.shares) made.insert(made.end(), share.begin(), share.end());
+    std::sort(made.begin(), made.end());
+    for (const std::size_t p : made)
+      if (!store_cached_piece(read.cache_dir, read.split.pieces[p], *read.bytes[p], path, notes)) break;
+  }
   std::unordered_map<std::int64_t, Handle(Standard_Transient)> by_id;
   for (const auto& [id, shape] : bound.shapes) by_id.emplace(id, Handle(Standard_Transient)());
   for (Standard_Integer e = 1; e <= model->NbEntities(); ++e)

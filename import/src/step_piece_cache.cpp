@@ -39,7 +39,7 @@ std::optional<std::string> load_cached_piece(const std::string& dir, const StepP
   return std::nullopt;
 }
 
-void store_cached_piece(const std::string& dir, const StepPiece& piece, std::string_view bytes, const std::string& path,
+bool store_cached_piece(const std::string& dir, const StepPiece& piece, std::string_view bytes, const std::string& path,
                         std::vector<Diagnostic>& notes) {
   std::unordered_map<std::int64_t, std::int64_t> canonical;
   canonical.reserve(piece.ids.size());
@@ -50,8 +50,9 @@ void store_cached_piece(const std::string& dir, const StepPiece& piece, std::str
     return it->second;
   });
   std::string why = "a worker's shapes name entities the piece does not hold";
-  if (stored && write_cache_entry(dir, piece_key(piece), *stored, why)) return;
+  if (stored && write_cache_entry(dir, piece_key(piece), *stored, why)) return true;
   notes.push_back(note(path, "for a product's shapes could not be written in " + dir + " (" + why + ")"));
+  return false;
 }
 
 }  // namespace cadclash::detail

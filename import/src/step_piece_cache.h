@@ -21,9 +21,9 @@ namespace cadclash::detail {
 std::optional<std::string> load_cached_piece(const std::string& dir, const StepPiece& piece, const std::string& path,
                                              std::vector<Diagnostic>& notes);
 
-// Stores a worker's bytes for the piece (its ids made canonical); a warning in `notes` when they
-// cannot be stored. Precondition: the piece was split with `canonical`.
-void store_cached_piece(const std::string& dir, const StepPiece& piece, std::string_view bytes, const std::string& path,
+// Stores a worker's bytes for the piece (its ids made canonical); false, and a warning in `notes`,
+// when they cannot be stored. Precondition: the piece was split with `canonical`.
+bool store_cached_piece(const std::string& dir, const StepPiece& piece, std::string_view bytes, const std::string& path,
                         std::vector<Diagnostic>& notes);
 
 }  // namespace cadclash::detail

@@ -197,6 +197,22 @@ TEST(ImportCache, UnwritableCacheIsAWarning) {
   ASSERT_FALSE(r.diagnostics.empty());
   EXPECT_EQ(r.diagnostics.back().severity, Severity::Warning);
   EXPECT_NE(r.diagnostics.back().message.find("could not store the file in the cache"), std::string::npos);
+
+  // A STEP file cut into pieces, with parts: one warning for the pieces, one for the parts, one for
+  // the file (not one per piece or part), and the file as read without a cache.
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/cad/valid_two_solids.step";
+  options.transfer_workers = 2;
+  const ImportResult cut = import_file(step, options);
+  ImportOptions plain = options;
+  plain.cache_dir.clear();
+  const ImportResult fresh = import_file(step, plain);
+  ASSERT_GT(cut.files[0].pieces, 1u);
+  std::vector<std::string> warnings = messages(cut);
+  std::erase_if(warnings, [](const std::string& m) { return m.find("could not") == std::string::npos; });
+  EXPECT_EQ(warnings.size(), 3u) << ::testing::PrintToString(warnings);
+  ImportResult without = cut;
+  std::erase_if(without.diagnostics, [](const Diagnostic& d) { return d.message.find("could not") != std::string::npos; });
+  EXPECT_TRUE(same_bytes(everything(without), everything(fresh)));
 }
 
 }  // namespace
