@@ -484,10 +484,17 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       renumbered(text, st[k], number, c);
       c += '\n';
     }
-    for (const Synthetic& r : synthetic_reps[w]) {
-      c += "#" + std::to_string(number.at(r.id)) + "=SHAPE_REPRESENTATION('',(";
-      for (std::size_t k = 0; k < r.items.size(); ++k) c += (k ? ",#" : "#") + std::to_string(number.at(r.items[k]));
-      c += "),#" + std::to_string(number.at(r.context)) + ");\n";
+    for (const Synthetic& r : synthetic_reps[w]) {  // appended piece by piece: GCC 12 warns falsely on "#" + string
+      c += '#';
+      c += std::to_string(number.at(r.id));
+      c += "=SHAPE_REPRESENTATION('',(";
+      for (std::size_t k = 0; k < r.items.size(); ++k) {
+        c += k ? ",#" : "#";
+        c += std::to_string(number.at(r.items[k]));
+      }
+      c += "),#";
+      c += std::to_string(number.at(r.context));
+      c += ");\n";
     }
   }
   return out;
