@@ -42,6 +42,10 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
                  "Directory of a persistent cache of imported files: a file read again with the same bytes and "
                  "settings comes back from it, the same as when it was read; a changed STEP file reads again only "
                  "the products that changed (made when missing)");
+  cmd.add_option("--cache-max-mb", in.cache_max_mb,
+                 "With --cache: keep the cache under this many MiB, removing the least recently used entries "
+                 "(default 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option("--parallel-files", in.parallel_files, "Files read at once (default: one per core)")
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("-q,--quiet", in.quiet,
@@ -97,6 +101,7 @@ ImportOptions import_options(const InputOptions& in) {
   options.model_tolerance = in.model_tolerance;
   options.tessellation.time_limit_seconds = in.import_time_limit;
   options.cache_dir = in.cache;
+  options.cache_max_bytes = static_cast<std::uint64_t>(in.cache_max_mb * 1024.0 * 1024.0);
   options.parallel_files = in.parallel_files;
   return options;
 }

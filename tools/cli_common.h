@@ -27,6 +27,7 @@ struct InputOptions {
   double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   std::string cache;               // directory of the import cache (ImportOptions::cache_dir); empty = none
+  double cache_max_mb = 0.0;       // ImportOptions::cache_max_bytes in MiB; 0 = no limit
   int parallel_files = 0;          // files read at once; 0 = one per core
   bool quiet = false;              // no progress line and no summary lines on stderr (progress_line.h)
   // Mesh post-processing (mesh parts only; see tessellate.h).

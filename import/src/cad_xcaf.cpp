@@ -303,6 +303,7 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
   std::size_t cached = 0;
   auto record = std::make_shared<CacheRecord>();
   record->dir = options.cache_dir;
+  record->max_bytes = options.cache_max_bytes;
   const std::vector<PartId> ids = add_brep_parts_cached(result.model, nonempty_inputs, options, result.diagnostics,
                                                         result.complete, timings, &cached, record.get());
   if (!result.files.empty()) {

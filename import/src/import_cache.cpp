@@ -9,6 +9,7 @@
 #include <TopLoc_Location.hxx>
 #include <openssl/evp.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -168,6 +169,12 @@ bool write_entry(const std::filesystem::path& target, const std::string& bytes, 
   return true;
 }
 
+// An entry's use, for prune_cache: its modification time set to now (errors ignored).
+void mark_used(const std::string& file) {
+  std::error_code ignored;
+  std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now(), ignored);
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -200,8 +207,40 @@ CacheRead read_cache_entry(const std::string& dir, const std::string& key) {
   out.file = entry.string();
   const std::optional<std::string> stored = file_bytes(out.file);
   if (!stored) return out;
-  if (const auto payload = entry_payload(*stored, key, out.damaged)) out.payload.emplace(*payload);
+  if (const auto payload = entry_payload(*stored, key, out.damaged)) {
+    out.payload.emplace(*payload);
+    mark_used(out.file);
+  }
   return out;
+}
+
+void prune_cache(const std::string& dir, std::uint64_t max_bytes) {
+  if (max_bytes == 0 || dir.empty()) return;
+  struct Held {
+    std::filesystem::file_time_type used;
+    std::string name;
+    std::uintmax_t size;
+  };
+  std::vector<Held> held;
+  std::uintmax_t total = 0;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::filesystem::path& p = it->path();
+    if (p.extension() != ".entry") continue;
+    std::error_code e;
+    const std::uintmax_t size = std::filesystem::file_size(p, e);
+    const auto used = std::filesystem::last_write_time(p, e);
+    if (e) continue;
+    held.push_back({used, p.string(), size});
+    total += size;
+  }
+  std::sort(held.begin(), held.end(), [](const Held& a, const Held& b) { return a.used != b.used ? a.used < b.used : a.name < b.name; });
+  for (const Held& h : held) {
+    if (total <= max_bytes) break;
+    std::error_code e;
+    std::filesystem::remove(h.name, e);
+    total -= h.size;
+  }
 }
 
 bool write_cache_entry(const std::string& dir, const std::string& key, const std::string& payload, std::string& why) {
@@ -256,9 +295,12 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     if (const auto payload = entry_payload(*stored, key, why); payload && load_import(*payload, hit, why)) {
       hit.files.assign(1, FileImport{path, CacheUse::Hit, {}});
       hit.files.back().timings.read = seconds_since(load_start);
+      mark_used(entry.string());
+      prune_cache(options.cache_dir, options.cache_max_bytes);
       if (options.lazy) {
         auto record = std::make_shared<CacheRecord>();
         record->dir = options.cache_dir;
+        record->max_bytes = options.cache_max_bytes;
         record->file = record_entry(key, hit);
         hit.files.back().cache_record = std::move(record);
       }
@@ -294,6 +336,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     std::shared_ptr<CacheRecord>& record = result.files.front().cache_record;
     if (!record) record = std::make_shared<CacheRecord>();
     record->dir = options.cache_dir;
+    record->max_bytes = options.cache_max_bytes;
     ImportResult stored;
     stored.model = result.model;
     stored.complete = result.complete;
@@ -301,6 +344,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
       if (!is_cache_note(d)) stored.diagnostics.push_back(d);
     record->file = record_entry(key, std::move(stored));
   }
+  prune_cache(options.cache_dir, options.cache_max_bytes);
   return result;
 }
 
@@ -335,6 +379,7 @@ std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<D
     };
     if (record.file) store(*record.file);
     for (detail::CacheRecord::Entry& e : record.parts) store(e);
+    detail::prune_cache(record.dir, record.max_bytes);
   }
   return written;
 }

@@ -61,9 +61,15 @@ struct CacheRecord {
     std::vector<std::size_t> triangulated;
   };
   std::string dir;
+  std::uint64_t max_bytes = 0;  // ImportOptions::cache_max_bytes
   std::optional<Entry> file;  // the whole file's entry
   std::vector<Entry> parts;   // each B-rep part's entry (brep_part_cache.h)
 };
+// Removes the least recently used entries of `dir` (oldest modification time first, then by name)
+// until its entries take at most `max_bytes`; nothing when max_bytes is 0. Errors are ignored: an
+// entry another run removes first, or one it is reading, costs nothing (POSIX keeps an open file).
+void prune_cache(const std::string& dir, std::uint64_t max_bytes);
+
 // Faces of the part's B-rep source that hold a triangulation; 0 for other parts.
 std::size_t triangulated_faces(const Part& part);
 // An entry of a record for `stored` (its parts' current triangulations counted).

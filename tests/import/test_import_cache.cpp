@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -166,6 +167,50 @@ TEST(ImportCache, OnlyChangedFilesAreReadAgain) {
   ImportOptions parallel = options;
   parallel.parallel_files = 1;  // does not change the result: the same entry
   EXPECT_EQ(import_file(as1, parallel).files[0].cache, CacheUse::Hit);
+}
+
+// A cache kept under its cap (ImportOptions::cache_max_bytes): the least recently used entries go
+// first. An old file's entries are removed, the ones just read stay; the old file read again is
+// read from the file, as without a cache.
+TEST(ImportCache, KeptUnderItsCapLeastRecentlyUsedFirst) {
+  const std::string old_file = kExternal + "screw.step", recent = std::string(CADCLASH_DATA_DIR) + "/cad/valid_two_solids.step";
+  if (!fs::exists(old_file)) GTEST_SKIP() << old_file << " missing: run scripts/setup.sh";
+  ImportOptions options;
+  options.cache_dir = fresh_cache("capped");
+  auto entries = [&] {
+    std::map<std::string, std::uintmax_t> out;
+    for (const auto& e : fs::directory_iterator(options.cache_dir)) out[e.path().filename().string()] = fs::file_size(e.path());
+    return out;
+  };
+  auto bytes = [](const std::map<std::string, std::uintmax_t>& m) {
+    std::uintmax_t n = 0;
+    for (const auto& [name, size] : m) n += size;
+    return n;
+  };
+  import_file(old_file, options);
+  const auto old_entries = entries();
+  import_file(recent, options);
+  const auto all = entries();
+  std::map<std::string, std::uintmax_t> recent_entries;
+  for (const auto& [name, size] : all)
+    if (!old_entries.count(name)) recent_entries[name] = size;
+  ASSERT_FALSE(recent_entries.empty());
+  ASSERT_GT(old_entries.size(), 1u);  // the file's and its parts'
+
+  options.cache_max_bytes = bytes(recent_entries);
+  const ImportResult hit = import_file(recent, options);  // a hit, which uses the recent file's entry
+  EXPECT_EQ(hit.files[0].cache, CacheUse::Hit);
+  const auto kept = entries();
+  EXPECT_LE(bytes(kept), options.cache_max_bytes);
+  for (const auto& [name, size] : old_entries) EXPECT_EQ(kept.count(name), 0u) << name;
+  EXPECT_EQ(kept.count(*detail::cache_entry_name(recent, options)), 1u);
+
+  options.cache_max_bytes = 0;
+  const ImportResult again = import_file(old_file, options);
+  EXPECT_EQ(again.files[0].cache, CacheUse::Miss);
+  ImportOptions plain;
+  EXPECT_EQ(messages(again), messages(import_file(old_file, plain)));
+  EXPECT_TRUE(same_bytes(everything(again), everything(import_file(old_file, plain))));
 }
 
 // Parts of one file healed and meshed on several threads (TessellationOptions::parallel, the default),

@@ -96,12 +96,17 @@ struct ImportOptions {
   // (format version, key, size, SHA-256 of its contents) before it is used; a damaged one is read
   // again from the file, rewritten, and named in a warning. Entries are written whole (temporary file,
   // then rename), so runs sharing the directory never see half an entry. A file whose reading ran into
-  // a time limit is not stored. Entries are never removed: delete the directory to empty it.
+  // a time limit is not stored. Entries are removed only under cache_max_bytes (below).
   // Besides the file's entry, a STEP file that can be cut (docs/import.md) keeps one entry per piece
   // (a product's shapes, keyed by the piece's text with its ids renumbered canonically) and every
   // CAD file one per checked and healed B-rep part (keyed by its transferred shape, names, tags and
   // the tessellation options): a changed file reads and heals only the products that changed.
   std::string cache_dir;
+  // With cache_dir: after a file is read (and after store_triangles_in_cache), the least recently
+  // used entries are removed until the directory's entries take at most this many bytes (an entry
+  // is used when it is written or read; its file's modification time says when); 0 = no limit.
+  // Never part of a key: it changes what is kept, not what is read.
+  std::uint64_t cache_max_bytes = 0;
   // import_files: how many files are read at once (each in its own thread, a CAD file's isolated reader
   // in its own process); 0 = one per OpenMP thread (omp_get_max_threads). The result does not depend on it.
   int parallel_files = 0;
