@@ -7,8 +7,6 @@
 #include <BRep_Builder.hxx>
 #include <BinTools.hxx>
 #include <Standard_Failure.hxx>
-#include <TopExp.hxx>
-#include <TopTools_IndexedMapOfShape.hxx>
 
 #include <chrono>
 #include <optional>
@@ -106,25 +104,13 @@ bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, st
   return true;
 }
 
-bool share_edges(std::span<const BrepPartInput> parts) {
-  TopTools_IndexedMapOfShape all;
-  int sum = 0;
-  for (const BrepPartInput& in : parts) {
-    TopTools_IndexedMapOfShape edges;
-    TopExp::MapShapes(*in.shape, TopAbs_EDGE, edges);
-    sum += edges.Extent();
-    for (Standard_Integer e = 1; e <= edges.Extent(); ++e) all.Add(edges(e));
-  }
-  return all.Extent() != sum;
-}
-
 }  // namespace
 
 std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
                                           std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
                                           std::size_t* from_cache, CacheRecord* record) {
   if (from_cache) *from_cache = 0;
-  if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() || share_edges(parts))
+  if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() || brep_inputs_share_edges(parts))
     return add_brep_parts(model, parts, options.tessellation, options.lazy, diagnostics, complete, timings);
 
   const std::size_t n = parts.size();

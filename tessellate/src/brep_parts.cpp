@@ -247,11 +247,6 @@ bool shapes_share_edges(const Shapes& shapes) {
   return all.Extent() != sum;
 }
 
-bool parts_share_edges(std::span<const BrepPartInput> parts) {
-  std::vector<TopoDS_Shape> shapes;
-  for (const BrepPartInput& in : parts) shapes.push_back(*in.shape);
-  return shapes_share_edges(shapes);
-}
 
 // A part's faces as one compound (what its edges are).
 TopoDS_Shape faces_compound(const BrepSource::Impl& impl) {
@@ -291,7 +286,7 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   const detail::MeshDeadline deadline = detail::MeshDeadline::after(options.time_limit_seconds);
-  const bool in_parallel = options.parallel && parts.size() > 1 && !parts_share_edges(parts);
+  const bool in_parallel = options.parallel && parts.size() > 1 && !brep_inputs_share_edges(parts);
   const auto first_id = static_cast<PartId>(model.parts.size());
   std::vector<PartWork> work(parts.size());
 
@@ -417,6 +412,12 @@ bool brep_parts_share_edges(const Model& model) {
   std::vector<TopoDS_Shape> shapes;
   for (PartId p = 0; p < model.parts.size(); ++p)
     if (const BrepSource* source = brep_source_of(model, p)) shapes.push_back(faces_compound(*source->impl_));
+  return shapes_share_edges(shapes);
+}
+
+bool brep_inputs_share_edges(std::span<const BrepPartInput> parts) {
+  std::vector<TopoDS_Shape> shapes;
+  for (const BrepPartInput& in : parts) shapes.push_back(*in.shape);
   return shapes_share_edges(shapes);
 }
 

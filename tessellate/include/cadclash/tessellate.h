@@ -242,6 +242,8 @@ void release_part_triangles(Model& model, std::span<const PartId> parts);
 
 // True when two B-rep parts of the model share an edge (a file may let two products reach one edge).
 bool brep_parts_share_edges(const Model& model);
+// The same for inputs of add_brep_parts, before they are added. Precondition: every shape non-null.
+bool brep_inputs_share_edges(std::span<const BrepPartInput> parts);
 
 // =============================================================================================
 // Raw meshes: repair and segmentation (CGAL Polygon_mesh_processing)
