@@ -196,10 +196,18 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
        << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
 }
 
+// Report::stopped_by of a query refused for a value outside the supported range (model.h).
+const std::string kOutOfRange = "out of range";
+
+// What stopped a query, for "stopped by ...".
+std::string stopped_text(const std::string& stopped_by) {
+  return stopped_by == kOutOfRange ? "a value outside the supported range (see the errors)" : "the " + stopped_by;
+}
+
 // A loud line (and the first few pairs not examined) when a budget ran out.
 void print_partial(const Model& m, const Report& r, std::ostream& os) {
   if (r.complete) return;
-  os << "\nPARTIAL REPORT: stopped by the " << r.stopped_by << ": " << r.unexamined_pairs.size() << " of "
+  os << "\nPARTIAL REPORT: stopped by " << stopped_text(r.stopped_by) << ": " << r.unexamined_pairs.size() << " of "
      << r.counters.instance_pairs << " instance pairs not examined (or not finished)\n";
   constexpr std::size_t kShown = 10;
   for (std::size_t k = 0; k < r.unexamined_pairs.size() && k < kShown; ++k)
@@ -285,7 +293,7 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run
     measure_clashes(m, *report.review);
   }
   out.collision = unapproved_collision(*report.review);  // approved clashes never fail the audit
-  if (!r.complete) std::cout << "PARTIAL REPORT: stopped by the " << r.stopped_by << " (what was not examined: at the end)\n";
+  if (!r.complete) std::cout << "PARTIAL REPORT: stopped by " << stopped_text(r.stopped_by) << " (what was not examined: at the end)\n";
   if (r.pairs.empty()) std::cout << "no colliding, touching or close surface pairs\n";
   print_table(m, r, *report.review, collapse_clashes(o.review), std::cout);
   print_summary(r, !o.no_timings, std::cout);
@@ -314,7 +322,7 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
               << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided";
     if (!o.no_timings) std::cout << "  (" << fmt(s.report.timings.total * 1e3) << " ms)";
     if (!s.report.complete) {
-      std::cout << "  PARTIAL: stopped by the " << s.report.stopped_by << ", " << s.report.unexamined_pairs.size()
+      std::cout << "  PARTIAL: stopped by " << stopped_text(s.report.stopped_by) << ", " << s.report.unexamined_pairs.size()
                 << " of " << s.report.counters.instance_pairs << " instance pairs not examined";
       if (out.stopped_by.empty()) out.stopped_by = s.report.stopped_by;
     }
@@ -352,7 +360,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
   for (const Diagnostic& d : run.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
   report.complete = imported.complete && !has_error(run.diagnostics) && run.stopped_by.empty();
-  if (!run.stopped_by.empty())
+  if (!run.stopped_by.empty() && run.stopped_by != kOutOfRange)
     std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
   if (!o.no_timings) {

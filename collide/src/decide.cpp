@@ -47,7 +47,7 @@ double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, doubl
 }
 
 double effective_uncertainty(const Surface& s, double part_magnitude) {
-  return s.uncertainty > 0.0 ? s.uncertainty : 0x1p-24 * part_magnitude;
+  return std::max(kMinUncertainty, s.uncertainty > 0.0 ? s.uncertainty : 0x1p-24 * part_magnitude);
 }
 
 bool triangles_are_exact(const Model& model, SurfaceId s) {

@@ -25,7 +25,8 @@ struct Interval {
 double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, double mag_b);
 
 // ε of a surface as the decision uses it: Surface::uncertainty, or when that is 0 the
-// single-precision representation bound 2^-24 of its part's largest coordinate magnitude.
+// single-precision representation bound 2^-24 of its part's largest coordinate magnitude; never below
+// kMinUncertainty (model.h).
 double effective_uncertainty(const Surface& s, double part_magnitude);
 
 // The touching threshold T = tolerance + εa + εb (effective uncertainties).

@@ -86,6 +86,10 @@ Report Scene::check(const CollideOptions& o) {
   detail::QueryState q(o, std::chrono::steady_clock::now());
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   q.progress = &o.progress;
+  if (std::vector<Diagnostic> e = detail::range_errors(s, o); !e.empty()) {
+    detail::refuse(q.report, std::move(e));
+    return std::move(q.report);
+  }
   detail::set_schedule(o.schedule);
   detail::broad_phase_stage(s, q);  // which instance pairs can meet
   q.report.timings.broad = detail::seconds_since(q.t0);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 
 namespace cadclash::detail {
 namespace {
@@ -33,6 +34,14 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   for (PartId p = 0; p < model.parts.size(); ++p) {
     for (SurfaceId s = first(p); s < end(p); ++s) part_box[p].extend(surface_box(s));
     part_norm[p] = box_norm(part_box[p]);
+  }
+  part_length.assign(model.parts.size(), 0.0);
+  for (PartId p = 0; p < model.parts.size(); ++p) {
+    double& length = part_length[p];
+    auto take = [&length](double x) { length = in_supported_range(x) ? std::max(length, std::abs(x)) : HUGE_VAL; };
+    if (!part_box[p].isEmpty())
+      for (int k = 0; k < 3; ++k) take(part_box[p].min()[k]), take(part_box[p].max()[k]);
+    for (SurfaceId s = first(p); s < end(p); ++s) take(model.surfaces[s].deflection), take(model.surfaces[s].uncertainty);
   }
   eps.resize(model.surfaces.size());
   for (SurfaceId s = 0; s < model.surfaces.size(); ++s)

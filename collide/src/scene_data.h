@@ -59,6 +59,7 @@ struct SceneData {
   std::vector<Pose> poses;
   std::vector<Aabb> part_box;       // part-local union of its surfaces' boxes
   std::vector<double> part_norm;    // largest norm of a point of part_box (round-off bounds)
+  std::vector<double> part_length;  // largest |coordinate| of part_box, deflection or uncertainty (range check)
   std::vector<double> eps;          // per surface: effective_uncertainty (decide.h)
   std::vector<Aabb> world_box;      // per instance
   std::vector<char> dirty;

@@ -90,10 +90,12 @@ CheckPlan Scene::plan(const CollideOptions& options) {
   o.memory_budget_bytes = 0;
   detail::QueryState q(o, std::chrono::steady_clock::now());
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  CheckPlan plan;
+  plan.refused = detail::range_errors(s, o);
+  if (!plan.refused.empty()) return plan;
   detail::set_schedule(o.schedule);
   detail::broad_phase_stage(s, q);
   detail::surface_level_stage(s, q);
-  CheckPlan plan;
   plan.broad = q.report.counters;
   plan.broad.instance_pairs = 0;  // each part counts its own
   plan.pairs = costed_pairs(s, q);
@@ -107,6 +109,11 @@ PartialCheck Scene::check_part(const CollideOptions& o, const CheckPlan& plan, s
   assert(o.memory_budget_bytes == 0);
   detail::SceneData& s = *impl_;
   detail::QueryState q(o, std::chrono::steady_clock::now());
+  if (!plan.refused.empty()) {
+    PartialCheck out;
+    detail::refuse(out.report, {});
+    return out;
+  }
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   detail::set_schedule(o.schedule);
   q.pairs.resize(part.size());

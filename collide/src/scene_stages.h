@@ -11,6 +11,12 @@
 
 namespace cadclash::detail {
 
+// 0. Why the query is outside the supported range (model.h), if it is: the options, then each
+//    selected instance whose part (box, deflections, uncertainties) or pose is; at most 16 listed.
+std::vector<Diagnostic> range_errors(const SceneData& s, const CollideOptions& o);
+// A refused query's report: nothing examined, complete false, stopped_by "out of range".
+void refuse(Report& r, std::vector<Diagnostic> errors);
+
 // 1. World boxes of the instances moved since the last check, then sweep-and-prune over them (brute
 //    force: every selected pair) → q.pairs.
 void broad_phase_stage(SceneData& s, QueryState& q);

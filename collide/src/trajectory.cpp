@@ -73,11 +73,22 @@ std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::
         ok = false;
       }
     }
+    for (int k = 0; k < 3 && ok; ++k) {
+      if (!in_supported_range(v[k])) {
+        error("field " + std::to_string(k + 3) + " '" + fields[static_cast<std::size_t>(k) + 2] +
+              "' is outside the supported range (magnitude <= 2^128, about 3.4e38 mm)");
+        ok = false;
+      }
+    }
     if (!ok) continue;
     Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
     const double n = q.norm();
     if (!(n > 1e-12)) {
       error("quaternion (qw,qx,qy,qz) is zero");
+      continue;
+    }
+    if (!std::isfinite(n)) {
+      error("quaternion (qw,qx,qy,qz) is too large to normalise");
       continue;
     }
     q.coeffs() /= n;

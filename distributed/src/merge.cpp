@@ -96,6 +96,12 @@ MergedCheck merge_parts(const CheckPlan& plan, std::span<const PartialCheck> par
   assert(history.tessellated.size() == model.surfaces.size());
   MergedCheck out;
   Report& r = out.report;
+  if (!plan.refused.empty()) {  // every part was refused alike
+    r.diagnostics = plan.refused;
+    r.complete = false;
+    r.stopped_by = "out of range";
+    return out;
+  }
   r.counters = plan.broad;
   r.timings.broad = plan.seconds;
   bool time_cut = false;

@@ -26,6 +26,7 @@
 #include <XCAFPrs_Style.hxx>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -150,6 +151,16 @@ struct Walker {
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) pose.matrix()(r, c) = trsf.Value(r + 1, c + 1) / trsf.ScaleFactor();
       pose.matrix()(r, 3) = trsf.Value(r + 1, 4);
+    }
+    for (int r = 0; r < 3; ++r) {
+      if (in_supported_range(pose.translation()[r])) continue;
+      char value[40];
+      std::snprintf(value, sizeof value, "%.6g", pose.translation()[r]);
+      diagnostics.push_back({Severity::Error, file, 0, -1,
+                             "instance " + path + " is placed " + value +
+                                 " mm from the origin, outside the supported range (magnitude <= 2^128, about "
+                                 "3.4e38 mm); the instance is dropped"});
+      return;
     }
     instance.pose = pose;
     instances.push_back(std::move(instance));

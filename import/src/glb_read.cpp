@@ -194,6 +194,8 @@ ImportResult read_cadclash_glb(const std::string& path, const ImportOptions&) {
           }
           for (const Vec3& v : s.mesh.vertices)
             if (!v.allFinite()) throw std::runtime_error("a position is not finite");
+            else if (!(v.cwiseAbs().maxCoeff() <= kMaxLength))
+              throw std::runtime_error("a position is " + kOutsideRange);
           s.has_triangles = true;
           if (s.aabb.isEmpty()) s.aabb = mesh_aabb(s.mesh);
           model.surfaces.push_back(std::move(s));
@@ -215,6 +217,8 @@ ImportResult read_cadclash_glb(const std::string& path, const ImportOptions&) {
           for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r) e(r, c) = m[static_cast<std::size_t>(4 * c + r)];
           if (!e.allFinite()) throw std::runtime_error("a node matrix is not finite");
+          if (!(e.col(3).head<3>().cwiseAbs().maxCoeff() <= kMaxLength))
+            throw std::runtime_error("a node matrix translates by a length " + kOutsideRange);
           instance.pose.matrix() = e;
         }
         model.instances.push_back(std::move(instance));

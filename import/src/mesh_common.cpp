@@ -1,7 +1,10 @@
 #include "mesh_common.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cstdlib>
 #include <cmath>
 #include <filesystem>
@@ -63,6 +66,14 @@ void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) 
     while (i < line.size() && !is_space(line[i])) ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
+}
+
+const std::string kOutsideRange = "outside the supported range (magnitude <= 2^128, about 3.4e38 mm)";
+
+std::string printable_number(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
 }
 
 NumberStatus parse_double(std::string_view token, double& value) {
@@ -191,10 +202,15 @@ std::string degenerate_face(std::span<const Vec3> c) {
     if (c[k] == c[(k + 1) % n])
       return "has a zero-length edge (corners " + std::to_string(k + 1) + " and " + std::to_string((k + 1) % n + 1) +
              " are the same point)";
-  Vec3 normal = Vec3::Zero();
-  for (std::size_t k = 1; k + 1 < n; ++k) normal += (c[k] - c[0]).cross(c[k + 1] - c[0]);
-  if (n >= 3 && normal == Vec3::Zero()) return "has zero area (its corners are collinear)";
-  return {};
+  if (n < 3) return {};
+  // Exact (CGAL's filtered predicate): a float cross product underflows to zero for faces of 1e-160
+  // mm and less, which have area.
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  const auto point = [](const Vec3& v) { return K::Point_3(v.x(), v.y(), v.z()); };
+  const K::Point_3 p0 = point(c[0]), p1 = point(c[1]);  // distinct: no zero-length edge
+  for (std::size_t k = 2; k < n; ++k)
+    if (!CGAL::collinear(p0, p1, point(c[k]))) return {};
+  return "has zero area (its corners are collinear)";
 }
 
 }  // namespace cadclash::detail

@@ -36,6 +36,12 @@ class LineReader {
 // Splits a line into whitespace-separated tokens.
 void split_tokens(std::string_view line, std::vector<std::string_view>& tokens);
 
+// How a reader says that a value is past cadclash::kMaxLength (model.h): "outside the supported
+// range (magnitude <= 2^128, about 3.4e38 mm)".
+extern const std::string kOutsideRange;
+// A double as a diagnostic shows it ("%.17g").
+std::string printable_number(double x);
+
 enum class NumberStatus { Ok, Invalid, NotFinite };
 // Parses the whole token as a double ("1", "-2.5e3", "nan", "inf", "1e999" → NotFinite).
 NumberStatus parse_double(std::string_view token, double& value);
@@ -79,8 +85,8 @@ class DiagnosticCollector {
 
 // Why a face with these corner positions (in order) is degenerate, as a phrase: "has a zero-length
 // edge (corners 1 and 2 are the same point)" or "has zero area (its corners are collinear)"; empty
-// when it is neither. Exact on the stored doubles for repeated points; zero area means the summed
-// fan cross product is exactly zero. Readers keep such faces and warn: a degenerate triangle is a
+// when it is neither. Exact on the stored doubles: zero area means every corner lies on the line
+// through the first two. Readers keep such faces and warn: a degenerate triangle is a
 // segment or point that can still touch another surface, and dropping it would renumber triangles.
 std::string degenerate_face(std::span<const Vec3> corners);
 

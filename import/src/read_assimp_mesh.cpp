@@ -84,19 +84,28 @@ struct Walker {
 
     std::unordered_map<PositionKey, std::uint32_t, PositionHash> merged;
     std::vector<std::uint32_t> local(mesh.mNumVertices, kInvalidId);
-    std::vector<bool> finite(mesh.mNumVertices, true);
+    std::vector<bool> finite(mesh.mNumVertices, true);  // finite and within the supported range
+    bool reported_range = false;
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D& p = mesh.mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
         finite[v] = false;
         continue;
       }
+      const Eigen::Vector4d w = to_world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+      if (!in_supported_range(w.x()) || !in_supported_range(w.y()) || !in_supported_range(w.z())) {
+        finite[v] = false;
+        if (!reported_range)
+          diags.add(Severity::Error, 0, "bad vertices",
+                    "mesh '" + printable_text(surface.name) + "': vertex " + std::to_string(v) + " placed at (" +
+                        printable_number(w.x()) + ", " + printable_number(w.y()) + ", " + printable_number(w.z()) +
+                        ") has a coordinate " + kOutsideRange);
+        reported_range = true;
+        continue;
+      }
       auto [it, inserted] = merged.try_emplace(PositionKey{float_bits(p.x), float_bits(p.y), float_bits(p.z)},
                                                 static_cast<std::uint32_t>(surface.mesh.vertices.size()));
-      if (inserted) {
-        const Eigen::Vector4d w = to_world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
-        surface.mesh.vertices.emplace_back(w.x(), w.y(), w.z());
-      }
+      if (inserted) surface.mesh.vertices.emplace_back(w.x(), w.y(), w.z());
       local[v] = it->second;
     }
     std::vector<std::uint32_t> corners;

@@ -132,6 +132,11 @@ void scan_obj(std::string_view text, ObjScan& scan, DiagnosticCollector& diags, 
                       "vertex " + std::to_string(scan.vertices.size() + 1) + " has a coordinate that is not finite ('" +
                           printable_token(tokens[static_cast<std::size_t>(c)]) + "')");
             bad = line_no;
+          } else if (!in_supported_range(p[c])) {
+            diags.add(Severity::Error, line_no, "bad vertices",
+                      "vertex " + std::to_string(scan.vertices.size() + 1) + " has a coordinate " + kOutsideRange + " ('" +
+                          printable_token(tokens[static_cast<std::size_t>(c)]) + "')");
+            bad = line_no;
           }
         }
       }

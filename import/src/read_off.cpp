@@ -182,6 +182,12 @@ std::optional<ImportResult> read_vertices(OffScanner& sc, const OffHeader& heade
           p /= w;
         }
       }
+      for (int c = 0; c < 3 && bad == 0; ++c)
+        if (!in_supported_range(p[c])) {
+          diags.add(Severity::Error, line_no, "bad vertices",
+                    "vertex " + std::to_string(i) + " has a coordinate " + kOutsideRange + " (" + printable_number(p[c]) + ")");
+          bad = line_no;
+        }
     }
     vertices.push_back(bad ? Vec3::Zero() : p);
     bad_vertex_line.push_back(bad);

@@ -49,6 +49,7 @@ struct BrepSource::Impl {
   std::vector<std::int64_t> entity_ids;     // per face; -1 if unknown
   std::vector<Aabb> boxes;                  // part-local box of each exact face
   std::vector<char> exact_faces;            // per face: planar and bounded by lines (deflection 0)
+  std::vector<char> outside_range;          // per face: beyond cadclash::kMaxLength, dropped (no triangles)
   double default_deflection = 0.1;          // absolute, mm
   double angular_deflection = 0.5;
   bool verify_deflection = true;

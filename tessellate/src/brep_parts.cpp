@@ -21,6 +21,7 @@
 #include <cassert>
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <exception>
 #include <mutex>
 #include <shared_mutex>
@@ -118,7 +119,8 @@ void mesh_faces(BrepSource::Impl& impl, double deflection, const TessellationOpt
   TopoDS_Compound compound;
   BRep_Builder builder;
   builder.MakeCompound(compound);
-  for (const TopoDS_Face& f : impl.faces) builder.Add(compound, f);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!impl.outside_range[i]) builder.Add(compound, impl.faces[i]);
   std::string why;
   const bool meshed =
       detail::run_brepmesh(compound, deflection, options.angular_deflection, options.parallel, why, deadline);
@@ -128,6 +130,10 @@ void mesh_faces(BrepSource::Impl& impl, double deflection, const TessellationOpt
 #pragma omp parallel for schedule(dynamic, 4) if (options.parallel && n > 8)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
     const auto i = static_cast<std::size_t>(k);
+    if (impl.outside_range[i]) {  // dropped in prepare_part: stays without triangles
+      good[i] = 1;
+      continue;
+    }
     double achieved = 0.0;
     if (detail::read_face_triangles(impl.faces[i], options.verify_deflection, surfaces[i].mesh, achieved)) {
       surfaces[i].deflection = achieved;
@@ -175,6 +181,29 @@ struct PartWork {
   double deflection = 0.0;
 };
 
+// Faces whose exact box reaches past cadclash::kMaxLength (model.h) are dropped, each with an error
+// naming its entity and the coordinate: no query could certify an answer about them. They keep
+// their index and an empty box and get no triangles.
+void drop_faces_outside_range(const BrepPartInput& in, BrepSource::Impl& impl, PartWork& w) {
+  const std::size_t n = impl.faces.size();
+  impl.outside_range.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Aabb& b = impl.boxes[i];
+    if (b.isEmpty()) continue;
+    const double largest = std::max(b.min().cwiseAbs().maxCoeff(), b.max().cwiseAbs().maxCoeff());
+    if (in_supported_range(largest)) continue;
+    impl.outside_range[i] = 1;
+    impl.boxes[i] = Aabb();
+    char value[40];
+    std::snprintf(value, sizeof value, "%.6g", largest);
+    w.diagnostics.push_back(Diagnostic{Severity::Error, in.source_file, 0, impl.entity_ids[i],
+                                       "face " + std::to_string(i) + " of part '" + in.name + "' reaches a coordinate of " +
+                                           value + " mm, outside the supported range (magnitude <= 2^128, about 3.4e38 "
+                                           "mm); the face is dropped"});
+    w.complete = false;
+  }
+}
+
 // Faces, healing, exact boxes and face facts of one part, whose id will be `part_id`.
 void prepare_part(const BrepPartInput& in, const TessellationOptions& options, PartId part_id, PartWork& w) {
   assert(in.shape != nullptr);
@@ -201,6 +230,7 @@ void prepare_part(const BrepPartInput& in, const TessellationOptions& options, P
 #pragma omp parallel for schedule(dynamic, 8) if (options.parallel && n > 16)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i)
     impl.boxes[static_cast<std::size_t>(i)] = detail::face_aabb(impl.faces[static_cast<std::size_t>(i)]);
+  drop_faces_outside_range(in, impl, w);
   for (const Aabb& b : impl.boxes)
     if (!b.isEmpty()) part_box.extend(b);
   w.deflection = options.linear_deflection;
@@ -225,6 +255,10 @@ void prepare_part(const BrepPartInput& in, const TessellationOptions& options, P
       s.provenance.colour = in.tags[i].colour;
     }
     s.aabb = impl.boxes[i];
+    if (impl.outside_range[i]) {
+      s.has_triangles = true;  // none: the face is left out of every query
+      continue;
+    }
     detail::describe_face(impl.faces[i], s);
   }
   impl.exact_faces.resize(n);

@@ -62,7 +62,9 @@ bool BrepSource::triangulate(std::uint32_t local_index, double deflection, Trian
   const double target = deflection > 0.0 ? deflection : impl_->default_deflection;
   std::string why;
   bool ok = false;
-  {
+  if (local_index < impl_->outside_range.size() && impl_->outside_range[local_index]) {
+    why = "it was dropped: outside the supported range";
+  } else {
     std::lock_guard<std::shared_mutex> lock(impl_->mutex);
     // Finer than the part's own deflection is a refinement for one query: BRepMesh stores what it
     // makes in the face, so it meshes a copy (shared geometry, own topology), and the face keeps the

@@ -37,7 +37,7 @@ std::string save_brep_source(const BrepSource& source) {
   o.u64(n);
   for (std::size_t i = 0; i < n; ++i) {
     o.u64(static_cast<std::uint64_t>(impl.entity_ids[i]));
-    o.u64(impl.exact_faces[i] != 0 ? 1 : 0);
+    o.u64((impl.exact_faces[i] != 0 ? 1 : 0) | (i < impl.outside_range.size() && impl.outside_range[i] ? 2 : 0));
     const Aabb& b = impl.boxes[i];
     for (int k = 0; k < 3; ++k) o.f64(b.min()[k]);
     for (int k = 0; k < 3; ++k) o.f64(b.max()[k]);
@@ -70,10 +70,13 @@ std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string
   const std::uint64_t n = in.count(8 * 8);
   impl->entity_ids.resize(n);
   impl->exact_faces.resize(n);
+  impl->outside_range.resize(n);
   impl->boxes.resize(n);
   for (std::size_t i = 0; i < n && in.ok; ++i) {
     impl->entity_ids[i] = static_cast<std::int64_t>(in.u64());
-    impl->exact_faces[i] = in.u64() != 0 ? 1 : 0;
+    const std::uint64_t flags = in.u64();
+    impl->exact_faces[i] = (flags & 1) != 0 ? 1 : 0;
+    impl->outside_range[i] = (flags & 2) != 0 ? 1 : 0;
     Vec3 lo, hi;
     for (int k = 0; k < 3; ++k) lo[k] = in.f64();
     for (int k = 0; k < 3; ++k) hi[k] = in.f64();

@@ -532,6 +532,35 @@ bool intersect_with(const Tri& ta, const Tri& tb) {
 
 bool oracle_intersect(const Tri& ta, const Tri& tb) { return intersect_with<EK>(ta, tb); }
 
+int oracle_compare_distance(const Tri& ta, const Tri& tb, double limit) {
+  if (oracle_intersect(ta, tb)) return limit > 0.0 ? -1 : 0;
+  auto point = [](const Vec3& v) { return EK::Point_3(v.x(), v.y(), v.z()); };
+  const EK::FT limit2 = EK::FT(limit) * EK::FT(limit);
+  // The closed triangles are disjoint: their distance is attained between a vertex and the other
+  // triangle or between two edges (a degenerate triangle is the union of its edges, which the
+  // edge pairs cover).
+  bool below = false, equal = false;
+  auto take = [&](const EK::FT& d2) {
+    below = below || d2 < limit2;
+    equal = equal || d2 == limit2;
+  };
+  for (const auto& [p, q] : {std::pair{&ta, &tb}, std::pair{&tb, &ta}}) {
+    const EK::Triangle_3 face(point((*q)[0]), point((*q)[1]), point((*q)[2]));
+    if (face.is_degenerate()) continue;
+    for (const Vec3& v : *p) take(CGAL::squared_distance(point(v), face));
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const EK::Point_3 a0 = point(ta[i]), a1 = point(ta[(i + 1) % 3]), b0 = point(tb[j]), b1 = point(tb[(j + 1) % 3]);
+      // A zero-length edge is a point: its distance to the other edge.
+      if (a0 == a1 && b0 == b1) take(CGAL::squared_distance(a0, b0));
+      else if (a0 == a1) take(CGAL::squared_distance(a0, EK::Segment_3(b0, b1)));
+      else if (b0 == b1) take(CGAL::squared_distance(b0, EK::Segment_3(a0, a1)));
+      else take(CGAL::squared_distance(EK::Segment_3(a0, a1), EK::Segment_3(b0, b1)));
+    }
+  return below ? -1 : equal ? 0 : 1;
+}
+
 bool may_need_cgal(const Tri& a, const Tri& b) {
   for (const Tri* t : {&a, &b}) {
     for (const Vec3& v : *t)

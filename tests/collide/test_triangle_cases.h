@@ -86,6 +86,10 @@ TriPair rigid_motion(const TriPair& p, Rng& rng, double max_shift);
 // The oracle: exact intersection of the closed point sets with CGAL's Epeck (exact constructions).
 bool oracle_intersect(const Tri& a, const Tri& b);
 
+// The sign of (exact distance between the closed triangles) - limit, exactly (Epeck): -1 below,
+// 0 equal, +1 above. limit >= 0.
+int oracle_compare_distance(const Tri& a, const Tri& b, double limit);
+
 // True when triangles_intersect may hand (a, b) to CGAL (triangles_intersect_exact): one of them is
 // degenerate (collinear or repeated vertices, decided with Epeck), or a coordinate is beyond 2^48 in
 // magnitude, or nonzero and below 2^-300 (outside the exact stage's domain).

@@ -343,7 +343,10 @@ struct Report {
   // then holds what was found: every result of the examined instance pairs and, under a time budget,
   // the surface pairs finished within the others. Counters count the work whose results are kept.
   bool complete = true;
-  std::string stopped_by;  // "time budget" or "memory budget" when !complete; empty otherwise
+  // "time budget" or "memory budget" when !complete; empty otherwise. "out of range" when the query
+  // was refused because a selected instance or an option is outside the supported range (model.h):
+  // nothing was examined, no pairs, and `diagnostics` has an error for each cause.
+  std::string stopped_by;
   // Broad-phase instance pairs (of counters.instance_pairs) not fully examined, sorted; (a < b).
   std::vector<std::array<InstanceId, 2>> unexamined_pairs;
   // Bytes charged against memory_budget_bytes (computed whether or not a budget is set); the same
@@ -355,6 +358,7 @@ struct Report {
 };
 
 // One-off query of two instances. Tessellates (require_triangles) exactly the surfaces it needs.
+// Refuses a query outside the supported range (model.h; Report::stopped_by "out of range").
 // Preconditions: a < model.instances.size(); b < model.instances.size(); a != b.
 Report collide(Model& model, InstanceId a, InstanceId b, const CollideOptions& options = {});
 
@@ -391,6 +395,9 @@ struct CheckPlan {
   CollideCounters broad;           // the broad phase's own work (world-box updates, sweep tests); instance_pairs 0
   std::vector<SurfaceId> needed;   // surfaces the pairs reach, in order of first need (as check() tessellates them)
   double seconds = 0.0;            // time plan() took
+  // Not empty when the query is outside the supported range (model.h): why, as check() would list
+  // it; then pairs is empty and each check_part() returns a refused report (stopped_by "out of range").
+  std::vector<Diagnostic> refused;
 };
 
 // What a check_part() did to one surface, for a merge to count it once over all parts.
@@ -433,6 +440,8 @@ class Scene {
   // Returns the instance id with this path, or kInvalidId.
   InstanceId find_instance(const std::string& path) const;
 
+  // Refused (Report::stopped_by "out of range") when a selected instance or an option is outside the
+  // supported range (model.h).
   Report check(const CollideOptions& options = {});
 
   // Builds now the hierarchy of every surface that has triangles and none yet (check() builds them
@@ -473,7 +482,8 @@ struct TrajectoryRow {
 
 // Parses CSV text "step,instance_path,tx,ty,tz,qw,qx,qy,qz" (optional header line starting with
 // "step"; blank lines and lines starting with '#' skipped). Bad rows become diagnostics naming
-// `file` and the line and are skipped; quaternions are normalised (a zero quaternion is an error).
+// `file` and the line and are skipped; quaternions are normalised (a zero quaternion is an error);
+// a translation outside the supported range (model.h) is an error.
 std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::string& file,
                                             std::vector<Diagnostic>& diagnostics);
 

@@ -39,6 +39,21 @@ using Aabb = Eigen::AlignedBox3d;
 // Rigid transform (rotation + translation) from a part's local frame to the world frame.
 using Pose = Eigen::Isometry3d;
 
+// The range collide certifies. Every answer is certified for lengths of at most kMaxLength in
+// magnitude: vertex coordinates and surface boxes (part-local), pose translations (a pose's rotation
+// entries are at most 1), deflections, uncertainties, the tolerance and the clearance. Beyond it
+// squares and fourth powers of lengths in the float steps of a query overflow, so the readers reject
+// such values (a diagnostic naming the file and line or STEP #id and the value) and collide() and
+// Scene refuse such a query (Report::stopped_by "out of range", an error diagnostic per offending
+// instance or option). Small coordinates have no limit: a surface's ε is never taken below
+// kMinUncertainty, which keeps every length that decides a contact far above the range where its
+// products underflow (faces closer than 2 x kMinUncertainty + tolerance touch).
+inline constexpr double kMaxLength = 0x1p128;        // mm, about 3.4e38
+inline constexpr double kMinUncertainty = 0x1p-128;  // mm, about 2.9e-39
+
+// True when |x| <= kMaxLength; false for NaN and infinities.
+inline bool in_supported_range(double x) { return x >= -kMaxLength && x <= kMaxLength; }
+
 // Indexed triangles in double precision, in the owning part's local frame.
 struct TriangleMesh {
   std::vector<Vec3> vertices;
@@ -121,7 +136,8 @@ struct Surface {
   // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger. Meshes: the single-precision
   // representation bound 2^-24 · (largest coordinate magnitude of the part), or the importer's
   // model_tolerance when given. 0 (a Model built by hand) means that same bound, derived by collide
-  // from the part's box. Two faces touch when their exact distance <= tolerance + εa + εb.
+  // from the part's box. Never taken below kMinUncertainty. Two faces touch when their exact distance
+  // <= tolerance + εa + εb.
   double uncertainty = 0.0;
   // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
   // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
