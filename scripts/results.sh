@@ -81,6 +81,18 @@ echo "results: numerical extremes (triangle test against the exact oracle)"
   grep '^\[ family   \] |' "$out/extremes.log" | sed 's/^\[ family   \] //'
 } >"$out/extremes.md"
 
+echo "results: the triangle families through collide() and Scene::check at every scale"
+"$build/tests/collide/test_triangle_predicates" --gtest_filter='Families/PipelineOracle.*' >"$out/pipeline.log" 2>&1 || {
+  tail -30 "$out/pipeline.log"
+  echo "results: the pipeline oracle test failed" >&2
+  exit 1
+}
+{
+  echo "| family | pairs | intersecting | refused (past 2^128) | undecided | wrong |"
+  echo "|---|---|---|---|---|---|"
+  grep '^\[ pipeline \] |' "$out/pipeline.log" | sed 's/^\[ pipeline \] //'
+} >"$out/pipeline.md"
+
 echo "results: triangle predicate speed (bench_triangle_predicates)"
 # Time per test of the staged predicate (filters, then CGAL only where they cannot decide) against
 # CGAL's exact test on every pair, on the same 4,096 pairs per set.
@@ -128,6 +140,7 @@ while IFS= read -r line || [ -n "$line" ]; do
     @ACCURACY@) relink "$out/accuracy.md" ;;
     @EXTREMES@) cat "$out/extremes.md" ;;
     @PREDICATES@) cat "$out/predicates.md" ;;
+    @PIPELINE_ORACLE@) cat "$out/pipeline.md" ;;
     @SCALE@) cat "$out/scale.md" ;;
     @IMPORT_PEER@)
       # Measured by scripts/import_peer_bench.sh (~20 min), not here: its last table, as it is.

@@ -1,5 +1,6 @@
 // cadclash check's review options: the baseline and approvals read, and the review printed.
 #include "check_review.h"
+#include "check_print.h"
 #include "cmd_check_mpi.h"
 
 #include "cli_common.h"
@@ -17,13 +18,6 @@
 
 namespace cadclash::cli {
 namespace {
-
-std::string fmt_mm(double v) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s << std::setprecision(4) << v;
-  return s.str();
-}
 
 std::map<std::string, InstanceId> instances_by_path(const Model& m) {
   std::map<std::string, InstanceId> out;
@@ -158,10 +152,10 @@ std::string clash_heading(const ClashReview& r, const ReportClash& c) {
   s << "clash " << c.id << "  " << clash_status_name(c.status);
   if (c.approval >= 0) s << ", approved (" << r.approvals[c.approval].approval.reason << ")";
   s << "  " << contact_class_name(c.worst);
-  if (c.max_penetration > 0) s << ", max penetration " << fmt_mm(c.max_penetration);
+  if (c.max_penetration > 0) s << ", max penetration " << fmt(c.max_penetration);
   s << ", " << c.surface_pairs.size() << " surface pair" << (c.surface_pairs.size() == 1 ? "" : "s");
   if (c.interference && c.interference->measured)
-    s << ", interference " << fmt_mm(c.interference->volume) << " mm3, depth " << fmt_mm(c.interference->depth) << " mm";
+    s << ", interference " << fmt(c.interference->volume) << " mm3, depth " << fmt(c.interference->depth) << " mm";
   else if (c.interference)
     s << ", no volume: " << c.interference->note;
   if (r.group_by != "instance") s << "  [group " << c.group << "]";

@@ -1,4 +1,5 @@
 // cadclash check: which surfaces of which instances penetrate, touch, come close or contain each other.
+#include "check_print.h"
 #include "check_review.h"
 #include "cli_common.h"
 #include "cmd_check_mpi.h"
@@ -114,106 +115,6 @@ ReportSettings report_settings_of(const CheckOptions& o, const CollideOptions& c
   s.select_b = o.select_b;
   s.memory_budget_mb = o.memory_budget_mb;  // as given, not rounded through bytes
   return s;
-}
-
-// "#123" for STEP faces, the group name for mesh groups, else the face index.
-std::string source_label(const Surface& s) {
-  if (s.provenance.step_id >= 0) return "#" + std::to_string(s.provenance.step_id);
-  if (!s.provenance.source_name.empty()) return s.provenance.source_name;
-  return "face " + std::to_string(s.provenance.face_index);
-}
-
-struct ClassCounts {
-  std::size_t c[5] = {0, 0, 0, 0, 0};  // by ContactClass
-  void add(const Report& r) {
-    for (const SurfacePairResult& p : r.pairs) ++c[static_cast<int>(p.contact)];
-  }
-  // An undecided pair may be a contact: an audit fails safe.
-  bool collision() const { return c[0] + c[1] + c[3] + c[4] > 0; }
-};
-
-std::string fmt(double v) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s << std::setprecision(4) << v;
-  return s.str();
-}
-
-// The pairs under one heading per instance pair (its clash's id, status and worst class); with
-// `collapse`, the headings alone.
-void print_table(const Model& m, const Report& r, const ClashReview& review, bool collapse, std::ostream& os) {
-  const std::vector<const ReportClash*> clash = clash_of_pairs(review, r.pairs.size());
-  InstanceId ca = kInvalidId, cb = kInvalidId;
-  for (std::size_t k = 0; k < r.pairs.size(); ++k) {
-    const SurfacePairResult& p = r.pairs[k];
-    if (p.instance_a != ca || p.instance_b != cb) {
-      ca = p.instance_a;
-      cb = p.instance_b;
-      const Instance& a = m.instances[ca];
-      const Instance& b = m.instances[cb];
-      os << '\n' << a.path << " (" << m.parts[a.part].name << ")  x  " << b.path << " (" << m.parts[b.part].name << ")\n";
-      if (clash[k]) os << "  " << clash_heading(review, *clash[k]) << '\n';
-      if (!collapse)
-        os << "  " << std::left << std::setw(12) << "class" << std::setw(12) << "decided by" << std::setw(11)
-           << "distance" << std::setw(34) << "surface A" << "surface B\n";
-    }
-    if (collapse) continue;
-    auto side = [&](SurfaceId s) {
-      if (s == kInvalidId) return std::string("(whole part)");
-      return m.surfaces[s].name + " [" + source_label(m.surfaces[s]) + "]";
-    };
-    std::string dist = p.contact == ContactClass::Penetrating ? "-" + fmt(p.penetration) : fmt(p.distance);
-    const char* by = p.contact == ContactClass::Containment ? "mesh" : decided_by_name(p.decided_by);
-    os << "  " << std::left << std::setw(12) << contact_class_name(p.contact) << std::setw(12) << by << std::setw(11)
-       << dist << std::setw(34) << side(p.surface_a) << side(p.surface_b);
-    if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
-    if (p.contact == ContactClass::Undecided)
-      os << "  exact distance in [" << fmt(p.distance_lo) << ", " << fmt(p.distance_hi) << "]";
-    os << '\n';
-  }
-}
-
-void print_summary(const Report& r, bool timings, std::ostream& os) {
-  ClassCounts n;
-  n.add(r);
-  const CollideCounters& c = r.counters;
-  if (n.c[0] > 0) os << "\n(distance of a penetrating pair: minus its crossing-depth estimate)\n";
-  os << "\n" << r.pairs.size() << " reported pairs: " << n.c[0] << " penetrating, " << n.c[1] << " touching, "
-     << n.c[2] << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided\n";
-  os << "decided by: mesh " << c.decided_mesh << ", mesh-exact " << c.decided_mesh_exact << ", analytic "
-     << c.decided_analytic << ", refined " << c.decided_refined << ", exact " << c.decided_exact << ", undecided "
-     << c.undecided << "; ambiguous " << c.ambiguous_pairs << ", faces refined " << c.refined_surfaces
-     << ", witness queries " << c.witness_queries << ", exact queries " << c.exact_queries << ", dismissed " << c.dismissed_pairs << '\n';
-  os << "counters: instance pairs " << c.instance_pairs << ", AABB tests " << c.aabb_tests << ", AABB updates "
-     << c.aabb_updates << ", msA " << c.surfaces_a << ", msB " << c.surfaces_b << ", surface pairs " << c.surface_pairs
-     << ", mpSk " << c.triangles_a << ", mpSl " << c.triangles_b << ", triangle tests " << c.triangle_tests
-     << ", exact fallbacks " << c.exact_fallbacks << ", distance tests " << c.distance_tests
-     << ", intersecting surface pairs " << c.intersecting_pairs << ", tessellated on demand "
-     << c.tessellated_surfaces << '\n';
-  if (timings)
-    os << "time: " << fmt(r.timings.total * 1e3) << " ms (broad " << fmt(r.timings.broad * 1e3) << ", surfaces "
-       << fmt(r.timings.surface_level * 1e3) << ", tessellation " << fmt(r.timings.tessellation * 1e3)
-       << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
-}
-
-// Report::stopped_by of a query refused for a value outside the supported range (model.h).
-const std::string kOutOfRange = "out of range";
-
-// What stopped a query, for "stopped by ...".
-std::string stopped_text(const std::string& stopped_by) {
-  return stopped_by == kOutOfRange ? "a value outside the supported range (see the errors)" : "the " + stopped_by;
-}
-
-// A loud line (and the first few pairs not examined) when a budget ran out.
-void print_partial(const Model& m, const Report& r, std::ostream& os) {
-  if (r.complete) return;
-  os << "\nPARTIAL REPORT: stopped by " << stopped_text(r.stopped_by) << ": " << r.unexamined_pairs.size() << " of "
-     << r.counters.instance_pairs << " instance pairs not examined (or not finished)\n";
-  constexpr std::size_t kShown = 10;
-  for (std::size_t k = 0; k < r.unexamined_pairs.size() && k < kShown; ++k)
-    os << "  not examined: " << m.instances[r.unexamined_pairs[k][0]].path << "  x  "
-       << m.instances[r.unexamined_pairs[k][1]].path << '\n';
-  if (r.unexamined_pairs.size() > kShown) os << "  ... and " << r.unexamined_pairs.size() - kShown << " more\n";
 }
 
 // The --path trajectory's rows; std::nullopt, after saying why on stderr, when the file cannot be

@@ -26,15 +26,27 @@ double orthonormal_defect(const Pose& p) {
 
 }  // namespace
 
+Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
+  Pose t = Pose::Identity();
+  const Eigen::Matrix3d ra_t = pose_a.linear().transpose();
+  t.linear() = ra_t * pose_b.linear();
+  const Vec3 d = pose_b.translation() - pose_a.translation();
+  t.translation() = ra_t * d;
+  return t;
+}
+
 double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, double mag_b) {
-  const double ta = pose_a.translation().norm(), tb = pose_b.translation().norm();
-  // t_ab = pose_a⁻¹·pose_b = (R_aᵀR_b, R_aᵀ(t_b - t_a)) in doubles: each rotation entry is a 3-term
-  // dot product of unit rows (error <= γ3), the translation two 3-term products and a sum
-  // (error <= γ5·(|t_a| + |t_b|) per component).
-  const double t_ab = (pose_a.inverse(Eigen::Isometry) * pose_b).translation().norm() + gamma(5) * (ta + tb);
+  // t_ab = relative_pose(pose_a, pose_b) = (R_aᵀR_b, R_aᵀ(t_b - t_a)) in doubles: each rotation entry
+  // is a 3-term dot product of unit rows (error <= γ3); each translation component one rounded
+  // difference and a 3-term dot product with a unit row, error <= γ4·|t_b - t_a|_1 <= γ4·√3·|t_b -
+  // t_a|, which 2·γ6 of the computed difference's norm covers with its own roundings. Where the pair
+  // is placed does not enter, only where B lies relative to A: the same verdicts wherever the
+  // assembly is moved.
+  const double t_err = 2.0 * gamma(6) * (pose_b.translation() - pose_a.translation()).norm();
+  const double t_ab = relative_pose(pose_a, pose_b).translation().norm() + t_err;
   // Mapping a vertex v (|v| <= mag_b): R v + t, 3 products and 3 sums per component (γ4 of
   // |v| + |t_ab|), plus the rotation entries' own error times |v|_1 <= √3|v|.
-  double comp = gamma(4) * (mag_b + t_ab) + gamma(3) * std::sqrt(3.0) * mag_b + gamma(5) * (ta + tb);
+  double comp = gamma(4) * (mag_b + t_ab) + gamma(3) * std::sqrt(3.0) * mag_b + t_err;
   // R_aᵀ stands for R_a⁻¹: off by the defect, applied to B's points near A (within mag_a + mag_b of
   // A's origin wherever the faces can be close); likewise R_b's defect on |v|.
   comp += orthonormal_defect(pose_a) * (mag_a + mag_b) + orthonormal_defect(pose_b) * mag_b;

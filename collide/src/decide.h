@@ -19,10 +19,14 @@ struct Interval {
 
 // A computed bound r on the rounding between the triangle arithmetic and exact arithmetic on the
 // placed geometry, for an instance pair: mapping B's vertices (part-local magnitude <= mag_b) into
-// A's frame with pose_a⁻¹·pose_b composed in doubles, the rotations' deviation from orthonormal (as
+// A's frame with relative_pose (below) in doubles, the rotations' deviation from orthonormal (as
 // stored), the vertices' own evaluation on their surfaces, and triangle_distance's error (64·2^-53
 // of the pair's extent). Every term is a count of roundings times the magnitude it applies to.
 double pair_roundoff(const Pose& pose_a, const Pose& pose_b, double mag_a, double mag_b);
+
+// B's frame -> A's frame as the query computes it, (R_aᵀR_b, R_aᵀ(t_b - t_a)) in doubles: its
+// rounding depends on where B lies relative to A, not on how far the pair is from the origin.
+Pose relative_pose(const Pose& pose_a, const Pose& pose_b);
 
 // ε of a surface as the decision uses it: Surface::uncertainty, or when that is 0 the
 // single-precision representation bound 2^-24 of its part's largest coordinate magnitude; never below

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "decide.h"
+#include "cadclash/geometry.h"
 #include "surface_bvh.h"
 
 #include <array>
@@ -36,6 +37,10 @@ struct FaceView {
   const SurfaceBvh& bvh;
   const Outline* outline = nullptr;
 };
+
+// A box enclosing the exact face: Surface::aabb does for B-rep faces, but for a mesh it encloses the
+// triangles, which may lie up to the deflection inside the surface they stand for.
+inline Aabb own_box(const Surface& s) { return pad_box(s.aabb.isEmpty() ? mesh_aabb(s.mesh) : s.aabb, s.deflection); }
 
 // Step 1: the interval of the model's triangles, settled when it decides (certified and exact modes).
 Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask& t, const CollideOptions& o);

@@ -34,7 +34,7 @@ void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o
   const Model& model = s.model;
   const Instance& ia = model.instances[ip.a];
   const Instance& ib = model.instances[ip.b];
-  ip.t_ab = s.poses[ip.a].inverse(Eigen::Isometry) * s.poses[ip.b];
+  ip.t_ab = relative_pose(s.poses[ip.a], s.poses[ip.b]);
   ip.t_ba = ip.t_ab.inverse(Eigen::Isometry);
   if (o.decision != DecisionMode::Fast)
     ip.roundoff = pair_roundoff(s.poses[ip.a], s.poses[ip.b], s.part_norm[ia.part], s.part_norm[ib.part]);

@@ -24,8 +24,6 @@ using detail::build_surface_bvh;
 using detail::point_mesh_distance;
 using detail::SurfaceBvh;
 
-using Mat4L = Eigen::Matrix<long double, 4, 4>;
-
 Pose random_pose(std::mt19937_64& rng, double offset) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Vec3 axis(u(rng), u(rng), u(rng));
@@ -38,7 +36,7 @@ Pose random_pose(std::mt19937_64& rng, double offset) {
 
 // A's triangle lies in its plane z = 0; B's small triangle is placed (by its pose) above A's interior
 // at height h, so the exact distance of the placed triangles is B's lowest vertex height, computed
-// here in long double from the stored doubles (pose_a⁻¹ inverted exactly, not transposed).
+// here in long double from the stored doubles (R_a inverted, not transposed).
 TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
   std::mt19937_64 rng(7);
   const Vec3 a0(-50, -50, 0), a1(50, -50, 0), a2(0, 60, 0);
@@ -54,15 +52,18 @@ TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
       rel.linear() = Eigen::AngleAxisd(0.3 * (k % 7), Vec3::UnitZ()).toRotationMatrix();
       rel.translation() = Vec3(0.1 * (k % 5), -0.2, std::pow(10.0, hh(rng)));
       const Pose pb = pa * rel;  // B's pose as a user's assembly would store it: rounded doubles
-      const Pose t_ab = pa.inverse(Eigen::Isometry) * pb;
+      const Pose t_ab = detail::relative_pose(pa, pb);  // as the query maps B into its frame
       const double got = triangle_distance(a0, a1, a2, t_ab * b0, t_ab * b1, t_ab * b2);
-      const Mat4L ma = pa.matrix().cast<long double>(), mb = pb.matrix().cast<long double>();
-      const Mat4L rel_ld = ma.inverse() * mb;
+      // pose_a⁻¹·pose_b = (R_a⁻¹R_b, R_a⁻¹(t_b - t_a)): the difference of the stored translations is
+      // exact in long double, and R_a⁻¹ of a near-rotation is well conditioned (a 4x4 inverse with a
+      // 1e9 translation would itself be off by 1e-11).
+      using Mat3L = Eigen::Matrix<long double, 3, 3>;
+      using Vec3L = Eigen::Matrix<long double, 3, 1>;
+      const Mat3L ra_inv = Mat3L(pa.linear().cast<long double>()).inverse();
+      const Mat3L rel_r = ra_inv * pb.linear().cast<long double>();
+      const Vec3L rel_t = ra_inv * (pb.translation().cast<long double>() - pa.translation().cast<long double>());
       long double ref = 1e300L;
-      for (const Vec3& v : {b0, b1, b2}) {
-        const Eigen::Matrix<long double, 4, 1> p = rel_ld * Eigen::Matrix<long double, 4, 1>(v.x(), v.y(), v.z(), 1);
-        ref = std::min(ref, p(2));
-      }
+      for (const Vec3& v : {b0, b1, b2}) ref = std::min(ref, (rel_r * v.cast<long double>() + rel_t)(2));
       ASSERT_GT(ref, 0.0L);
       const double r = pair_roundoff(pa, pb, mag_a, mag_b);
       const double err = static_cast<double>(std::fabs(static_cast<long double>(got) - ref));
@@ -81,11 +82,17 @@ TEST(PairRoundoff, BoundsTheDistanceErrorUnderLargeRigidMotions) {
   std::printf("worst error / bound: %.3g\n", worst_ratio);
 }
 
-TEST(PairRoundoff, GrowsWithTheMagnitudes) {
+// It grows with the parts' magnitudes and with how far B lies from A, not with where the pair is:
+// two instances 1e6 mm from the origin get the bound they get at the origin.
+TEST(PairRoundoff, GrowsWithTheMagnitudesNotThePlacement) {
   const Pose id = Pose::Identity();
   Pose far = id;
   far.translation() = Vec3(1e6, 0, 0);
-  EXPECT_GT(pair_roundoff(far, far, 10, 10), pair_roundoff(id, id, 10, 10));
+  Pose farther = far;
+  farther.translation() = Vec3(2e6, 0, 0);
+  EXPECT_EQ(pair_roundoff(far, far, 10, 10), pair_roundoff(id, id, 10, 10));
+  EXPECT_EQ(pair_roundoff(far, farther, 10, 10), pair_roundoff(id, far, 10, 10));
+  EXPECT_GT(pair_roundoff(id, far, 10, 10), pair_roundoff(id, id, 10, 10));
   EXPECT_GT(pair_roundoff(id, id, 1e3, 1e3), pair_roundoff(id, id, 10, 10));
   EXPECT_GT(pair_roundoff(id, id, 1, 1), 0.0);
 }
