@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <memory>
@@ -46,8 +47,33 @@ using truth::GroundTruth;
 using truth::PairKey;
 
 constexpr double kDeflection = 0.1;  // the default tessellation
-constexpr double kTolerances[] = {1e-4, 0.025};
-constexpr DecisionMode kModes[] = {DecisionMode::Certified, DecisionMode::Exact};
+
+// Under a sanitizer (scripts/test.sh's ASan+UBSan pass; scripts/tsan.sh) each test runs a reduced
+// form: the tighter tolerance and the certified mode only, one distance of each family of moved
+// variants, fewer copies and motions. The Release pass runs them whole.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define CADCLASH_REDUCED_TRUTH 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define CADCLASH_REDUCED_TRUTH 1
+#endif
+#endif
+#ifdef CADCLASH_REDUCED_TRUTH
+constexpr bool kReduced = true;
+#else
+constexpr bool kReduced = false;
+#endif
+
+// `all`, or under a sanitizer only `reduced`.
+template <class T>
+std::vector<T> pick(std::initializer_list<T> all, std::initializer_list<T> reduced) {
+  return kReduced ? std::vector<T>(reduced) : std::vector<T>(all);
+}
+
+const std::vector<double> kTolerances = pick({1e-4, 0.025}, {1e-4});
+const std::vector<DecisionMode> kModes = pick({DecisionMode::Certified, DecisionMode::Exact}, {DecisionMode::Certified});
+// How far the moved variants of as1 move one instance.
+const std::vector<double> kMovedBy = pick({0.005, 0.02, 0.05}, {0.02});
 
 std::string external_dir() { return std::string(CADCLASH_DATA_DIR) + "/external"; }
 
@@ -190,7 +216,7 @@ std::size_t expect_matches_truth(const std::string& scene, const Model& m, const
 // Both modes at both tolerances; the truth is measured once at the larger tolerance.
 void expect_scene_matches_truth(const std::string& name, Model& model) {
   const auto t0 = std::chrono::steady_clock::now();
-  const GroundTruth wide = truth::compute_ground_truth(model, kTolerances[1], 0);
+  const GroundTruth wide = truth::compute_ground_truth(model, kTolerances.back(), 0);
   std::printf("[ truth    ] %s: %zu candidate face pairs measured in %.2f s (%llu failed)\n", name.c_str(),
               wide.measured.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
               static_cast<unsigned long long>(wide.failed));
@@ -234,7 +260,7 @@ TEST(TruthScenes, As1VariantsMoveOneInstanceByTheirDistance) {
   REQUIRE_SAMPLES();
   ASSERT_TRUE(as1().ok());
   for (const auto& [moved, partner] : {std::pair{kNut, kPlate}, std::pair{kPlate, kBracket}})
-    for (double d : {0.005, 0.02, 0.05}) {
+    for (double d : kMovedBy) {
       const BuiltScene v = truth::as1_moved(as1(), moved, partner, d);
       const truth::Placement& p = v.placements.at(0);
       const double measured = truth::instance_distance(v.model, p.instance, p.partner, 1.0);
@@ -256,7 +282,7 @@ TEST(CertifiedTruth, As1AsRead) {
 
 TEST(CertifiedTruth, As1NutMovedOffThePlate) {
   REQUIRE_SAMPLES();
-  for (double d : {0.005, 0.02, 0.05}) {
+  for (double d : kMovedBy) {
     BuiltScene v = truth::as1_moved(as1(), kNut, kPlate, d);
     expect_scene_matches_truth(v.name, v.model);
   }
@@ -264,7 +290,7 @@ TEST(CertifiedTruth, As1NutMovedOffThePlate) {
 
 TEST(CertifiedTruth, As1PlateMovedOffABracket) {
   REQUIRE_SAMPLES();
-  for (double d : {0.005, 0.02, 0.05}) {
+  for (double d : kMovedBy) {
     BuiltScene v = truth::as1_moved(as1(), kPlate, kBracket, d);
     expect_scene_matches_truth(v.name, v.model);
   }
@@ -294,7 +320,7 @@ TEST(CertifiedTruth, As1BracketWithdrawnOnADriftingPath) {
   REQUIRE_SAMPLES();
   const std::set<std::int64_t> shank = {673, 705};
   const std::set<std::int64_t> hole_walls = {1906, 2002, 1954, 2050, 1970, 2066};
-  for (double lift : {2.0, 10.0}) {
+  for (double lift : pick({2.0, 10.0}, {2.0})) {
     Model m = drifting_bracket(lift);
     const std::string name = "as1, L-bracket assembly lifted " + std::to_string(lift) + " mm, drifting";
     const GroundTruth t = truth::compute_ground_truth(m, 0.0, 0);
@@ -428,7 +454,7 @@ TEST(Invariance, As1UnderARigidMotionOfTheWholeScene) {
     const Rows expected = rows(base, r0.report);
     std::printf("[ invariant] as1 as read, tolerance %g: %zu rows, %.1f ms\n[ decided  ]   %s\n", tol, expected.rows.size(),
                 r0.seconds * 1e3, counters_text(r0.report.counters).c_str());
-    for (double distance : {1e3, 1e6}) {
+    for (double distance : pick({1e3, 1e6}, {1e6})) {
       Model moved = as1().model;
       truth::move_scene(moved, skew_motion(distance));
       const Checked r = check(moved, DecisionMode::Certified, tol);
@@ -451,7 +477,7 @@ TEST(Invariance, TheDriftingBracketUnderARigidMotionOfTheWholeScene) {
   Model base = drifting_bracket(2.0);
   const Checked r0 = check(base, DecisionMode::Certified, 0.0);  // rows point into its report
   const Rows expected = rows(base, r0.report);
-  for (double distance : {1e3, 1e6}) {
+  for (double distance : pick({1e3, 1e6}, {1e6})) {
     Model moved = drifting_bracket(2.0);
     truth::move_scene(moved, skew_motion(distance));
     const Checked r = check(moved, DecisionMode::Certified, 0.0);
@@ -465,8 +491,8 @@ TEST(Invariance, TheDriftingBracketUnderARigidMotionOfTheWholeScene) {
 TEST(Invariance, FiftyCopiesOfAs1ReportCopyZerosPairs) {
   REQUIRE_SAMPLES();
   ASSERT_TRUE(as1().ok());
-  constexpr int kCopies = 50;
-  const double tol = kTolerances[1];
+  const int kCopies = kReduced ? 4 : 50;
+  const double tol = kTolerances.back();
   Model one = as1().model;
   const Report one_report = check(one, DecisionMode::Certified, tol).report;
   const Rows expected = rows(one, one_report);
