@@ -3,16 +3,9 @@
 // entry ("=>[0:1:1:9]") and its leaf product after the shape type ("SOLID"). The check reads
 // "/board/D15 (LED_D5.0mm)", not "/board/D15/=>[0:1:1:9] (SOLID)".
 #include "cadclash/import.h"
-#include "../test_temp.h"
+#include "xcaf_test_doc.h"
 
 #include <BRepPrimAPI_MakeBox.hxx>
-#include <Interface_Static.hxx>
-#include <STEPCAFControl_Writer.hxx>
-#include <TDataStd_Name.hxx>
-#include <TDocStd_Document.hxx>
-#include <XCAFApp_Application.hxx>
-#include <XCAFDoc_DocumentTool.hxx>
-#include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Trsf.hxx>
 
 #include <gtest/gtest.h>
@@ -29,34 +22,23 @@ namespace {
 // board → D15 → model "LED_D5.0mm" → one unnamed occurrence of an unnamed box; board → R1 →
 // model "R_0603" → two unnamed occurrences of two boxes (two children: their levels stay).
 std::string write_kicad_like_board() {
-  Handle(TDocStd_Document) doc;
-  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-  auto name = [](const TDF_Label& l, const char* n) { TDataStd_Name::Set(l, TCollection_ExtendedString(n)); };
+  testing::XcafTestDoc doc;
+  const Handle(XCAFDoc_ShapeTool)& tool = doc.tool();
+  const auto name = testing::XcafTestDoc::name;
   auto at = [](double x) {
     gp_Trsf t;
     t.SetTranslation(gp_Vec(x, 0, 0));
     return TopLoc_Location(t);
   };
-  const TDF_Label board = tool->NewShape();
-  name(board, "board");
-  const TDF_Label led = tool->NewShape();
-  name(led, "LED_D5.0mm");
+  const TDF_Label board = name(tool->NewShape(), "board");
+  const TDF_Label led = name(tool->NewShape(), "LED_D5.0mm");
   tool->AddComponent(led, tool->AddShape(BRepPrimAPI_MakeBox(5, 5, 8).Shape(), Standard_False), TopLoc_Location());
-  const TDF_Label resistor = tool->NewShape();
-  name(resistor, "R_0603");
+  const TDF_Label resistor = name(tool->NewShape(), "R_0603");
   tool->AddComponent(resistor, tool->AddShape(BRepPrimAPI_MakeBox(1.6, 0.8, 0.5).Shape(), Standard_False), TopLoc_Location());
   tool->AddComponent(resistor, tool->AddShape(BRepPrimAPI_MakeBox(0.3, 0.8, 0.5).Shape(), Standard_False), at(2));
   name(tool->AddComponent(board, led, at(0)), "D15");
   name(tool->AddComponent(board, resistor, at(20)), "R1");
-  tool->UpdateAssemblies();
-  const std::string path = testing::scratch_dir() + "/kicad_like_board.step";
-  STEPCAFControl_Writer writer;
-  writer.SetNameMode(Standard_True);
-  EXPECT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
-  EXPECT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
-  XCAFApp_Application::GetApplication()->Close(doc);
-  return path;
+  return doc.write_step("kicad_like_board.step");
 }
 
 TEST(CadNames, GenericOnlyChildrenAddNoLevelAndPartsTakeTheModelsName) {

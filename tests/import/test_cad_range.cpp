@@ -3,15 +3,9 @@
 // error naming its path and the offset; the rest of the file is kept.
 #include "cadclash/collide.h"
 #include "cadclash/import.h"
-#include "../test_temp.h"
+#include "xcaf_test_doc.h"
 
 #include <BRepPrimAPI_MakeBox.hxx>
-#include <STEPCAFControl_Writer.hxx>
-#include <TDataStd_Name.hxx>
-#include <TDocStd_Document.hxx>
-#include <XCAFApp_Application.hxx>
-#include <XCAFDoc_DocumentTool.hxx>
-#include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
@@ -26,29 +20,19 @@ namespace {
 // assembly → plate (a 10 mm box at the origin), far (a 1 mm box at x = 1e200), and a second
 // occurrence of the plate translated by 1e200 in z.
 std::string write_far_assembly() {
-  Handle(TDocStd_Document) doc;
-  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-  auto name = [](const TDF_Label& l, const char* n) { TDataStd_Name::Set(l, TCollection_ExtendedString(n)); };
-  const TDF_Label root = tool->NewShape();
-  name(root, "assembly");
-  const TDF_Label plate = tool->AddShape(BRepPrimAPI_MakeBox(10, 10, 1).Shape(), Standard_False);
-  name(plate, "plate");
-  const TDF_Label far = tool->AddShape(BRepPrimAPI_MakeBox(gp_Pnt(1e200, 0, 0), 1, 1, 1).Shape(), Standard_False);
-  name(far, "far");
+  testing::XcafTestDoc doc;
+  const Handle(XCAFDoc_ShapeTool)& tool = doc.tool();
+  const auto name = testing::XcafTestDoc::name;
+  const TDF_Label root = name(tool->NewShape(), "assembly");
+  const TDF_Label plate = name(tool->AddShape(BRepPrimAPI_MakeBox(10, 10, 1).Shape(), Standard_False), "plate");
+  const TDF_Label far =
+      name(tool->AddShape(BRepPrimAPI_MakeBox(gp_Pnt(1e200, 0, 0), 1, 1, 1).Shape(), Standard_False), "far");
   name(tool->AddComponent(root, plate, TopLoc_Location()), "plate");
   name(tool->AddComponent(root, far, TopLoc_Location()), "far");
   gp_Trsf up;
   up.SetTranslation(gp_Vec(0, 0, 1e200));
   name(tool->AddComponent(root, plate, TopLoc_Location(up)), "lifted");
-  tool->UpdateAssemblies();
-  const std::string path = testing::scratch_dir() + "/far_assembly.step";
-  STEPCAFControl_Writer writer;
-  writer.SetNameMode(Standard_True);
-  EXPECT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
-  EXPECT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
-  XCAFApp_Application::GetApplication()->Close(doc);
-  return path;
+  return doc.write_step("far_assembly.step");
 }
 
 std::string messages(const ImportResult& r) {
