@@ -48,6 +48,8 @@ void print_table(const Model& m, const Report& r, const ClashReview& review, boo
     if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
     if (p.contact == ContactClass::Undecided)
       os << "  exact distance in [" << fmt(p.distance_lo) << ", " << fmt(p.distance_hi) << "]";
+    if (p.within == ContactWithin::ModelUncertainty)
+      os << "  only within the model uncertainty (eps " << fmt(p.uncertainty_a) << " + " << fmt(p.uncertainty_b) << ")";
     os << '\n';
   }
 }
@@ -59,6 +61,12 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
   if (n.c[0] > 0) os << "\n(distance of a penetrating pair: minus its crossing-depth estimate)\n";
   os << "\n" << r.pairs.size() << " reported pairs: " << n.c[0] << " penetrating, " << n.c[1] << " touching, "
      << n.c[2] << " clearance, " << n.c[3] << " containment, " << n.c[4] << " undecided\n";
+  std::size_t within[3] = {0, 0, 0};
+  for (const SurfacePairResult& p : r.pairs)
+    if (p.contact == ContactClass::Penetrating || p.contact == ContactClass::Touching) ++within[static_cast<int>(p.within)];
+  if (n.c[0] + n.c[1] > 0)
+    os << "contacts within the tolerance " << within[1] << ", only within the model uncertainty " << within[2]
+       << ", either " << within[0] << '\n';
   os << "decided by: mesh " << c.decided_mesh << ", mesh-exact " << c.decided_mesh_exact << ", analytic "
      << c.decided_analytic << ", refined " << c.decided_refined << ", exact " << c.decided_exact << ", undecided "
      << c.undecided << "; ambiguous " << c.ambiguous_pairs << ", faces refined " << c.refined_surfaces

@@ -26,6 +26,15 @@ const char* decided_by_name(DecidedBy d) {
   return "unknown";
 }
 
+const char* contact_within_name(ContactWithin w) {
+  switch (w) {
+    case ContactWithin::Unknown: return "unknown";
+    case ContactWithin::Tolerance: return "tolerance";
+    case ContactWithin::ModelUncertainty: return "model uncertainty";
+  }
+  return "unknown";
+}
+
 const char* decision_mode_name(DecisionMode m) {
   switch (m) {
     case DecisionMode::Certified: return "certified";

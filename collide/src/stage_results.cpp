@@ -35,6 +35,18 @@ void release_past_cutoff(SceneData& s, const QueryState& q) {
   s.surfaces_changed(revision, released);
 }
 
+// The ε each side's decision used, and whether the contact needs it (ContactWithin).
+void note_uncertainty(const SceneData& s, const CollideOptions& o, SurfacePairResult& p) {
+  if (p.contact == ContactClass::Containment) return;
+  p.uncertainty_a = s.eps[p.surface_a];
+  p.uncertainty_b = s.eps[p.surface_b];
+  if (o.decision == DecisionMode::Fast) return;
+  if (p.contact == ContactClass::Penetrating || (p.contact == ContactClass::Touching && p.distance_hi <= o.tolerance))
+    p.within = ContactWithin::Tolerance;
+  else if (p.contact == ContactClass::Touching && p.distance_lo > o.tolerance)
+    p.within = ContactWithin::ModelUncertainty;
+}
+
 }  // namespace
 
 void results_stage(SceneData& s, QueryState& q) {
@@ -42,7 +54,7 @@ void results_stage(SceneData& s, QueryState& q) {
   CollideCounters& total = report.counters;
   report.pairs.reserve(report.pairs.size() + q.results.size());
   for (std::size_t i = 0; i < q.results.size(); ++i)
-    if (q.result_pair[i] < q.cutoff) report.pairs.push_back(std::move(q.results[i]));
+    if (q.result_pair[i] < q.cutoff) note_uncertainty(s, q.o, report.pairs.emplace_back(std::move(q.results[i])));
   for (std::uint32_t k = 0; k < q.pairs.size(); ++k) {
     if (k >= q.cutoff || q.pair_cut[k]) report.unexamined_pairs.push_back({q.pairs[k].a, q.pairs[k].b});
     if (k >= q.cutoff) continue;

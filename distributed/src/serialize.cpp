@@ -38,7 +38,8 @@ Diagnostic diagnostic_from(const json& j) {
 json result_to(const SurfacePairResult& r) {
   json j = {r.instance_a, r.instance_b, r.surface_a, r.surface_b, static_cast<int>(r.contact), r.intersecting,
             r.distance, r.penetration, static_cast<int>(r.decided_by), r.distance_lo, r.distance_hi,
-            r.exact_distance ? json(*r.exact_distance) : json(nullptr), r.triangle_pairs};
+            r.exact_distance ? json(*r.exact_distance) : json(nullptr), r.triangle_pairs, r.uncertainty_a,
+            r.uncertainty_b, static_cast<int>(r.within)};
   return j;
 }
 SurfacePairResult result_from(const json& j) {
@@ -56,6 +57,9 @@ SurfacePairResult result_from(const json& j) {
   r.distance_hi = j.at(10).get<double>();
   if (!j.at(11).is_null()) r.exact_distance = j.at(11).get<double>();
   r.triangle_pairs = j.at(12).get<std::vector<std::array<std::uint32_t, 2>>>();
+  r.uncertainty_a = j.at(13).get<double>();
+  r.uncertainty_b = j.at(14).get<double>();
+  r.within = static_cast<ContactWithin>(j.at(15).get<int>());
   return r;
 }
 

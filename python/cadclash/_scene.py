@@ -23,7 +23,7 @@ def _report(model: Model, raw, settings=None) -> Report:
     raw_pairs, counters, timings, diags, complete, stopped_by, unexamined, memory_charged, model_bytes, record = raw
     paths, part_names, surface_names, step_ids = model._names()
     pairs = []
-    for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri, by, lo, hi in raw_pairs:
+    for ia, ib, sa, sb, contact, intersecting, distance, penetration, exact, tri, by, lo, hi, within in raw_pairs:
         whole = sa < 0  # containment: whole instances
         pairs.append(PairResult(
             contact=contact, instance_a=paths[ia], instance_b=paths[ib], part_a=part_names[ia],
@@ -32,7 +32,7 @@ def _report(model: Model, raw, settings=None) -> Report:
             step_id_b=None if whole else step_ids[sb], intersecting=intersecting, distance=distance,
             penetration=penetration, exact_distance=exact, instance_id_a=ia, instance_id_b=ib,
             surface_id_a=None if whole else sa, surface_id_b=None if whole else sb, triangle_pairs=tri,
-            decided_by=by, distance_lo=lo, distance_hi=hi))
+            decided_by=by, distance_lo=lo, distance_hi=hi, contact_within=within))
     run_diagnostics = _diagnostics(diags)
     document = None
     if settings is not None:  # as `cadclash check --json` assembles it

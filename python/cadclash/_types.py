@@ -134,6 +134,9 @@ class PairResult:
     decided_by: str = "mesh"
     distance_lo: float = 0.0
     distance_hi: float = 0.0
+    # Penetrating and touching pairs: "tolerance" when the tolerance alone holds the contact, "model
+    # uncertainty" when only the faces' ε does; None when the interval cannot tell (collide.h, ContactWithin).
+    contact_within: Optional[str] = None
 
     @property
     def key(self) -> tuple:
@@ -315,6 +318,11 @@ class Report:
             if p.contact != "containment":
                 by[p.decided_by] += 1
         out["decided_by"] = by
+        within = {"unknown": 0, "tolerance": 0, "model uncertainty": 0}
+        for p in self.pairs:
+            if p.contact in ("penetrating", "touching"):
+                within[p.contact_within or "unknown"] += 1
+        out["contact_within"] = within
         return out
 
 
@@ -326,13 +334,14 @@ def _query_from_document(raw, diagnostics: List[Diagnostic], complete: bool, doc
 
 
 def _pair_from_document(raw) -> PairResult:
-    contact, by, lo, hi, intersecting, distance, penetration, exact, tri, a, b = raw
+    contact, by, lo, hi, intersecting, distance, penetration, exact, tri, a, b, within = raw
     (instance_a, part_a, surface_a, step_a), (instance_b, part_b, surface_b, step_b) = a, b
     return PairResult(
         contact=contact, instance_a=instance_a, instance_b=instance_b, part_a=part_a, part_b=part_b,
         surface_a=surface_a, surface_b=surface_b, step_id_a=step_a, step_id_b=step_b, intersecting=intersecting,
         distance=distance, penetration=penetration, exact_distance=exact, instance_id_a=None, instance_id_b=None,
-        surface_id_a=None, surface_id_b=None, triangle_pairs=tri, decided_by=by, distance_lo=lo, distance_hi=hi)
+        surface_id_a=None, surface_id_b=None, triangle_pairs=tri, decided_by=by, distance_lo=lo, distance_hi=hi,
+        contact_within=within)
 
 
 @dataclass(frozen=True)

@@ -93,6 +93,10 @@ pyb::dict timings_to_dict(const CollideTimings& t) {
   return d;
 }
 
+pyb::object within_or_none(ContactWithin w) {
+  return w == ContactWithin::Unknown ? pyb::object(pyb::none()) : pyb::object(pyb::str(contact_within_name(w)));
+}
+
 pyb::array_t<std::uint32_t> triangle_pairs_array(const std::vector<std::array<std::uint32_t, 2>>& pairs) {
   pyb::array_t<std::uint32_t> tri({static_cast<pyb::ssize_t>(pairs.size()), pyb::ssize_t{2}});
   if (!pairs.empty()) std::memcpy(tri.mutable_data(), pairs.data(), pairs.size() * sizeof(pairs[0]));
@@ -112,7 +116,8 @@ pyb::tuple report_to_tuple(const Report& report, QueryReport record) {
     pyb::object exact = p.exact_distance ? pyb::object(pyb::float_(*p.exact_distance)) : pyb::object(pyb::none());
     pairs.append(pyb::make_tuple(p.instance_a, p.instance_b, id_or_minus_one(p.surface_a), id_or_minus_one(p.surface_b),
                                  contact_class_name(p.contact), p.intersecting, p.distance, p.penetration, exact,
-                                 tri, decided_by_name(p.decided_by), p.distance_lo, p.distance_hi));
+                                 tri, decided_by_name(p.decided_by), p.distance_lo, p.distance_hi,
+                                 within_or_none(p.within)));
   }
   pyb::list unexamined;
   for (const auto& [a, b] : report.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));

@@ -28,7 +28,8 @@ pyb::list diagnostics_to_list(std::span<const Diagnostic> ds);
 // (pairs, counters, timings, diagnostics, complete, stopped_by, unexamined_pairs [(a, b)],
 //  memory_charged, record) with each pair as
 // (instance_a, instance_b, surface_a|-1, surface_b|-1, class, intersecting, distance, penetration,
-//  exact_distance|None, triangle_pairs (k x 2 uint32 array), decided_by, distance_lo, distance_hi),
+//  exact_distance|None, triangle_pairs (k x 2 uint32 array), decided_by, distance_lo, distance_hi,
+//  contact_within|None),
 // and `record` the same query as the JSON report holds it (query_report(model, report), made under
 // the model's lock: surface deflections change when a running query tessellates).
 // Builds Python objects: needs the GIL.
@@ -39,6 +40,9 @@ pyb::dict counters_to_dict(const CollideCounters& c);
 pyb::dict timings_to_dict(const CollideTimings& t);
 // {triangles, vertices, hierarchies, instances, triangle_count}: bytes per component of SceneMemory.
 pyb::dict model_memory_to_dict(const SceneMemory& m);
+
+// contact_within_name(w), None for ContactWithin::Unknown.
+pyb::object within_or_none(ContactWithin w);
 
 // A k x 2 uint32 array (a copy) of triangle index pairs.
 pyb::array_t<std::uint32_t> triangle_pairs_array(const std::vector<std::array<std::uint32_t, 2>>& pairs);

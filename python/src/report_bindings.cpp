@@ -34,14 +34,15 @@ pyb::object side_tuple(const ReportSide& s) {
 
 // (pairs, counters, timings|None, stopped_by, unexamined [(a, b)], memory_charged, model bytes) with each pair
 // (class, decided_by, lo, hi, intersecting, distance, penetration, exact|None, triangle_pairs,
-//  (instance, part, surface|None, step_id|None) of a, the same of b).
+//  (instance, part, surface|None, step_id|None) of a, the same of b, contact_within|None).
 pyb::tuple query_tuple(const QueryReport& q) {
   pyb::list pairs;
   for (const ReportPair& p : q.pairs) {
     pyb::object exact = p.exact_distance ? pyb::object(pyb::float_(*p.exact_distance)) : pyb::object(pyb::none());
     pairs.append(pyb::make_tuple(contact_class_name(p.contact), decided_by_name(p.decided_by), p.distance_lo,
                                  p.distance_hi, p.intersecting, p.distance, p.penetration, exact,
-                                 triangle_pairs_array(p.triangle_pairs), side_tuple(p.a), side_tuple(p.b)));
+                                 triangle_pairs_array(p.triangle_pairs), side_tuple(p.a), side_tuple(p.b),
+                                 within_or_none(p.within)));
   }
   pyb::list unexamined;
   for (const auto& [a, b] : q.unexamined_pairs) unexamined.append(pyb::make_tuple(a, b));

@@ -41,6 +41,12 @@ ReportSide side(const Model& m, InstanceId i, SurfaceId s) {
   return out;
 }
 
+ReportSide side(const Model& m, InstanceId i, SurfaceId s, double uncertainty) {
+  ReportSide out = side(m, i, s);
+  out.uncertainty = uncertainty;
+  return out;
+}
+
 double or_infinity(double v) { return std::isfinite(v) ? v : std::numeric_limits<double>::infinity(); }
 
 nlohmann::json side_json(const ReportSide& s) {
@@ -52,6 +58,7 @@ nlohmann::json side_json(const ReportSide& s) {
   if (s.step_id >= 0) j["step_id"] = s.step_id;
   if (!s.source_name.empty()) j["source_name"] = s.source_name;
   j["deflection"] = s.deflection;
+  j["uncertainty"] = s.uncertainty;
   return j;
 }
 
@@ -108,8 +115,9 @@ QueryReport query_report(const Model& model, const Report& r) {
   q.pairs.reserve(r.pairs.size());
   for (const SurfacePairResult& p : r.pairs) {
     ReportPair out;
-    out.a = side(model, p.instance_a, p.surface_a);
-    out.b = side(model, p.instance_b, p.surface_b);
+    out.a = side(model, p.instance_a, p.surface_a, p.uncertainty_a);
+    out.b = side(model, p.instance_b, p.surface_b, p.uncertainty_b);
+    out.within = p.within;
     out.contact = p.contact;
     out.decided_by = p.decided_by;
     out.distance_lo = or_infinity(p.distance_lo);
@@ -135,8 +143,11 @@ nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 nlohmann::json summary_json(const std::vector<ReportPair>& pairs) {
   std::array<std::size_t, EnumNames<ContactClass>::values.size()> by_class{};
   std::array<std::size_t, EnumNames<DecidedBy>::values.size()> by_decision{};
+  std::array<std::size_t, EnumNames<ContactWithin>::values.size()> by_within{};
   for (const ReportPair& p : pairs) {
     ++by_class[static_cast<std::size_t>(p.contact)];
+    if (p.contact == ContactClass::Penetrating || p.contact == ContactClass::Touching)
+      ++by_within[static_cast<std::size_t>(p.within)];
     if (p.contact != ContactClass::Containment) ++by_decision[static_cast<std::size_t>(p.decided_by)];
   }
   nlohmann::json j{{"pairs", pairs.size()}};
@@ -144,6 +155,10 @@ nlohmann::json summary_json(const std::vector<ReportPair>& pairs) {
   nlohmann::json by = nlohmann::json::object();
   for (DecidedBy d : EnumNames<DecidedBy>::values) by[decided_by_name(d)] = by_decision[static_cast<std::size_t>(d)];
   j["decided_by"] = std::move(by);
+  nlohmann::json within = nlohmann::json::object();
+  for (ContactWithin w : EnumNames<ContactWithin>::values)
+    within[contact_within_name(w)] = by_within[static_cast<std::size_t>(w)];
+  j["contact_within"] = std::move(within);
   return j;
 }
 
@@ -163,6 +178,8 @@ nlohmann::json pair_json(const ReportPair& p, bool sides) {
   nlohmann::json j{{"class", contact_class_name(p.contact)},
                    {"decided_by", decided_by_name(p.decided_by)},
                    {"distance_interval", {number_or_null(p.distance_lo), number_or_null(p.distance_hi)}},
+                   {"contact_within", p.within == ContactWithin::Unknown ? nlohmann::json(nullptr)
+                                                                         : nlohmann::json(contact_within_name(p.within))},
                    {"intersecting", p.intersecting},
                    {"distance", number_or_null(p.distance)},
                    {"penetration", p.penetration}};

@@ -161,3 +161,56 @@ TEST(SupportedRange, TrajectoryTranslationsOutsideItAreErrors) {
 
 }  // namespace
 }  // namespace cadclash
+
+namespace cadclash {
+namespace {
+
+// Two one-triangle faces with ε = 0.01 mm each: B's lowest vertex `gap` above A's interior (a
+// negative gap crosses A).
+Model banded_pair(double gap) {
+  Model m;
+  add_part(m, "a", {triangle("a", Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0))});
+  add_part(m, "b", {triangle("b", Vec3(0.25, 0.25, gap), Vec3(0.25, 0.25, 1), Vec3(1.5, 1.5, 1))});
+  for (Surface& s : m.surfaces) s.uncertainty = 0.01;
+  add_instance(m, "/a", 0);
+  add_instance(m, "/b", 1);
+  return m;
+}
+
+// A contact says whether the tolerance alone holds it or only the model uncertainty does
+// (collide.h, ContactWithin), with the ε each side used.
+TEST(ContactWithin, ToleranceAloneOrOnlyTheModelUncertainty) {
+  CollideOptions o;
+  auto only = [&](double gap, double tolerance) {
+    Model m = banded_pair(gap);
+    o.tolerance = tolerance;
+    const Report r = collide(m, 0, 1, o);
+    EXPECT_EQ(r.pairs.size(), 1u) << gap << " " << tolerance;
+    return r.pairs.empty() ? SurfacePairResult{} : r.pairs[0];
+  };
+  SurfacePairResult p = only(0.015, 0.0);  // 0.015 > tolerance 0, <= T = 0.02
+  EXPECT_EQ(p.contact, ContactClass::Touching);
+  EXPECT_EQ(p.within, ContactWithin::ModelUncertainty);
+  EXPECT_EQ(p.uncertainty_a, 0.01);
+  EXPECT_EQ(p.uncertainty_b, 0.01);
+  p = only(0.015, 0.016);  // within the tolerance itself
+  EXPECT_EQ(p.contact, ContactClass::Touching);
+  EXPECT_EQ(p.within, ContactWithin::Tolerance);
+  p = only(0.0, 0.001);  // exact contact: d* within the rounding r of 0
+  EXPECT_EQ(p.within, ContactWithin::Tolerance);
+  p = only(0.0, 0.0);  // ... which tolerance 0 cannot be shown to hold: either
+  EXPECT_EQ(p.contact, ContactClass::Touching);
+  EXPECT_EQ(p.within, ContactWithin::Unknown);
+  p = only(-0.5, 0.0);  // crossing
+  EXPECT_EQ(p.contact, ContactClass::Penetrating);
+  EXPECT_EQ(p.within, ContactWithin::Tolerance);
+  o.decision = DecisionMode::Fast;  // the triangles' band: ε plays no part
+  p = only(0.0, 0.0);
+  EXPECT_EQ(p.within, ContactWithin::Unknown);
+  o.decision = DecisionMode::Certified;
+  Model apart = banded_pair(0.03);
+  EXPECT_TRUE(collide(apart, 0, 1).pairs.empty());
+}
+
+}  // namespace
+}  // namespace cadclash

@@ -137,7 +137,8 @@ def test_a_report_built_by_hand_has_no_document():
 def test_names_come_from_the_library():
     assert cadclash.Report([], cadclash.Counters(), cadclash.Timings(), []).summary() == {
         "pairs": 0, "penetrating": 0, "touching": 0, "clearance": 0, "containment": 0, "undecided": 0,
-        "decided_by": {"mesh": 0, "mesh-exact": 0, "analytic": 0, "refined": 0, "exact": 0, "undecided": 0}}
+        "decided_by": {"mesh": 0, "mesh-exact": 0, "analytic": 0, "refined": 0, "exact": 0, "undecided": 0},
+        "contact_within": {"unknown": 0, "tolerance": 0, "model uncertainty": 0}}
     assert len(vars(cadclash.Counters())) == 24
 
 

@@ -85,7 +85,7 @@ TEST(CheckCli, TableAndJsonReport) {
 // --fast and --exact exclude each other; the modes are recorded; on meshes all three agree.
 TEST(CheckCli, DecisionModes) {
   EXPECT_EQ(run("check " + boxes() + " --fast --exact").code, 2);
-  nlohmann::json summary;
+  nlohmann::json summary, within;
   for (const char* mode : {"--fast", "--exact", ""}) {
     const std::string json = tmp(std::string("mode") + mode + ".json");
     const Proc r = run("check " + boxes() + " " + mode + " --clearance 0.6 --no-timings --json " + json);
@@ -94,6 +94,18 @@ TEST(CheckCli, DecisionModes) {
     EXPECT_EQ(j["settings"]["decision"], *mode == 0 ? "certified" : std::string(mode + 2));
     nlohmann::json counts = j["summary"];
     counts.erase("decided_by");
+    // Whether the tolerance alone holds a contact: the fast mode uses no ε and never says.
+    const nlohmann::json w = counts["contact_within"];
+    counts.erase("contact_within");
+    if (*mode != 0 && std::string(mode) == "--fast") {
+      EXPECT_EQ(w["tolerance"], 0);
+      EXPECT_EQ(w["model uncertainty"], 0);
+    } else if (within.is_null()) {
+      within = w;
+      EXPECT_GT(w["tolerance"].get<int>(), 0);  // the penetrating pairs at least
+    } else {
+      EXPECT_EQ(w, within) << mode;
+    }
     if (summary.is_null()) summary = counts;
     else EXPECT_EQ(counts, summary) << mode;
   }

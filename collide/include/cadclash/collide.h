@@ -146,6 +146,15 @@ enum class DecidedBy : std::uint8_t {
 
 // Returns "mesh", "mesh-exact", "analytic", "refined", "exact" or "undecided".
 const char* decided_by_name(DecidedBy d);
+
+// Whether a contact holds within the tolerance alone, or only because of the model uncertainty
+// (T = tolerance + εa + εb; docs/report-schema.md, "Classes"), from the pair's proven interval of the
+// exact distance: Tolerance when its top is at most the tolerance (penetrating pairs always),
+// ModelUncertainty when its bottom is above it, Unknown when the interval straddles it, for pairs
+// that are not contacts, and in the fast mode (which does not use ε).
+enum class ContactWithin : std::uint8_t { Unknown, Tolerance, ModelUncertainty };
+// Returns "unknown", "tolerance" or "model uncertainty".
+const char* contact_within_name(ContactWithin w);
 // Returns "certified", "fast" or "exact".
 const char* decision_mode_name(DecisionMode m);
 
@@ -312,6 +321,10 @@ struct SurfacePairResult {
   // Bounds on the exact face distance d* from the evidence that decided the pair (see "Certified
   // decisions"); [d*, d*] when the exact distance was computed. Containment: [distance, distance].
   double distance_lo = 0.0, distance_hi = 0.0;
+  // ε of each surface as the decision used it (Surface::uncertainty, or 2^-24 of its part's largest
+  // coordinate when that is 0, never below kMinUncertainty); 0 for Containment.
+  double uncertainty_a = 0.0, uncertainty_b = 0.0;
+  ContactWithin within = ContactWithin::Unknown;  // see ContactWithin
   // SurfaceSource::exact_distance when the decision asked for it (exact step; DecisionMode::Exact asks
   // for every pair with exact geometry); a value > max(T, clearance) means "farther than that". In
   // the certified mode the search stops at the first two points within T: a value <= T there is an

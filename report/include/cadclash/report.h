@@ -53,6 +53,10 @@ template <> struct EnumNames<DecidedBy> {
                                      DecidedBy::Refined, DecidedBy::Exact,     DecidedBy::Undecided};
   static const char* name(DecidedBy d) { return decided_by_name(d); }
 };
+template <> struct EnumNames<ContactWithin> {
+  static constexpr std::array values{ContactWithin::Unknown, ContactWithin::Tolerance, ContactWithin::ModelUncertainty};
+  static const char* name(ContactWithin w) { return contact_within_name(w); }
+};
 template <> struct EnumNames<DecisionMode> {
   static constexpr std::array values{DecisionMode::Certified, DecisionMode::Fast, DecisionMode::Exact};
   static const char* name(DecisionMode m) { return decision_mode_name(m); }
@@ -176,6 +180,7 @@ struct ReportSide {
   std::int64_t step_id = -1;  // < 0: not written
   std::string source_name;    // empty: not written
   double deflection = 0.0;
+  double uncertainty = 0.0;   // ε the decision used (SurfacePairResult::uncertainty_a/b); 0 in reports written before it
 };
 
 struct ReportPair {
@@ -183,6 +188,7 @@ struct ReportPair {
   ContactClass contact = ContactClass::Touching;
   DecidedBy decided_by = DecidedBy::Mesh;
   double distance_lo = 0.0, distance_hi = 0.0;  // +infinity: unbounded (null)
+  ContactWithin within = ContactWithin::Unknown;  // "contact_within"; Unknown: null
   bool intersecting = false;
   double distance = 0.0;  // +infinity: null
   double penetration = 0.0;
