@@ -64,6 +64,7 @@ struct SceneData {
   std::vector<Aabb> world_box;      // per instance
   std::vector<char> dirty;
   std::vector<InstanceId> dirty_list;  // the instances with dirty set, in the order they were moved
+  std::set<InstanceId> outside_range;  // instances outside the supported range (query_range.cpp), as of their last move
   InstanceTree instance_tree;          // built by the first broad phase with a small selection side
   std::vector<SurfaceBvh> bvh;
   std::vector<char> bvh_ready;

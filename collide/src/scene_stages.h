@@ -13,7 +13,7 @@ namespace cadclash::detail {
 
 // 0. Why the query is outside the supported range (model.h), if it is: the options, then each
 //    selected instance whose part (box, deflections, uncertainties) or pose is; at most 16 listed.
-std::vector<Diagnostic> range_errors(const SceneData& s, const CollideOptions& o);
+std::vector<Diagnostic> range_errors(SceneData& s, const CollideOptions& o);
 // A refused query's report: nothing examined, complete false, stopped_by "out of range".
 void refuse(Report& r, std::vector<Diagnostic> errors);
 
