@@ -48,8 +48,13 @@ void print_table(const Model& m, const Report& r, const ClashReview& review, boo
     if (p.exact_distance) os << "  exact " << fmt(*p.exact_distance);
     if (p.contact == ContactClass::Undecided)
       os << "  exact distance in [" << fmt(p.distance_lo) << ", " << fmt(p.distance_hi) << "]";
-    if (p.within == ContactWithin::ModelUncertainty)
-      os << "  only within the model uncertainty (eps " << fmt(p.uncertainty_a) << " + " << fmt(p.uncertainty_b) << ")";
+    if (p.within == ContactWithin::ModelUncertainty) {
+      auto eps = [&](double e, SurfaceId s) {
+        return fmt(e) + " " + uncertainty_source_name(uncertainty_source(m.surfaces[s]));
+      };
+      os << "  only within the model uncertainty (eps " << eps(p.uncertainty_a, p.surface_a) << " + "
+         << eps(p.uncertainty_b, p.surface_b) << ")";
+    }
     os << '\n';
   }
 }

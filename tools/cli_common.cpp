@@ -55,6 +55,18 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
                  "Uncertainty of mesh coordinates, mm: faces within tolerance + both uncertainties touch "
                  "(default: 2^-24 x the largest coordinate, the single-precision bound)")
       ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--uncertainty", in.uncertainty,
+                 "Where a CAD face's model uncertainty comes from: auto (the larger of its OCCT tolerance and "
+                 "the STEP file's declared uncertainty), occt (OCCT tolerances only), declared (the file's "
+                 "declared uncertainty where it has one), or a value in mm for every surface, meshes too")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            if (v == "auto" || v == "occt" || v == "declared") return {};
+            const std::optional<double> x = uncertainty_value(v);
+            return x ? std::string() : "expected auto, occt, declared or a length in (0, 2^128] mm, got '" + v + "'";
+          },
+          "auto|occt|declared|MM"))
+      ->capture_default_str();
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
   cmd.add_flag("--fill-holes", in.fill_holes, "With --repair: also fill holes");
@@ -92,6 +104,16 @@ void print_repair_summary(const MeshRepairReport& r, bool fill_holes, double sec
 
 }  // namespace
 
+std::optional<double> uncertainty_value(const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size() && v > 0.0 && v <= kMaxLength) return v;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
 ImportOptions import_options(const InputOptions& in) {
   ImportOptions options;
   options.tessellation = effective_tessellation(in);
@@ -99,6 +121,12 @@ ImportOptions import_options(const InputOptions& in) {
   options.isolate_cad_readers = !in.no_isolation;
   options.reader_time_limit_seconds = in.import_time_limit;
   options.model_tolerance = in.model_tolerance;
+  if (in.uncertainty == "occt") options.uncertainty = UncertaintyChoice::OcctTolerance;
+  else if (in.uncertainty == "declared") options.uncertainty = UncertaintyChoice::Declared;
+  else if (const std::optional<double> v = uncertainty_value(in.uncertainty)) {
+    options.uncertainty = UncertaintyChoice::Value;
+    options.uncertainty_value = *v;
+  }
   options.tessellation.time_limit_seconds = in.import_time_limit;
   options.cache_dir = in.cache;
   options.cache_max_bytes = static_cast<std::uint64_t>(in.cache_max_mb * 1024.0 * 1024.0);

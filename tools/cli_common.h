@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@ struct InputOptions {
   bool lazy = false;
   bool no_isolation = false;
   double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
+  std::string uncertainty = "auto";  // auto | occt | declared | a value in mm (ImportOptions::uncertainty)
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   std::string cache;               // directory of the import cache (ImportOptions::cache_dir); empty = none
   double cache_max_mb = 0.0;       // ImportOptions::cache_max_bytes in MiB; 0 = no limit
@@ -37,6 +39,9 @@ struct InputOptions {
   double sharp_angle = 60.0;  // degrees
   bool planar = false;        // with --segment
 };
+
+// The value of --uncertainty MM: a length in (0, kMaxLength]; nullopt for anything else.
+std::optional<double> uncertainty_value(const std::string& text);
 
 // Adds FILE... and the tessellation switches to `cmd`, bound to `in`.
 void add_input_options(CLI::App& cmd, InputOptions& in);

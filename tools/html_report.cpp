@@ -144,6 +144,13 @@ nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Repo
     jp["instance_b"] = p.instance_b;
     jp["surface_a"] = signed_id(p.surface_a);
     jp["surface_b"] = signed_id(p.surface_b);
+    // ε of each side and where it came from (the report's side fields, which the page does not carry).
+    for (const auto& [key, side] : {std::pair{"a", &q.pairs[k].a}, std::pair{"b", &q.pairs[k].b}}) {
+      if (side->whole_part) continue;
+      jp[std::string("uncertainty_") + key] = side->uncertainty;
+      if (side->uncertainty_source)
+        jp[std::string("uncertainty_source_") + key] = uncertainty_source_name(*side->uncertainty_source);
+    }
     pairs.push_back(std::move(jp));
   }
   j["parts"] = std::move(parts);

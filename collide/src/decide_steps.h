@@ -28,6 +28,7 @@ struct Pending {
   bool needs_lower = false;      // the exact value is above T: "apart" still needs a lower bound
   std::optional<PairOutcome> fine;  // the finer triangles' outcome, once refined
   bool cut = false;
+  double depth = 0.0;  // a crossing depth depth_step proved on the exact faces (0: none)
 };
 
 // A face as one step sees it: the model's surface (or its finer copy), the tree over its triangles
@@ -66,6 +67,18 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = fa
 // from there onto the curve where its surface meets the plane.
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                    Pending& p, const CollideOptions& o, CollideCounters& c);
+
+// After a contact is proved: two planar faces whose triangles cross deeper than T (the band hides
+// whether the faces do) are proved penetrating on their planes (decide_depth.cpp): a point c where
+// one face's triangles cross the other's plane, inside both faces, and from it, within each face's plane and across
+// the line where the planes meet, the points at height ±H over the other plane (H > T), inside
+// their face, their feet on the other plane inside the other face. Sets p.cls Penetrating and
+// p.depth (the largest H it proved, at most T + the band) and returns true; false leaves p as it
+// was. Precondition: p settled in contact.
+bool depth_step(const DecideTask& t, FaceView a, FaceView b, Pending& p, CollideCounters& c);
+// Whether depth_step can apply to task t (both faces planar, triangles crossing deeper than T, the
+// pair settled touching): the faces' outlines are then needed.
+bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p);
 
 // Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface
 // nearest the plane (closed form, near its lowest vertices), inside both faces, proves contact.

@@ -48,6 +48,16 @@ const char* source_kind_name(SourceKind kind) {
   return "unknown";
 }
 
+const char* uncertainty_source_name(UncertaintySource source) {
+  switch (source) {
+    case UncertaintySource::Coordinates: return "coordinates";
+    case UncertaintySource::OcctTolerance: return "occt tolerance";
+    case UncertaintySource::Declared: return "declared";
+    case UncertaintySource::Given: return "given";
+  }
+  return "unknown";
+}
+
 void append_model(Model& into, Model from, const std::string& path_prefix) {
   const auto part_shift = static_cast<PartId>(into.parts.size());
   const auto surface_shift = static_cast<SurfaceId>(into.surfaces.size());

@@ -109,6 +109,7 @@ struct DecisionRun::Impl {
     Pending p;
     CollideCounters c;
     const bool ambiguous = early(k, p, c);
+    deepen(k, p, c);
     char st = ambiguous ? kAmbiguous : 0;
     if (p.settled || p.cut) {
       CollideCounters counts;
@@ -123,6 +124,18 @@ struct DecisionRun::Impl {
   }
   // Steps 1 to 3c into p and c; whether steps 1 and 2 left the task open (ambiguous).
   bool early(std::size_t k, Pending& p, CollideCounters& c);
+  // A contact of two planar faces whose triangles cross deeper than T: proved penetrating on the
+  // exact planes where it can be (depth_step), whichever step proved the contact.
+  void deepen(std::size_t k, Pending& p, CollideCounters& c) {
+    if (!depth_step_applies(model, tasks[k], p)) return;
+    if (deadline.expired()) {
+      p.cut = true;
+      return;
+    }
+    need_outline(tasks[k].sa);
+    need_outline(tasks[k].sb);
+    depth_step(tasks[k], view(tasks[k].sa), view(tasks[k].sb), p, c);
+  }
   // Task k's answer from its final state p, adding to `counts` the work its steps counted (`steps`)
   // and what decided it.
   DecideResult answer(std::size_t k, Pending& p, const CollideCounters& steps, CollideCounters& counts) const;
@@ -195,6 +208,7 @@ DecideResult DecisionRun::Impl::answer(std::size_t k, Pending& p, const CollideC
   if (!p.cls) return out;
   count(counts, p.by);
   SurfacePairResult r = make_result(t, t.outcome, *p.cls);
+  r.penetration = std::max(r.penetration, p.depth);
   r.decided_by = p.by;
   r.distance_lo = p.d.lo;
   r.distance_hi = p.d.hi;
@@ -298,6 +312,14 @@ std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
   for (char st : run.state) counters.ambiguous_pairs += (st & kAmbiguous) != 0;
   if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
   exact_steps(run, counters);
+  // The contacts steps 4 to 6 proved, as early() does for its own.
+  std::vector<std::size_t> late;
+  for (std::size_t k = 0; k < run.tasks.size(); ++k)
+    if (!(run.state[k] & kAnswered) && depth_step_applies(run.model, run.tasks[k], run.pending[k])) late.push_back(k);
+  dynamic_loop(static_cast<std::ptrdiff_t>(late.size()), run.threads, true, [&](std::ptrdiff_t i) {
+    const std::size_t k = late[static_cast<std::size_t>(i)];
+    run.deepen(k, run.pending[k], run.task_counters[k]);
+  });
   return collect(run, counters);
 }
 

@@ -46,6 +46,19 @@ TopTools_IndexedMapOfShape document_faces(const Handle(TDocStd_Document)& doc) {
   return faces;
 }
 
+// Each face's ε from its OCCT tolerance (what tessellate put there) and the file's declared length
+// uncertainty (0: none), as `choice` says; Value is applied to every surface after reading
+// (import_file.cpp).
+void apply_declared_uncertainty(Model& m, double declared, UncertaintyChoice choice) {
+  if (!(declared > 0.0) || choice == UncertaintyChoice::OcctTolerance || choice == UncertaintyChoice::Value) return;
+  for (Surface& s : m.surfaces) {
+    if (choice == UncertaintyChoice::Declared || declared > s.uncertainty) {
+      s.uncertainty = declared;
+      s.uncertainty_source = UncertaintySource::Declared;
+    }
+  }
+}
+
 }  // namespace
 
 Transfer::~Transfer() { discard_shapes(); }
@@ -241,7 +254,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
       result.complete = false;
     }
   }
-  for (Surface& s : result.model.surfaces) s.uncertainty = std::max(s.uncertainty, t.declared_uncertainty);
+  apply_declared_uncertainty(result.model, t.declared_uncertainty, options.uncertainty);
   timings.heal = part_timings.heal;
   timings.tessellate = part_timings.tessellate;
   return result;

@@ -28,7 +28,7 @@ namespace {
 
 // Bumped whenever the entry layout or what it stores (save_import, save_brep_source) changes; part
 // of every key, so entries of another version are never looked up.
-constexpr std::uint64_t kCacheFormat = 1;
+constexpr std::uint64_t kCacheFormat = 2;
 constexpr std::string_view kMagic = "CCIMPORT";
 constexpr std::size_t kDigestBytes = 32;
 using Digest = std::array<unsigned char, kDigestBytes>;
@@ -90,7 +90,8 @@ std::string cache_key(const std::string& path, const std::string& bytes, const I
     << o.tessellation.relative << " angular " << o.tessellation.angular_deflection << " verify "
     << o.tessellation.verify_deflection << " time limit " << o.tessellation.time_limit_seconds << "\nlazy " << o.lazy
     << " isolated " << o.isolate_cad_readers << " reader time limit " << o.reader_time_limit_seconds
-    << " model tolerance " << o.model_tolerance << '\n';
+    << " model tolerance " << o.model_tolerance << " uncertainty " << static_cast<int>(o.uncertainty) << " "
+    << o.uncertainty_value << '\n';
   return k.str();
 }
 

@@ -68,14 +68,21 @@ namespace {
 // One file, without its ReadFile progress; `options.tessellation.progress` gets its parts' meshing.
 ImportResult import_one(const std::string& path, const ImportOptions& options) {
   assert(options.model_tolerance >= 0.0);
+  assert(options.uncertainty != UncertaintyChoice::Value || options.uncertainty_value > 0.0);
   const auto start = std::chrono::steady_clock::now();
   const detail::CadWork occt_in_this_process;
   auto read = [&] {
     const auto read_start = std::chrono::steady_clock::now();
     ImportResult r = read_any(path, options);
-    if (options.model_tolerance > 0.0)
-      for (Surface& s : r.model.surfaces)
-        if (!r.model.parts[s.part].source) s.uncertainty = options.model_tolerance;
+    for (Surface& s : r.model.surfaces) {
+      if (options.uncertainty == UncertaintyChoice::Value) {
+        s.uncertainty = options.uncertainty_value;
+        s.uncertainty_source = UncertaintySource::Given;
+      } else if (options.model_tolerance > 0.0 && !r.model.parts[s.part].source) {
+        s.uncertainty = options.model_tolerance;
+        s.uncertainty_source = UncertaintySource::Given;
+      }
+    }
     if (r.files.empty()) {  // a mesh file, or a CAD file that could not be opened: reading is all
       r.files.push_back(FileImport{path, CacheUse::Off, {}});
       r.files.back().timings.read = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();

@@ -44,7 +44,8 @@ void put_surface(ByteWriter& w, const Surface& s) {
   w.u64(p.colour ? 1 : 0);
   if (p.colour)
     for (const float c : *p.colour) w.f64(c);
-  w.u64((p.healed ? 1 : 0) | (p.repaired ? 2 : 0) | (s.exact_triangles ? 4 : 0) | (s.has_triangles ? 8 : 0));
+  w.u64((p.healed ? 1 : 0) | (p.repaired ? 2 : 0) | (s.exact_triangles ? 4 : 0) | (s.has_triangles ? 8 : 0) |
+        static_cast<std::uint64_t>(s.uncertainty_source) << 4);
   put_vec(w, s.aabb.min());
   put_vec(w, s.aabb.max());
   w.f64(s.deflection);
@@ -82,6 +83,8 @@ bool get_surface(ByteReader& r, Surface& s) {
   p.repaired = (flags & 2) != 0;
   s.exact_triangles = (flags & 4) != 0;
   s.has_triangles = (flags & 8) != 0;
+  const std::uint64_t source = flags >> 4 & 3;
+  s.uncertainty_source = static_cast<UncertaintySource>(source);
   const Vec3 lo = get_vec(r), hi = get_vec(r);
   s.aabb = Aabb(lo, hi);
   s.deflection = r.f64();

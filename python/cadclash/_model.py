@@ -74,17 +74,21 @@ class Surface:
     Vertices are part-local, millimetres; triangles index them counter-clockwise seen from outside.
     """
 
-    __slots__ = ("model", "id", "name", "part_id", "provenance")
+    __slots__ = ("model", "id", "name", "part_id", "provenance", "uncertainty", "uncertainty_source")
 
     def __init__(self, model: "Model", sid: int):
-        name, part, kind, source_file, step_id, face_index, source_name, parent, colour, healed, repaired = \
-            model._surface(sid)
+        (name, part, kind, source_file, step_id, face_index, source_name, parent, colour, healed, repaired,
+         uncertainty, uncertainty_source) = model._surface(sid)
         self.model = model
         self.id = sid
         self.name: str = name
         self.part_id: int = part
         self.provenance = Provenance(kind, source_file, None if step_id < 0 else step_id, face_index, source_name,
                                      None if parent < 0 else parent, colour, healed, repaired)
+        # The model uncertainty ε, mm (0: derived from the part's coordinates when a query runs), and
+        # where it came from: "coordinates", "occt tolerance", "declared" or "given" (load's uncertainty).
+        self.uncertainty: float = uncertainty
+        self.uncertainty_source: str = uncertainty_source
 
     @property
     def part(self) -> Part:
@@ -243,7 +247,7 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
          relative: bool = False, preset: Optional[str] = None, lazy: bool = False, repair: bool = False,
          fill_holes: bool = False, segment: bool = False, sharp_angle: float = 60.0, planar: bool = False,
          isolate: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
-         cache: Optional[PathLike] = None, threads: int = 0, strict: bool = False) -> Model:
+         uncertainty: Union[str, float] = "auto", cache: Optional[PathLike] = None, threads: int = 0, strict: bool = False) -> Model:
     """Reads one or more files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF) into one ``Model``.
 
     The arguments mirror ``cadclash check``'s input switches: ``deflection`` (mm, or a fraction of
@@ -256,7 +260,11 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     (seconds, 0 = none; the CLI's ``--import-time-limit``) stops an isolated reader that takes longer
     on one file, and then the file's tessellation, with error diagnostics naming what was not done.
     ``model_tolerance`` (mm; the CLI's ``--model-tolerance``) is the uncertainty of mesh coordinates
-    (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch. ``cache``
+    (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch.
+    ``uncertainty`` (the CLI's ``--uncertainty``) says where a CAD face's uncertainty comes from:
+    "auto" (the larger of its OCCT tolerance and the STEP file's declared uncertainty), "occt" (OCCT
+    tolerances only), "declared" (the file's declared uncertainty where it has one), or a length in mm
+    for every surface, meshes too (``Surface.uncertainty_source`` says which applied). ``cache``
     (a directory; the CLI's ``--cache``) keeps every file as imported, keyed by a SHA-256 of its bytes,
     path and these settings: a file loaded again unchanged comes back from it, the same model; a
     damaged entry is read again and named in a warning diagnostic. Several files form one scene,
@@ -277,6 +285,8 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     raw, complete = model._load(files, float(deflection), bool(relative), float(angular), preset or "",
                                 bool(lazy), bool(repair), bool(fill_holes), bool(segment), float(sharp_angle),
                                 bool(planar), bool(isolate), float(time_limit), float(model_tolerance),
+                                uncertainty if isinstance(uncertainty, str) else "value",
+                                0.0 if isinstance(uncertainty, str) else float(uncertainty),
                                 os.fspath(cache) if cache is not None else "", int(threads))
     model.files = files
     model.diagnostics = _diagnostics(raw)

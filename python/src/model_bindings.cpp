@@ -62,6 +62,8 @@ struct LoadArgs {
   bool isolate = true;
   double time_limit = 0.0;
   double model_tolerance = 0.0;
+  std::string uncertainty = "auto";  // auto | occt | declared | value (then uncertainty_value)
+  double uncertainty_value = 0.0;
   std::string cache;  // ImportOptions::cache_dir; empty: none
   int threads = 0;    // the whole load on at most this many threads; 0: every core
 };
@@ -88,6 +90,16 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   options.tessellation.time_limit_seconds = a.time_limit;
   if (!(a.model_tolerance >= 0.0)) throw pyb::value_error("model_tolerance must be >= 0 mm (0: from the coordinates)");
   options.model_tolerance = a.model_tolerance;
+  if (a.uncertainty == "occt") options.uncertainty = UncertaintyChoice::OcctTolerance;
+  else if (a.uncertainty == "declared") options.uncertainty = UncertaintyChoice::Declared;
+  else if (a.uncertainty == "value") {
+    if (!(a.uncertainty_value > 0.0 && a.uncertainty_value <= kMaxLength))
+      throw pyb::value_error("uncertainty must be 'auto', 'occt', 'declared' or a length in (0, 2^128] mm");
+    options.uncertainty = UncertaintyChoice::Value;
+    options.uncertainty_value = a.uncertainty_value;
+  } else if (a.uncertainty != "auto")
+    throw pyb::value_error("uncertainty must be 'auto', 'occt', 'declared' or a length in (0, 2^128] mm, not '" +
+                           a.uncertainty + "'");
   options.cache_dir = a.cache;
   options.parallel_files = checked_threads(a.threads);
 
@@ -182,15 +194,16 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate, double time_limit, double model_tolerance, std::string cache, int threads) {
+             bool planar, bool isolate, double time_limit, double model_tolerance, std::string uncertainty,
+             double uncertainty_value, std::string cache, int threads) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
                                fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance,
-                               std::move(cache), threads});
+                               std::move(uncertainty), uncertainty_value, std::move(cache), threads});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
           pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"),
-          pyb::arg("cache"), pyb::arg("threads"))
+          pyb::arg("uncertainty"), pyb::arg("uncertainty_value"), pyb::arg("cache"), pyb::arg("threads"))
       .def("_counts",
            [](const ModelCore& c) {
              const Model& md = c.state->model;  // sizes never change after load
@@ -219,7 +232,8 @@ void bind_model(pyb::module_& m) {
                                            : pyb::object(pyb::none());
              return pyb::make_tuple(s.name, s.part, source_kind_name(p.kind), p.source_file, p.step_id, p.face_index,
                                     p.source_name, p.parent == kInvalidId ? -1 : static_cast<std::int64_t>(p.parent),
-                                    colour, p.healed, p.repaired);
+                                    colour, p.healed, p.repaired, s.uncertainty,
+                                    uncertainty_source_name(uncertainty_source(s)));
            })
       .def("_surface_state",
            [](ModelCore& c, pyb::ssize_t id) {

@@ -120,6 +120,9 @@ ReportSide read_side(const Json& j, const std::string& p) {
   if (j.contains("source_name")) s.source_name = text(j["source_name"], p + "/source_name");
   s.deflection = number(field(j, p, "deflection"), p + "/deflection");
   if (j.contains("uncertainty")) s.uncertainty = number(j["uncertainty"], p + "/uncertainty");
+  if (j.contains("uncertainty_source"))
+    s.uncertainty_source =
+        named<UncertaintySource>(j["uncertainty_source"], p + "/uncertainty_source", "uncertainty source");
   return s;
 }
 

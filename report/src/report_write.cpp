@@ -44,6 +44,7 @@ ReportSide side(const Model& m, InstanceId i, SurfaceId s) {
 ReportSide side(const Model& m, InstanceId i, SurfaceId s, double uncertainty) {
   ReportSide out = side(m, i, s);
   out.uncertainty = uncertainty;
+  if (!out.whole_part) out.uncertainty_source = uncertainty_source(m.surfaces[s]);
   return out;
 }
 
@@ -59,6 +60,7 @@ nlohmann::json side_json(const ReportSide& s) {
   if (!s.source_name.empty()) j["source_name"] = s.source_name;
   j["deflection"] = s.deflection;
   j["uncertainty"] = s.uncertainty;
+  if (s.uncertainty_source) j["uncertainty_source"] = uncertainty_source_name(*s.uncertainty_source);
   return j;
 }
 

@@ -88,6 +88,7 @@ void describe_face(const TopoDS_Face& face, Surface& out) {
   for (TopExp_Explorer ex(face, TopAbs_VERTEX); ex.More(); ex.Next())
     tol = std::max(tol, BRep_Tool::Tolerance(TopoDS::Vertex(ex.Current())));
   out.uncertainty = std::max(out.uncertainty, tol);
+  out.uncertainty_source = UncertaintySource::OcctTolerance;
   try {
     const BRepAdaptor_Surface surface(face, Standard_False);  // part-local, as the triangles are
     out.analytic = analytic_of(surface);

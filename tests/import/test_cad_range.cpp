@@ -65,7 +65,9 @@ TEST(CadRange, FacesAndPlacementsPastTheRangeAreDroppedAndNamed) {
   EXPECT_EQ(paths, (std::vector<std::string>{"/assembly/far", "/assembly/plate"}));
   std::size_t meshed = 0;
   for (const Surface& s : r.model.surfaces) {
-    if (!s.aabb.isEmpty()) EXPECT_LE(std::max(s.aabb.min().cwiseAbs().maxCoeff(), s.aabb.max().cwiseAbs().maxCoeff()), kMaxLength);
+    if (!s.aabb.isEmpty()) {
+      EXPECT_LE(std::max(s.aabb.min().cwiseAbs().maxCoeff(), s.aabb.max().cwiseAbs().maxCoeff()), kMaxLength);
+    }
     meshed += !s.mesh.triangles.empty();
   }
   EXPECT_EQ(meshed, 6u);

@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -403,7 +404,76 @@ TEST(ModelUncertainty, FromTolerancesAndTheFilesDeclaredUncertainty) {
   std::ofstream(tmp, std::ios::binary) << coarse;
   ImportResult declared_in = import_file(tmp);
   ASSERT_EQ(declared_in.model.surfaces.size(), plain.model.surfaces.size());
-  for (const Surface& s : declared_in.model.surfaces) EXPECT_GE(s.uncertainty, 0.01 - 1e-12) << s.name;
+  for (const Surface& s : declared_in.model.surfaces) {
+    EXPECT_EQ(s.uncertainty, 0.01) << s.name;
+    EXPECT_EQ(uncertainty_source(s), UncertaintySource::Declared) << s.name;
+  }
+  // The file's own 1e-7 is never above OCCT's tolerances (at least 1e-7): they stand.
+  for (const Surface& s : plain.model.surfaces) EXPECT_EQ(uncertainty_source(s), UncertaintySource::OcctTolerance) << s.name;
+
+  // ImportOptions::uncertainty chooses the source. OCCT's tolerances alone: the declared 0.01 ignored.
+  ImportOptions occt;
+  occt.uncertainty = UncertaintyChoice::OcctTolerance;
+  const ImportResult occt_in = import_file(tmp, occt);
+  ASSERT_EQ(occt_in.model.surfaces.size(), plain.model.surfaces.size());
+  for (std::size_t k = 0; k < occt_in.model.surfaces.size(); ++k) {
+    EXPECT_EQ(occt_in.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty);
+    EXPECT_EQ(uncertainty_source(occt_in.model.surfaces[k]), UncertaintySource::OcctTolerance);
+  }
+  // The declared value even where it is below OCCT's tolerance (the plain file declares 1e-7).
+  ImportOptions declared_only;
+  declared_only.uncertainty = UncertaintyChoice::Declared;
+  const ImportResult declared_small = import_file(path, declared_only);
+  for (const Surface& s : declared_small.model.surfaces) {
+    EXPECT_EQ(s.uncertainty, 1e-7) << s.name;
+    EXPECT_EQ(uncertainty_source(s), UncertaintySource::Declared) << s.name;
+  }
+  // A value for every surface.
+  ImportOptions given;
+  given.uncertainty = UncertaintyChoice::Value;
+  given.uncertainty_value = 0.25;
+  for (const Surface& s : import_file(tmp, given).model.surfaces) {
+    EXPECT_EQ(s.uncertainty, 0.25) << s.name;
+    EXPECT_EQ(uncertainty_source(s), UncertaintySource::Given) << s.name;
+  }
+  // The import cache keeps the source, and keys it: the same file read with another choice is
+  // read again, not taken from the entry of the first.
+  ImportOptions cached;
+  cached.cache_dir = ::testing::TempDir() + "/declared_uncertainty_cache";
+  std::filesystem::remove_all(cached.cache_dir);
+  ImportOptions cached_occt = cached;
+  cached_occt.uncertainty = UncertaintyChoice::OcctTolerance;
+  for (int run = 0; run < 2; ++run) {
+    for (const Surface& s : import_file(tmp, cached).model.surfaces)
+      EXPECT_EQ(uncertainty_source(s), UncertaintySource::Declared) << "run " << run << " " << s.name;
+    for (const Surface& s : import_file(tmp, cached_occt).model.surfaces)
+      EXPECT_EQ(uncertainty_source(s), UncertaintySource::OcctTolerance) << "run " << run << " " << s.name;
+  }
+}
+
+// Mesh surfaces: ε derived from the coordinates unless the import gives one.
+TEST(ModelUncertainty, MeshSurfacesFromTheirCoordinatesOrGiven) {
+  const std::string path = std::string(CADCLASH_DATA_DIR) + "/collide/box_a.obj";
+  const ImportResult plain = import_file(path);
+  ASSERT_FALSE(plain.model.surfaces.empty());
+  for (const Surface& s : plain.model.surfaces) {
+    EXPECT_EQ(s.uncertainty, 0.0);
+    EXPECT_EQ(uncertainty_source(s), UncertaintySource::Coordinates);
+  }
+  ImportOptions tol;
+  tol.model_tolerance = 0.125;
+  ImportOptions value;
+  value.uncertainty = UncertaintyChoice::Value;
+  value.uncertainty_value = 0.5;
+  value.model_tolerance = 0.125;  // unused with a value
+  ImportOptions occt;
+  occt.uncertainty = UncertaintyChoice::OcctTolerance;  // B-rep faces only: meshes as by default
+  for (const auto& [o, eps] : {std::pair{tol, 0.125}, std::pair{value, 0.5}, std::pair{occt, 0.0}}) {
+    for (const Surface& s : import_file(path, o).model.surfaces) {
+      EXPECT_EQ(s.uncertainty, eps);
+      EXPECT_EQ(uncertainty_source(s), eps > 0.0 ? UncertaintySource::Given : UncertaintySource::Coordinates);
+    }
+  }
 }
 
 // The elementary surfaces are recognised in the part's frame: every vertex of a cylinder face's

@@ -122,6 +122,35 @@ TEST(CheckCli, ModelToleranceWidensTouching) {
   EXPECT_NE(r.out.find("touching    mesh-exact"), std::string::npos) << r.out;
 }
 
+// --uncertainty MM gives every surface that ε, and each side of a pair says where its ε came from
+// (JSON, table); a contact only that ε holds says so. Bad values are usage errors.
+TEST(CheckCli, UncertaintySwitchAndItsSource) {
+  const std::string pair = data("box_a.obj") + " " + data("box_near.obj");
+  for (const char* bad : {"0", "-1", "nan", "inf", "1e39", "occ", "0.1mm", ""})
+    EXPECT_EQ(run("check " + pair + " --uncertainty '" + bad + "'").code, 2) << bad;
+  const std::string json = tmp("uncertainty.json");
+  Proc r = run("check " + pair + " --uncertainty 0.3 --no-timings --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("only within the model uncertainty (eps 0.3 given + 0.3 given)"), std::string::npos) << r.out;
+  nlohmann::json j = nlohmann::json::parse(read(json));
+  ASSERT_FALSE(j["pairs"].empty());
+  for (const auto& p : j["pairs"]) {
+    EXPECT_EQ(p["class"], "touching");
+    EXPECT_EQ(p["contact_within"], "model uncertainty");
+    for (const char* side : {"a", "b"}) {
+      EXPECT_EQ(p[side]["uncertainty"], 0.3);
+      EXPECT_EQ(p[side]["uncertainty_source"], "given");
+    }
+  }
+  // By default a mesh's ε comes from its coordinates.
+  r = run("check " + boxes() + " --no-timings --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  j = nlohmann::json::parse(read(json));
+  ASSERT_FALSE(j["pairs"].empty());
+  for (const auto& p : j["pairs"])
+    for (const char* side : {"a", "b"}) EXPECT_EQ(p[side]["uncertainty_source"], "coordinates");
+}
+
 TEST(CheckCli, ReportIsByteIdenticalForAnyThreadCount) {
   for (const std::string variant : {"--parallel v1", "--parallel v2 --all-triangles", "--schedule static"}) {
     std::string first;

@@ -213,9 +213,14 @@ async function checkSelected(page, pairs, index, what) {
     check(await field(`${key}-step`) === stepText(side), `${key}: STEP id ${await field(`${key}-step`)}, expected ${stepText(side)}`);
     check(await field(`${key}-path`) === side.instance, `${key}: path ${await field(`${key}-path`)}, expected ${side.instance}`);
     check(await field(`${key}-part`) === side.part, `${key}: part ${await field(`${key}-part`)}, expected ${side.part}`);
+    // ε and its source, as the JSON side has them (a whole part has neither).
+    const eps = side.surface === undefined ? '–' : `${numberText(side.uncertainty)} mm (${side.uncertainty_source})`;
+    check(await field(`${key}-uncertainty`) === eps, `${key}: uncertainty ${await field(`${key}-uncertainty`)}, expected ${eps}`);
   }
   check((await field('class')).trim() === pair.class, `class ${await field('class')}, expected ${pair.class}`);
   check(await field('decided-by') === pair.decided_by, `decided by ${await field('decided-by')}, expected ${pair.decided_by}`);
+  const within = pair.contact_within ?? '–';
+  check(await field('within') === within, `contact within ${await field('within')}, expected ${within}`);
   check(await field('interval') === intervalText(pair),
         `exact distance in ${await field('interval')}, expected ${intervalText(pair)} (${JSON.stringify(pair.distance_interval)})`);
   console.log(`${what}: row ${index + 1}: ${pair.class} (${pair.decided_by}, ${intervalText(pair)}) ` +

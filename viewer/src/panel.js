@@ -40,7 +40,13 @@ export function showClassCounts(box, counts) {
   for (const c of CLASSES) box.querySelector(`[data-count="${c}"]`).textContent = (counts[c] || 0).toLocaleString('en');
 }
 
-function sideRows(data, label, instanceId, surfaceId) {
+// "0.01 mm (declared)": the side's model uncertainty and where it came from.
+function uncertaintyText(eps, source) {
+  if (eps === undefined) return '–';
+  return formatNumber(eps) + ' mm' + (source ? ` (${source})` : '');
+}
+
+function sideRows(data, label, instanceId, surfaceId, eps, source) {
   const inst = data.instances[instanceId];
   const part = data.parts[inst.part];
   const s = surfaceId >= 0 ? data.surfaces[surfaceId] : null;
@@ -49,6 +55,7 @@ function sideRows(data, label, instanceId, surfaceId) {
     [`<span class="chip ${cls}"></span>${label} STEP id`, s && s.step_id !== undefined ? '#' + s.step_id : '–', 'step'],
     ['surface', s ? s.name + (s.source_name ? ` (${s.source_name})` : '') : '(whole part)', 'surface'],
     ['kind', s ? s.kind : '–', 'kind'],
+    ['uncertainty ε', s ? uncertaintyText(eps, source) : '–', 'uncertainty'],
     ['part', part.name, 'part'],
     ['instance', inst.path, 'path'],
   ];
@@ -70,5 +77,7 @@ export function showSelection(panel, data, index) {
     `<tr><td>distance</td><td data-field="distance">${p.distance === null ? '–' : formatNumber(p.distance) + ' mm'}` +
     `${extra.length ? ' <span class="muted">(' + extra.join(', ') + ')</span>' : ''}</td></tr>` +
     `<tr><td>exact distance in</td><td data-field="interval">${intervalText(p)}</td></tr>` +
-    sideRows(data, 'A', p.instance_a, p.surface_a) + sideRows(data, 'B', p.instance_b, p.surface_b) + '</table>';
+    `<tr><td>contact within</td><td data-field="within">${escapeHtml(p.contact_within ?? '–')}</td></tr>` +
+    sideRows(data, 'A', p.instance_a, p.surface_a, p.uncertainty_a, p.uncertainty_source_a) +
+    sideRows(data, 'B', p.instance_b, p.surface_b, p.uncertainty_b, p.uncertainty_source_b) + '</table>';
 }

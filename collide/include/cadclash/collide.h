@@ -79,7 +79,8 @@ namespace cadclash {
 // vertices into A's frame (from the poses' magnitudes) and of the triangle arithmetic (triangle_distance
 // is accurate to 64·2^-53 of the pair's extent). hi <= T: certainly in contact; lo > T: certainly apart;
 // else ambiguous. A pair is penetrating only when its crossing depth exceeds T + δa + δb + r (the
-// exact faces cross); a contact whose crossing depth is only within the bands is touching.
+// exact faces cross); a contact whose crossing depth is only within the bands is touching, unless
+// both faces are planar and their planes prove it (depth: below).
 // Ambiguous pairs are refined, cheapest first, until decided:
 //   analytic  the other face's triangles lie provably off a plane, cylinder or sphere (Surface::analytic)
 //             by more than T + its deflection: a lower bound on d* (proves "apart"); or a vertex of
@@ -119,6 +120,14 @@ namespace cadclash {
 //             most 16,384 pairs of pieces);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
+//   depth     (after any of the above proved contact) two planar faces whose triangles cross deeper
+//             than T but within T + δa + δb + r: a point where one face's triangles cross the other's
+//             plane, inside both faces, and from it, within each face's plane across the line where
+//             the planes meet, the points at height ±H over the other plane (H > T) inside their own
+//             face, their feet on the other plane inside the other face, prove the exact faces cross
+//             deeper than T: penetrating (decided_by Analytic; penetration = the largest H proved).
+//             Heights are measured on the exact planes (a planar face's triangles lie on it; its band
+//             is in the outline, which "inside" accounts for).
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
 // class Undecided and its interval, never as touching. Clearance (T < d* <= clearance) is judged on
 // the mesh distance (or d* when it was computed). Results do not depend on the thread count.

@@ -110,6 +110,18 @@ struct Provenance {
   bool repaired = false;            // mesh repair changed the surface's triangles
 };
 
+// Where a surface's model uncertainty ε (Surface::uncertainty) came from.
+enum class UncertaintySource : std::uint8_t {
+  Coordinates,    // derived by collide from the part's coordinates (uncertainty 0: 2^-24 x the part's
+                  // largest coordinate magnitude, the single-precision bound of mesh formats)
+  OcctTolerance,  // the largest OCCT tolerance of the face, its edges and vertices
+  Declared,       // the length uncertainty the face's STEP file declares (UNCERTAINTY_MEASURE_WITH_UNIT)
+  Given,          // set by whoever built the model: ImportOptions' model_tolerance or uncertainty value
+};
+
+// Returns "coordinates", "occt tolerance", "declared" or "given".
+const char* uncertainty_source_name(UncertaintySource source);
+
 class SurfaceSource;
 
 // The exact surface a face lies on, part-local, when it is one of the elementary kinds. Lets
@@ -133,12 +145,16 @@ struct Surface {
   double deflection = 0.0; // achieved bound on the distance between triangles and the exact surface; 0 for meshes
   // Model uncertainty ε (mm): how far the stated geometry may be from the intended one. B-rep faces:
   // the largest OCCT tolerance of the face, its edges and vertices (never below Precision::Confusion,
-  // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger. Meshes: the single-precision
+  // 1e-7), or the STEP file's UNCERTAINTY_MEASURE_WITH_UNIT when larger (import's default;
+  // ImportOptions::uncertainty chooses). Meshes: the single-precision
   // representation bound 2^-24 · (largest coordinate magnitude of the part), or the importer's
   // model_tolerance when given. 0 (a Model built by hand) means that same bound, derived by collide
   // from the part's box. Never taken below kMinUncertainty. Two faces touch when their exact distance
   // <= tolerance + εa + εb.
   double uncertainty = 0.0;
+  // Where `uncertainty` came from; a surface whose uncertainty is 0 reports Coordinates whatever
+  // this says (uncertainty_source below).
+  UncertaintySource uncertainty_source = UncertaintySource::Given;
   // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
   // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
   bool exact_triangles = false;
@@ -146,6 +162,12 @@ struct Surface {
   bool has_triangles = false;  // false while a lazy source has not yet been asked for them
   TriangleMesh mesh;       // part-local triangles (empty until has_triangles)
 };
+
+// Where the ε collide uses for `s` came from: Coordinates when s.uncertainty is 0, else
+// s.uncertainty_source.
+inline UncertaintySource uncertainty_source(const Surface& s) {
+  return s.uncertainty > 0.0 ? s.uncertainty_source : UncertaintySource::Coordinates;
+}
 
 struct Part {
   std::string name;

@@ -62,6 +62,15 @@
 
 namespace cadclash {
 
+// Where a B-rep face's model uncertainty ε (Surface::uncertainty, uncertainty_source) is taken from.
+enum class UncertaintyChoice : std::uint8_t {
+  Auto,           // the larger of the face's OCCT tolerance and its STEP file's declared length uncertainty
+  OcctTolerance,  // the face's OCCT tolerance alone (the file's declared uncertainty ignored)
+  Declared,       // the file's declared uncertainty where it declares one (even below the OCCT tolerance),
+                  // else the OCCT tolerance
+  Value,          // ImportOptions::uncertainty_value for every surface, B-rep and mesh
+};
+
 struct ImportOptions {
   TessellationOptions tessellation;  // for B-rep formats
   bool lazy = false;                 // B-rep: AABBs from the exact geometry now, triangles when first required
@@ -87,6 +96,11 @@ struct ImportOptions {
   // every mesh surface's Surface::uncertainty. 0 = derived by collide from the coordinates (2^-24 x the
   // part's largest coordinate: the single-precision bound, as STL, glTF and PLY store float32).
   double model_tolerance = 0.0;
+  // B-rep faces' model uncertainty (docs/report-schema.md, "Classes"): see UncertaintyChoice. With
+  // Value, uncertainty_value (mm, > 0) is every surface's uncertainty, meshes' too (model_tolerance
+  // is then unused).
+  UncertaintyChoice uncertainty = UncertaintyChoice::Auto;
+  double uncertainty_value = 0.0;
   // A directory for a persistent cache of imported files (made when missing); empty = no cache. One
   // entry per file, keyed by a SHA-256 of the file's bytes, its path as given and every option above
   // that changes the result, the cache format and OCCT versions and the build of cadclash (the program

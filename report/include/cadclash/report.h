@@ -67,6 +67,11 @@ template <> struct EnumNames<SourceKind> {
                                      SourceKind::Segment};
   static const char* name(SourceKind k) { return source_kind_name(k); }
 };
+template <> struct EnumNames<UncertaintySource> {
+  static constexpr std::array values{UncertaintySource::Coordinates, UncertaintySource::OcctTolerance,
+                                     UncertaintySource::Declared, UncertaintySource::Given};
+  static const char* name(UncertaintySource u) { return uncertainty_source_name(u); }
+};
 template <> struct EnumNames<CollideMode> {
   static constexpr std::array values{CollideMode::EarlyExit, CollideMode::AllTrianglePairs};
   static const char* name(CollideMode m) { return collide_mode_name(m); }
@@ -181,6 +186,8 @@ struct ReportSide {
   std::string source_name;    // empty: not written
   double deflection = 0.0;
   double uncertainty = 0.0;   // ε the decision used (SurfacePairResult::uncertainty_a/b); 0 in reports written before it
+  // where ε came from (model.h, uncertainty_source(Surface)); empty in reports written before it
+  std::optional<UncertaintySource> uncertainty_source;
 };
 
 struct ReportPair {
