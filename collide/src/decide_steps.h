@@ -68,16 +68,18 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = fa
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                    Pending& p, const CollideOptions& o, CollideCounters& c);
 
-// After a contact is proved: two planar faces whose triangles cross deeper than T (the band hides
-// whether the faces do) are proved penetrating on their planes (decide_depth.cpp): a point c where
-// one face's triangles cross the other's plane, inside both faces, and from it, within each face's plane and across
-// the line where the planes meet, the points at height ±H over the other plane (H > T), inside
-// their face, their feet on the other plane inside the other face. Sets p.cls Penetrating and
-// p.depth (the largest H it proved, at most T + the band) and returns true; false leaves p as it
-// was. Precondition: p settled in contact.
-bool depth_step(const DecideTask& t, FaceView a, FaceView b, Pending& p, CollideCounters& c);
-// Whether depth_step can apply to task t (both faces planar, triangles crossing deeper than T, the
-// pair settled touching): the faces' outlines are then needed.
+// After a contact is proved: a planar face and a planar or cylindrical one whose triangles cross
+// deeper than T (the band hides whether the faces do) are proved penetrating on their exact
+// surfaces (decide_depth.cpp): a point c of both surfaces where the triangles cross, inside both
+// faces, and from it, along each surface (a line of the plane across the crossing, a cylinder's
+// generator), the points at height ±H over the other surface (H > T) inside their own face, their
+// feet on the other surface inside the other face (by the triangles, else the exact classifier
+// finding them on the face within the rounding). Sets p.cls Penetrating and p.depth (the largest
+// H it proved, at most T + the band) and returns true; false leaves p as it was. Precondition: p
+// settled in contact.
+bool depth_step(const Model& m, const DecideTask& t, FaceView a, FaceView b, Pending& p, CollideCounters& c);
+// Whether depth_step can apply to task t (a plane against a plane or cylinder, triangles crossing
+// deeper than T, the pair settled touching): the faces' outlines are then needed.
 bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p);
 
 // Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface

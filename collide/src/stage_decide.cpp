@@ -134,7 +134,7 @@ struct DecisionRun::Impl {
     }
     need_outline(tasks[k].sa);
     need_outline(tasks[k].sb);
-    depth_step(tasks[k], view(tasks[k].sa), view(tasks[k].sb), p, c);
+    depth_step(model, tasks[k], view(tasks[k].sa), view(tasks[k].sb), p, c);
   }
   // Task k's answer from its final state p, adding to `counts` the work its steps counted (`steps`)
   // and what decided it.
