@@ -2,7 +2,7 @@
 // for import benchmarks on large real files (issue 38; docs/import.md, "Large assemblies: the KiCad
 // board corpus"; scripts/make_corpus.sh makes the corpus with it).
 //   make_board_assembly --out OUT.step --placements N [--seed S] [--name board] [--list FILE] [--verbose]
-//                       [MODEL.step...]
+//                       [--seat MM] [--uncertainty MM] [MODEL.step...]
 // The models are the files given (and those listed in FILE, one path a line), in that order. Every
 // readable model is placed once, the remaining placements pick models by the seed. Same arguments,
 // same geometry, names and colours (OCCT writes the colour styles in an order that follows memory
@@ -15,6 +15,11 @@
 // that product holds the model's shapes through unnamed occurrences, whose products OCCT names
 // itself (SOLID, COMPOUND ...), as kicad2step leaves them. A model placed many times is one product
 // referenced many times, as in KiCad.
+//
+// --seat MM places every component that far above the board's top face (default 0.05; negative: sunk
+// into it, as real exports are where a model's body reaches below its origin); the holes stay those
+// of the default seat, so pins still clear them. --uncertainty MM writes that length uncertainty
+// (UNCERTAINTY_MEASURE_WITH_UNIT; KiCad declares 0.01) instead of OCCT's default.
 //
 // Only OCCT: this builds in seconds, without cadclash's libraries.
 #include <APIHeaderSection_MakeHeader.hxx>
@@ -256,7 +261,7 @@ std::size_t count_in_file(const std::string& path, const std::string& needle) {
 int usage() {
   std::fprintf(stderr,
                "usage: make_board_assembly --out OUT.step --placements N [--seed S] [--name board] "
-               "[--list FILE] [--verbose] [MODEL.step...]\n");
+               "[--list FILE] [--verbose] [--seat MM] [--uncertainty MM] [MODEL.step...]\n");
   return 2;
 }
 
@@ -268,6 +273,8 @@ int main(int argc, char** argv) {
   long placements = -1;
   std::uint64_t seed = 1;
   bool verbose = false;
+  double seat = kSeatHeight;
+  double uncertainty = 0.0;  // 0: OCCT's writer chooses
   std::vector<std::string> paths;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -288,6 +295,11 @@ int main(int argc, char** argv) {
       }
       for (std::string line; std::getline(list, line);)
         if (!line.empty() && line[0] != '#') paths.push_back(line);
+    } else if (a == "--seat" && has_value) {
+      seat = std::strtod(argv[++i], nullptr);
+    } else if (a == "--uncertainty" && has_value) {
+      uncertainty = std::strtod(argv[++i], nullptr);
+      if (!(uncertainty > 0.0)) return usage();
     } else if (a == "--verbose") {
       verbose = true;
     } else if (!a.empty() && a[0] == '-') {
@@ -421,7 +433,7 @@ int main(int argc, char** argv) {
     const Model& m = models[p.model];
     const auto [c, s] = cos_sin(p.quarter);
     gp_Trsf t;
-    t.SetValues(c, -s, 0, p.tx, s, c, 0, p.ty, 0, 0, 1, kSeatHeight);
+    t.SetValues(c, -s, 0, p.tx, s, c, 0, p.ty, 0, 0, 1, seat);
     const TDF_Label occurrence = shapes->AddComponent(root, m.product, TopLoc_Location(t));
     const std::string designator = m.prefix + std::to_string(++next_number[m.prefix]);
     TDataStd_Name::Set(occurrence, TCollection_ExtendedString(designator.c_str(), true));
@@ -430,6 +442,10 @@ int main(int argc, char** argv) {
 
   Interface_Static::SetCVal("write.step.schema", "AP214IS");
   Interface_Static::SetCVal("write.step.unit", "MM");
+  if (uncertainty > 0.0) {
+    Interface_Static::SetIVal("write.precision.mode", 2);  // the value given below
+    Interface_Static::SetRVal("write.precision.val", uncertainty);
+  }
   STEPCAFControl_Writer writer;
   writer.SetColorMode(true);
   writer.SetNameMode(true);

@@ -1,9 +1,11 @@
 // Penetration proved on the exact surfaces where the triangles' band hides it (decide_steps.h,
-// depth_step): a planar face against a planar or cylindrical one. A plane's triangles lie on it, so
-// its band is in its outline (chords of curved edges, a board's holes), which inside_face accounts
-// for; a cylinder's points are taken on the exact cylinder (its generators are lines on it). Heights
-// are measured over the exact surfaces: over a plane the signed distance to it, over a cylinder the
-// distance to its axis minus its radius.
+// depth_step): a planar face against a planar, cylindrical or any other face with exact geometry.
+// A plane's triangles lie on it, so its band is in its outline (chords of curved edges, a board's
+// holes), which the "inside" tests account for; a cylinder's points are taken on the exact cylinder
+// (its generators are lines on it), any other surface's by the source's foot points
+// (SurfaceSource::surface_point). Heights are signed distances to the exact surfaces: over a plane
+// along its normal, over a cylinder from its axis minus the radius, over another surface along its
+// normal at the foot point (oriented as at the crossing).
 #include "decide_steps.h"
 
 #include "cadclash/geometry.h"
@@ -16,48 +18,69 @@ namespace {
 
 constexpr std::size_t kMaxCrossingTrials = 8;  // crossing points tried, spread over the crossing
 constexpr int kBisections = 8;                 // steps from the smallest depth that proves it toward the band's top
-constexpr int kStepTrials = 4;                 // tries to reach a height over a cylinder (not linear in the step)
+constexpr int kStepTrials = 4;                 // tries to reach a height over a curved surface (not linear in the step)
+constexpr int kNewtonSteps = 6;                // onto the curve where a surface meets a plane
+constexpr std::size_t kVertexTrials = 4;       // a general face's vertices tried per side of the other surface
 // sin 0.5°: a direction closer than this to a surface's tangent plane does not rise over it.
 constexpr double kMinSine = 0.0087;
 
-// A plane or a cylinder, in A's frame.
-struct Shape {
-  bool plane = true;
-  Vec3 o;     // plane: a point on it; cylinder: a point on its axis
-  Vec3 n;     // plane: unit normal; cylinder: unit axis
-  double radius = 0.0;
+enum class Kind { Plane, Cylinder, General };
 
-  Vec3 radial(const Vec3& x) const { return (x - o) - (x - o).dot(n) * n; }
-  double height(const Vec3& x) const { return plane ? n.dot(x - o) : radial(x).norm() - radius; }
-  // The direction in which height grows at x (the normal of the surface through x parallel to this one).
-  std::optional<Vec3> rise(const Vec3& x) const {
-    if (plane) return n;
-    const Vec3 r = radial(x);
-    if (!(r.norm() > 0.0)) return std::nullopt;
-    return Vec3(r.normalized());
-  }
-  // x's foot on the surface.
-  std::optional<Vec3> foot(const Vec3& x) const {
-    if (plane) return Vec3(x - height(x) * n);
-    const Vec3 r = radial(x);
-    if (!(r.norm() > 0.0)) return std::nullopt;
-    return Vec3(x - r + radius * r.normalized());
-  }
-};
-
+// The exact surface of one face, and the face, seen from A's frame.
 struct Side {
   FaceView f;
-  Shape s;
-  const Pose* to_own;  // A's frame → this face's part frame
-  const SurfaceSource* source;  // the face's exact geometry (null: none)
-  std::uint32_t local;          // the face's index in its source
+  Kind kind = Kind::General;
+  Vec3 o = Vec3::Zero();  // plane: a point on it; cylinder: a point on its axis
+  Vec3 n = Vec3::UnitZ();  // plane: unit normal; cylinder: unit axis
+  double radius = 0.0;
+  const Pose* to_own = nullptr;  // A's frame → the face's part frame
+  const Pose* to_a = nullptr;    // back
+  const SurfaceSource* source = nullptr;  // the face's exact geometry (null: none)
+  std::uint32_t local = 0;                // the face's index in its source
 };
 
-// The classifier's answers one pair may ask for (each an OCCT projection and face classification).
+// What one pair may ask its sources (OCCT projections and face classifications).
 struct Asked {
-  int left = 16;
+  int classify = 16;
+  int feet = 96;
   CollideCounters& c;
 };
+
+// A point of a surface, its unit normal there (a cylinder's: outward; a general one's: either way)
+// and how far the point may be from the exact surface.
+struct Foot {
+  Vec3 point;
+  Vec3 normal;
+  double rounding = 0.0;
+};
+
+std::optional<Foot> foot(const Side& s, const Vec3& x, Asked& asked) {
+  switch (s.kind) {
+    case Kind::Plane: return Foot{x - s.n.dot(x - s.o) * s.n, s.n, 0.0};
+    case Kind::Cylinder: {
+      const Vec3 radial = (x - s.o) - (x - s.o).dot(s.n) * s.n;
+      if (!(radial.norm() > 0.0)) return std::nullopt;
+      const Vec3 u = radial.normalized();
+      return Foot{x - radial + s.radius * u, u, 0.0};
+    }
+    case Kind::General: {
+      if (s.source == nullptr || asked.feet <= 0) return std::nullopt;
+      --asked.feet;
+      ++asked.c.witness_queries;
+      const auto sp = s.source->surface_point(s.local, *s.to_own * x);
+      if (!sp) return std::nullopt;
+      return Foot{*s.to_a * sp->point, (s.to_a->linear() * sp->normal).normalized(), sp->rounding};
+    }
+  }
+  return std::nullopt;
+}
+
+// x's signed height over s (its foot f given): along the normal, a general surface's oriented as `up`.
+double height(const Side& s, const Vec3& x, const Foot& f, const Vec3& up) {
+  if (s.kind == Kind::Plane) return s.n.dot(x - s.o);
+  const Vec3 nu = s.kind == Kind::General && f.normal.dot(up) < 0.0 ? Vec3(-f.normal) : f.normal;
+  return nu.dot(x - f.point);
+}
 
 // Whether x (a point of the side's exact surface, within r) lies inside the face: by its triangles
 // (clear of their outline by twice the deflection: 0 returned), else by the exact face classifier
@@ -67,74 +90,108 @@ struct Asked {
 std::optional<double> inside(const Side& side, const Vec3& x, double r, double within, Asked& asked) {
   const Vec3 own = *side.to_own * x;
   if (inside_face(side.f, own, r)) return 0.0;
-  if (side.source == nullptr || asked.left <= 0) return std::nullopt;
-  --asked.left;
+  if (side.source == nullptr || asked.classify <= 0) return std::nullopt;
+  --asked.classify;
   ++asked.c.witness_queries;
   const std::optional<double> d = side.source->point_distance(side.local, own);
   if (!d || !(*d <= within)) return std::nullopt;
   return *d;
 }
 
-std::optional<Shape> shape_of(const Surface& s, const Pose& to_a) {
-  const AnalyticSurface an = transform_analytic(s.analytic, to_a);
-  if (an.shape == SurfaceShape::Plane) return Shape{true, an.origin, an.axis.normalized(), 0.0};
-  if (an.shape == SurfaceShape::Cylinder) return Shape{false, an.origin, an.axis.normalized(), an.radius};
+struct Tolerances {
+  double r;       // rounding of points and heights in A's frame
+  double within;  // what a point may be off its face and still count, given away from the depth
+};
+
+// A point of `own` at height sign * >= h over `other` whose foot is inside `other`'s face: the
+// height reached minus what it gives away, or nothing. x must be a point of own's exact surface
+// (within `off`).
+std::optional<double> witness(const Side& own, const Side& other, const Vec3& x, double off, double sign, double h,
+                              const Vec3& up, const Tolerances& tol, Asked& asked) {
+  const std::optional<Foot> f = foot(other, x, asked);
+  if (!f) return std::nullopt;
+  const double hx = sign * height(other, x, *f, up);
+  if (!(hx - off - f->rounding >= h)) return std::nullopt;
+  const std::optional<double> off_own = inside(own, x, tol.r, tol.within, asked);
+  if (!off_own) return std::nullopt;
+  const std::optional<double> off_other = inside(other, f->point, tol.r + f->rounding, tol.within, asked);
+  if (!off_other) return std::nullopt;
+  return hx - off - f->rounding - *off_own - *off_other;
+}
+
+// A general face: its vertices farthest on that side of `other` (by their heights), moved onto the
+// exact surface (their foot points), tried until one witnesses.
+std::optional<double> vertex_witness(const Side& own, const Side& other, double sign, double h, const Vec3& up,
+                                     const Tolerances& tol, Asked& asked) {
+  const TriangleMesh& mesh = own.f.surface.mesh;
+  std::vector<std::pair<double, std::uint32_t>> far;
+  for (std::uint32_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3 v = *own.to_a * mesh.vertices[i];
+    const Foot f{v - other.n.dot(v - other.o) * other.n, other.n, 0.0};  // other is a plane here
+    const double hv = sign * height(other, v, f, up);
+    if (hv >= h) far.emplace_back(-hv, i);
+  }
+  const std::size_t keep = std::min(far.size(), kVertexTrials);
+  std::partial_sort(far.begin(), far.begin() + static_cast<std::ptrdiff_t>(keep), far.end());
+  for (std::size_t k = 0; k < keep; ++k) {
+    const std::optional<Foot> on_own = foot(own, *own.to_a * mesh.vertices[far[k].second], asked);
+    if (!on_own) continue;
+    if (auto d = witness(own, other, on_own->point, on_own->rounding, sign, h, up, tol, asked)) return d;
+  }
   return std::nullopt;
 }
 
-// A direction from c that stays on `own`'s surface (a line in a plane, a cylinder's generator) along
-// which the height over `other` grows; nothing where it would barely grow.
-std::optional<Vec3> walk(const Shape& own, const Shape& other, const Vec3& c) {
-  const std::optional<Vec3> g = other.rise(c);
-  if (!g) return std::nullopt;
-  Vec3 d = own.plane ? Vec3(*g - g->dot(own.n) * own.n) : own.n;
+// The points of `own` at height +-h over `other`, each inside its face, its foot on `other` inside
+// that face: along own's surface from c (a line of a plane across the crossing, a cylinder's
+// generator), or a general face's vertices. Returns the smaller of the two depths, or nothing.
+std::optional<double> straddle(const Side& own, const Side& other, const Vec3& c, const Vec3& up, double h,
+                               const Tolerances& tol, Asked& asked) {
+  double reached = std::numeric_limits<double>::infinity();
+  if (own.kind == Kind::General) {
+    for (const double sign : {1.0, -1.0}) {
+      const auto d = vertex_witness(own, other, sign, h, up, tol, asked);
+      if (!d) return std::nullopt;
+      reached = std::min(reached, *d);
+    }
+    return reached;
+  }
+  const std::optional<Foot> at_c = foot(other, c, asked);
+  if (!at_c) return std::nullopt;
+  const Vec3 g = other.kind == Kind::General && at_c->normal.dot(up) < 0.0 ? Vec3(-at_c->normal) : at_c->normal;
+  Vec3 d = own.kind == Kind::Plane ? Vec3(g - g.dot(own.n) * own.n) : own.n;
   if (!(d.norm() > 0.0)) return std::nullopt;
   d.normalize();
-  if (d.dot(*g) < 0.0) d = -d;
-  if (!(d.dot(*g) > kMinSine)) return std::nullopt;
-  return d;
-}
-
-// The points of `own` through c at height +-h over `other`, each inside its face, its foot on
-// `other` inside that face. Returns the smaller of the two heights reached, or nothing.
-std::optional<double> straddle(const Side& own, const Side& other, const Vec3& c, double h, double r, double within,
-                               Asked& asked) {
-  const std::optional<Vec3> d = walk(own.s, other.s, c);
-  if (!d) return std::nullopt;
-  double reached = std::numeric_limits<double>::infinity();
+  if (d.dot(g) < 0.0) d = -d;
+  const double rate = d.dot(g);
+  if (!(rate > kMinSine)) return std::nullopt;
   for (const double sign : {1.0, -1.0}) {
-    // Linear in the step over a plane; over a cylinder a few corrections from the height reached.
-    double step = sign * h / d->dot(*other.s.rise(c));
-    double hx = 0.0;
-    Vec3 x = c;
-    for (int k = 0; k < kStepTrials; ++k) {
-      x = c + step * *d;
-      hx = other.s.height(x);
-      if (sign * hx >= h) break;
-      if (!(sign * hx > 0.0)) return std::nullopt;
-      step *= 1.25 * h / (sign * hx);
+    // Linear in the step over a plane; over a curved surface a few corrections from the height reached.
+    double step = sign * h / rate;
+    std::optional<double> got;
+    for (int k = 0; k < kStepTrials && !got; ++k) {
+      const Vec3 x = c + step * d;
+      const std::optional<Foot> f = foot(other, x, asked);
+      if (!f) return std::nullopt;
+      const double hx = sign * height(other, x, *f, up);
+      if (!(hx > 0.0)) return std::nullopt;
+      if (hx - f->rounding >= h) got = witness(own, other, x, 0.0, sign, h, up, tol, asked);
+      if (!got && hx - f->rounding >= h) return std::nullopt;  // high enough, but not inside the faces
+      step *= 1.25 * h / hx;
     }
-    if (!(sign * hx >= h)) return std::nullopt;
-    const std::optional<Vec3> f = other.s.foot(x);
-    if (!f) return std::nullopt;
-    const std::optional<double> off_own = inside(own, x, r, within, asked);
-    if (!off_own) return std::nullopt;
-    const std::optional<double> off_other = inside(other, *f, r, within, asked);
-    if (!off_other) return std::nullopt;
-    reached = std::min(reached, sign * hx - *off_own - *off_other);
+    if (!got) return std::nullopt;
+    reached = std::min(reached, *got);
   }
   return reached;
 }
 
-// The depth both faces reach through each other at c (on both surfaces), at least h: their heights
-// minus the rounding of points and heights.
-std::optional<double> crossing_at(const Side& a, const Side& b, const Vec3& c, double h, double r, double within,
-                                  Asked& asked) {
-  const auto da = straddle(a, b, c, h, r, within, asked);
+// The depth both faces reach through each other at c (a point of both), at least h.
+std::optional<double> crossing_at(const Side& a, const Side& b, const Vec3& c, const Vec3& up_a, const Vec3& up_b,
+                                  double h, const Tolerances& tol, Asked& asked) {
+  const auto da = straddle(a, b, c, up_b, h, tol, asked);
   if (!da) return std::nullopt;
-  const auto db = straddle(b, a, c, h, r, within, asked);
+  const auto db = straddle(b, a, c, up_a, h, tol, asked);
   if (!db) return std::nullopt;
-  return std::min(*da, *db) - 2.0 * r;
+  return std::min(*da, *db) - 2.0 * tol.r;
 }
 
 // The part of segment [e0, e1] inside `box` (slab clipping), or nothing.
@@ -155,15 +212,15 @@ std::optional<std::pair<Vec3, Vec3>> clip(const Vec3& e0, const Vec3& e1, const 
   return std::pair{e0 + s0 * d, e0 + s1 * d};
 }
 
-// Where the triangles of `q`'s face (mapped into A's frame by `to_a`) cross plane `p`, within
-// `region`: the midpoint of each crossing segment's part there, moved onto q's exact surface and
-// back onto the plane along a line of q's surface (a cylinder's generator): points of both surfaces.
-void crossings(const Side& q, const Pose& to_a, const Shape& p, const Aabb& region, std::vector<Vec3>& out) {
+// Where the triangles of `q` cross plane `p`, within `region`: the midpoint of each crossing
+// segment's part there (in triangle order).
+std::vector<Vec3> crossings(const Side& q, const Side& p, const Aabb& region) {
+  std::vector<Vec3> out;
   const TriangleMesh& mesh = q.f.surface.mesh;
   for (const auto& tri : mesh.triangles) {
-    const Vec3 v[3] = {to_a * mesh.vertices[tri[0]], to_a * mesh.vertices[tri[1]], to_a * mesh.vertices[tri[2]]};
+    const Vec3 v[3] = {*q.to_a * mesh.vertices[tri[0]], *q.to_a * mesh.vertices[tri[1]], *q.to_a * mesh.vertices[tri[2]]};
     double h[3];
-    for (int k = 0; k < 3; ++k) h[k] = p.height(v[k]);
+    for (int k = 0; k < 3; ++k) h[k] = p.n.dot(v[k] - p.o);
     if (!(std::min({h[0], h[1], h[2]}) < 0.0 && std::max({h[0], h[1], h[2]}) > 0.0)) continue;
     Vec3 ends[2];
     int found = 0;
@@ -173,17 +230,53 @@ void crossings(const Side& q, const Pose& to_a, const Shape& p, const Aabb& regi
       ends[found++] = v[k] + (h[k] / (h[k] - h[l])) * (v[l] - v[k]);
     }
     if (found < 2) continue;
-    const auto part = clip(ends[0], ends[1], region);
-    if (!part) continue;
-    Vec3 c = 0.5 * (part->first + part->second);
-    if (!q.s.plane) {
-      const std::optional<Vec3> on_q = q.s.foot(c);
-      const double rate = p.n.dot(q.s.n);
-      if (!on_q || !(std::abs(rate) > kMinSine)) continue;
-      c = *on_q - (p.height(*on_q) / rate) * q.s.n;
-    }
-    out.push_back(c);
+    if (const auto part = clip(ends[0], ends[1], region)) out.push_back(0.5 * (part->first + part->second));
   }
+  return out;
+}
+
+// A crossing point x of q's triangles with plane p moved onto both exact surfaces: a plane's point
+// is on it already; a cylinder's goes to the cylinder and back onto p along its generator; another
+// surface's by Newton on the curve where it meets p. Returns the point and what it may be off q
+// (its distance to p is within the rounding).
+std::optional<std::pair<Vec3, double>> onto_both(const Side& q, const Side& p, const Vec3& x, double within, Asked& asked) {
+  if (q.kind == Kind::Plane) return std::pair{x, 0.0};
+  if (q.kind == Kind::Cylinder) {
+    const std::optional<Foot> on_q = foot(q, x, asked);
+    const double rate = p.n.dot(q.n);
+    if (!on_q || !(std::abs(rate) > kMinSine)) return std::nullopt;
+    return std::pair{Vec3(on_q->point - (p.n.dot(on_q->point - p.o) / rate) * q.n), 0.0};
+  }
+  Vec3 y = x;
+  for (int step = 0; step < kNewtonSteps; ++step) {
+    const std::optional<Foot> f = foot(q, y, asked);
+    if (!f) return std::nullopt;
+    const double h = p.n.dot(f->point - p.o);
+    if (std::abs(h) + f->rounding <= within) return std::pair{Vec3(f->point - h * p.n), std::abs(h) + f->rounding};
+    // To the point of the line (p ∩ q's tangent plane) nearest the foot, then its foot again.
+    const double cn = p.n.dot(f->normal);
+    const double den = 1.0 - cn * cn;
+    if (!(den > 1e-6)) return std::nullopt;  // tangent there: no crossing curve to follow
+    const double alpha = -h / den;
+    y = f->point + alpha * p.n - alpha * cn * f->normal;
+  }
+  return std::nullopt;
+}
+
+Side side_of(const Model& m, FaceView f, SurfaceId s, const Pose& to_a, const Pose& to_own) {
+  const Part& part = m.parts[f.surface.part];
+  Side out{f};
+  out.to_own = &to_own;
+  out.to_a = &to_a;
+  out.source = part.source.get();
+  out.local = s - part.first_surface;
+  const AnalyticSurface an = transform_analytic(f.surface.analytic, to_a);
+  if (an.shape == SurfaceShape::Plane) out.kind = Kind::Plane;
+  else if (an.shape == SurfaceShape::Cylinder) out.kind = Kind::Cylinder;
+  out.o = an.origin;
+  out.n = an.axis.normalized();
+  out.radius = an.radius;
+  return out;
 }
 
 }  // namespace
@@ -193,51 +286,65 @@ bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p) {
   if (!t.outcome->intersecting || !t.outcome->crosses_threshold) return false;
   const Surface& a = m.surfaces[t.sa];
   const Surface& b = m.surfaces[t.sb];
+  if (!a.has_triangles || !b.has_triangles) return false;
   auto plane = [](const Surface& s) { return s.analytic.shape == SurfaceShape::Plane; };
-  auto cylinder = [](const Surface& s) { return s.analytic.shape == SurfaceShape::Cylinder; };
-  return a.has_triangles && b.has_triangles &&
-         ((plane(a) && (plane(b) || cylinder(b))) || (cylinder(a) && plane(b)));
+  auto exact = [&](const Surface& s) {  // a cylinder, or a face whose source gives its foot points
+    return s.analytic.shape == SurfaceShape::Cylinder || m.parts[s.part].source != nullptr;
+  };
+  return (plane(a) && (plane(b) || exact(b))) || (plane(b) && exact(a));
 }
 
 bool depth_step(const Model& m, const DecideTask& t, FaceView fa, FaceView fb, Pending& p, CollideCounters& c) {
   if (fa.outline == nullptr || fb.outline == nullptr) return false;
-  const std::optional<Shape> sa = shape_of(fa.surface, Pose::Identity());
-  const std::optional<Shape> sb = shape_of(fb.surface, t.t_ab());
-  if (!sa || !sb) return false;
   const Pose identity = Pose::Identity();
-  const Part& pa = m.parts[fa.surface.part];
-  const Part& pb = m.parts[fb.surface.part];
-  const Side a{fa, *sa, &identity, pa.source.get(), t.sa - pa.first_surface};
-  const Side b{fb, *sb, &t.t_ba(), pb.source.get(), t.sb - pb.first_surface};
-  Asked asked{16, c};
-  const double r = t.roundoff;
-  // Crossing points near both faces: each face's triangles against the other's plane.
-  const Aabb region = own_box(fa.surface).intersection(transform_box(own_box(fb.surface), t.t_ab()));
-  if (region.isEmpty()) return false;
-  std::vector<Vec3> xs;
-  if (a.s.plane) crossings(b, t.t_ab(), a.s, region, xs);
-  if (b.s.plane) crossings(a, identity, b.s, region, xs);
-  if (xs.empty()) return false;
+  const Side a = side_of(m, fa, t.sa, identity, identity);
+  const Side b = side_of(m, fb, t.sb, t.t_ab(), t.t_ba());
   // Deeper than T past the rounding of the heights (each within r), and never deeper than the
-  // triangles allow (T + their band).
+  // triangles allow (T + their band). What the classifier and the feet may leave between a point
+  // and its surface or face is a small part of the headroom, so the heights minus it exceed T.
+  const double r = t.roundoff;
   const double low = p.threshold * (1.0 + 0x1p-20) + 4.0 * r;
   const double high = p.threshold + p.mesh_band;
   if (!(low < high)) return false;
-  // What the classifier may leave between a point and its face: a small part of the headroom, so
-  // that the heights minus it still exceed T.
-  const double within = (low - p.threshold) / 8.0;
-  const std::size_t stride = (xs.size() + kMaxCrossingTrials - 1) / kMaxCrossingTrials;
-  for (std::size_t k = 0; k < xs.size(); k += stride) {
-    const Vec3& x = xs[k];
+  const Tolerances tol{r, (low - p.threshold) / 16.0};
+  Asked asked{16, 96, c};
+  // Crossing points near both faces: each face's triangles against the other's plane.
+  const Aabb region = own_box(fa.surface).intersection(transform_box(own_box(fb.surface), t.t_ab()));
+  if (region.isEmpty()) return false;
+  struct Start {
+    const Side* q;  // the face whose triangles crossed the plane of the other
+    const Side* p;
+    Vec3 x;
+  };
+  std::vector<Start> starts;
+  if (a.kind == Kind::Plane)
+    for (const Vec3& x : crossings(b, a, region)) starts.push_back({&b, &a, x});
+  if (b.kind == Kind::Plane)
+    for (const Vec3& x : crossings(a, b, region)) starts.push_back({&a, &b, x});
+  if (starts.empty()) return false;
+  const std::size_t stride = (starts.size() + kMaxCrossingTrials - 1) / kMaxCrossingTrials;
+  for (std::size_t k = 0; k < starts.size(); k += stride) {
+    const Start& s = starts[k];
+    const auto on = onto_both(*s.q, *s.p, s.x, tol.within, asked);
+    if (!on) continue;
+    const Vec3& x = on->first;
     // The crossing point itself, inside both faces.
-    if (!inside(a, x, r, within, asked) || !inside(b, x, r, within, asked)) continue;
-    std::optional<double> proved = crossing_at(a, b, x, low + 4.0 * within, r, within, asked);
+    const auto in_a = inside(a, x, r + on->second, tol.within, asked);
+    const auto in_b = in_a ? inside(b, x, r + on->second, tol.within, asked) : std::nullopt;
+    if (!in_b) continue;
+    // A general surface's normal at the crossing orients its heights on both sides.
+    const std::optional<Foot> fa_x = foot(a, x, asked);
+    const std::optional<Foot> fb_x = foot(b, x, asked);
+    if (!fa_x || !fb_x) continue;
+    const Vec3 up_a = fa_x->normal, up_b = fb_x->normal;
+    const double first = low + 8.0 * tol.within + on->second;
+    std::optional<double> proved = crossing_at(a, b, x, up_a, up_b, first, tol, asked);
     if (!proved || !(*proved > p.threshold)) continue;
     // The deepest height this crossing holds, up to the band's top (what a depth estimate says).
-    double lo = low, hi = high;
+    double lo = first, hi = high;
     for (int i = 0; i < kBisections; ++i) {
       const double mid = 0.5 * (lo + hi);
-      if (const auto d = crossing_at(a, b, x, mid, r, within, asked); d && *d > p.threshold) {
+      if (const auto d = crossing_at(a, b, x, up_a, up_b, mid, tol, asked); d && *d > p.threshold) {
         lo = mid;
         proved = std::max(*proved, *d);
       } else {

@@ -68,18 +68,18 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = fa
 void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
                    Pending& p, const CollideOptions& o, CollideCounters& c);
 
-// After a contact is proved: a planar face and a planar or cylindrical one whose triangles cross
-// deeper than T (the band hides whether the faces do) are proved penetrating on their exact
-// surfaces (decide_depth.cpp): a point c of both surfaces where the triangles cross, inside both
-// faces, and from it, along each surface (a line of the plane across the crossing, a cylinder's
-// generator), the points at height ±H over the other surface (H > T) inside their own face, their
-// feet on the other surface inside the other face (by the triangles, else the exact classifier
-// finding them on the face within the rounding). Sets p.cls Penetrating and p.depth (the largest
-// H it proved, at most T + the band) and returns true; false leaves p as it was. Precondition: p
-// settled in contact.
+// After a contact is proved: a planar face and a planar, cylindrical or other exact face whose
+// triangles cross deeper than T (the band hides whether the faces do) are proved penetrating on
+// their exact surfaces (decide_depth.cpp): a point c of both surfaces where the triangles cross,
+// inside both faces, and points of each face at height above +H and below -H over the other's
+// exact surface (H > T; along a plane or a cylinder's generator from c, or a general face's
+// vertices moved onto it), inside their own face, their feet on the other surface inside the other
+// face (by the triangles, else the exact classifier, what it leaves given away from H). Sets p.cls
+// Penetrating and p.depth (the largest H it proved, at most T + the band) and returns true; false
+// leaves p as it was. Precondition: p settled in contact.
 bool depth_step(const Model& m, const DecideTask& t, FaceView a, FaceView b, Pending& p, CollideCounters& c);
-// Whether depth_step can apply to task t (a plane against a plane or cylinder, triangles crossing
-// deeper than T, the pair settled touching): the faces' outlines are then needed.
+// Whether depth_step can apply to task t (a plane against a plane, a cylinder or a face with exact
+// geometry, triangles crossing deeper than T, the pair settled touching): the outlines are then needed.
 bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p);
 
 // Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface

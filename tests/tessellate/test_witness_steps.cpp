@@ -280,29 +280,34 @@ TEST(CrossingWitness, SunkPartsTouchWithoutTheExactFaceDistance) {
   }
 }
 
-// A box or a cylinder sunk into a disk's flat top (a plane bounded by a circle: its triangles' band
-// is the 0.1 mm deflection) with every face's ε 0.01 mm, so T = 0.02 at tolerance 0. Sunk 0.06 mm,
-// their side faces cross the top deeper than T but within T + the band: the triangles cannot tell,
-// the exact plane and cylinder do (penetrating, decided analytic, the proved depth in (T, 0.06]).
-// Sunk 0.015 mm (within T) they are touching. The same wherever the pair is placed.
+// A box, a cylinder, a sphere or a box whose faces are B-splines sunk into a disk's flat top (a plane
+// bounded by a circle: its triangles' band is the 0.1 mm deflection) with every face's ε 0.01 mm, so
+// T = 0.02 at tolerance 0. Sunk 0.06 mm, their side faces cross the top deeper than T but within T +
+// the band: the triangles cannot tell, the exact surfaces do (penetrating, decided analytic, the
+// proved depth in (T, 0.06]). Sunk 0.015 mm (within T) they are touching. The same wherever the
+// pair is placed.
 TEST(DepthWitness, FacesCrossingDeeperThanTheUncertaintyArePenetrating) {
+  enum Kind { Box, Cylinder, Sphere, SplineBox };
+  const char* names[] = {"box", "cylinder", "sphere", "B-spline box"};
   for (const Pose& where : {Pose::Identity(), moved(Vec3(1e6, -3e5, 2e4), 0.7)})
-  for (const bool cylinder : {false, true})
+  for (const Kind kind : {Box, Cylinder, Sphere, SplineBox})
     for (const double sunk : {0.06, 0.015}) {
-      Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(),
-                       cylinder ? BRepPrimAPI_MakeCylinder(3, 5).Shape() : BRepPrimAPI_MakeBox(6, 4, 5).Shape()},
-                      0.1);
+      const TopoDS_Shape part = kind == Cylinder ? BRepPrimAPI_MakeCylinder(3, 5).Shape()
+                                : kind == Sphere ? BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 3), 3).Shape()
+                                : kind == Box    ? BRepPrimAPI_MakeBox(6, 4, 5).Shape()
+                                                 : BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeBox(6, 4, 5).Shape()).Shape();
+      Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(), part}, 0.1);
       for (Surface& s : m.surfaces) s.uncertainty = 0.01;
       place(m, 0, "/disk", where);
       place(m, 1, "/part", where * moved(Vec3(-3, -2, 2 - sunk), 0.3));
       const Outcome r = check_pair(m, 0.0);
-      const std::string what = std::string(cylinder ? "cylinder" : "box") + " sunk " + std::to_string(sunk) + " at " +
+      const std::string what = std::string(names[kind]) + " sunk " + std::to_string(sunk) + " at " +
                                std::to_string(where.translation().x());
       EXPECT_EQ(r.report.counters.undecided, 0u) << what;
       int sides = 0;
       for (const SurfacePairResult& p : r.report.pairs) {
         const Surface& b = m.surfaces[p.surface_b];
-        if (b.aabb.sizes().z() < 4.0) continue;  // the box's side faces (5 mm tall), not its bottom
+        if (b.aabb.sizes().z() < 4.0) continue;  // the side faces (5 or 6 mm tall), not a bottom
         ++sides;
         if (sunk > 0.02) {
           EXPECT_EQ(p.contact, ContactClass::Penetrating) << what << " " << b.name;
@@ -314,7 +319,7 @@ TEST(DepthWitness, FacesCrossingDeeperThanTheUncertaintyArePenetrating) {
           EXPECT_EQ(p.contact, ContactClass::Touching) << what << " " << b.name;
         }
       }
-      EXPECT_EQ(sides, cylinder ? 1 : 4) << what;
+      EXPECT_EQ(sides, kind == Cylinder || kind == Sphere ? 1 : 4) << what;
     }
 }
 

@@ -120,14 +120,16 @@ namespace cadclash {
 //             most 16,384 pairs of pieces);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
-//   depth     (after any of the above proved contact) two planar faces whose triangles cross deeper
-//             than T but within T + δa + δb + r: a point where one face's triangles cross the other's
-//             plane, inside both faces, and from it, within each face's plane across the line where
-//             the planes meet, the points at height ±H over the other plane (H > T) inside their own
-//             face, their feet on the other plane inside the other face, prove the exact faces cross
-//             deeper than T: penetrating (decided_by Analytic; penetration = the largest H proved).
-//             Heights are measured on the exact planes (a planar face's triangles lie on it; its band
-//             is in the outline, which "inside" accounts for).
+//   depth     (after any of the above proved contact) a planar face and a planar, cylindrical or
+//             other exact face whose triangles cross deeper than T but within T + δa + δb + r: a
+//             point where one's triangles cross the other's plane, moved onto both exact surfaces
+//             and inside both faces, and points of each face at heights above +H and below -H over
+//             the other's exact surface (H > T; a line of a plane across the crossing, a cylinder's
+//             generator, a general face's vertices moved onto it by SurfaceSource::surface_point),
+//             inside their own face, their feet on the other surface inside the other face (by the
+//             triangles, else SurfaceSource::point_distance), prove the exact faces cross deeper
+//             than T: penetrating (decided_by Analytic; penetration = the largest H proved, at most
+//             T + the band). Heights are signed distances to the exact surfaces.
 // A pair none of these decides (mesh-only input, no exact geometry, OCCT failed) is reported with
 // class Undecided and its interval, never as touching. Clearance (T < d* <= clearance) is judged on
 // the mesh distance (or d* when it was computed). Results do not depend on the thread count.
