@@ -24,7 +24,7 @@ else
   cmake -S "$root" -B "$build" -DCADCLASH_BUILD_BENCH=ON -DCADCLASH_BUILD_TESTS=ON >/dev/null
 fi
 cmake --build "$build" -j "$(nproc)" --target bench_accuracy test_triangle_predicates bench_scale_path \
-  bench_triangle_predicates
+  bench_triangle_predicates make_board_assembly cadclash
 compare_built=no
 if cmake --build "$build" --target help | grep -q '^bench_compare:'; then
   if cmake --build "$build" -j "$(nproc)" --target bench_compare; then compare_built=yes
@@ -111,6 +111,8 @@ for name, r in rows.items():
     ns_s, ns_e = 1e9 * s["per_pair"], 1e9 * e["per_pair"]
     print(f"| {name} | {ns_s:.1f} | {100 * s.get('fallback', 0.0):.2f}% | {ns_e:.1f} | {ns_e / ns_s:.1f}x |")
 PY
+echo "results: the model-uncertainty band on real-part boards (scripts/uncertainty_bench.sh)"
+bash "$root/scripts/uncertainty_bench.sh" "$build" "$out/uncertainty" >"$out/uncertainty.md"
 elapsed=$(( $(date +%s) - start ))
 
 # Plots next to the page; links in the embedded tables point there.
@@ -142,6 +144,7 @@ while IFS= read -r line || [ -n "$line" ]; do
     @PREDICATES@) cat "$out/predicates.md" ;;
     @PIPELINE_ORACLE@) cat "$out/pipeline.md" ;;
     @SCALE@) cat "$out/scale.md" ;;
+    @UNCERTAINTY_BAND@) cat "$out/uncertainty.md" ;;
     @IMPORT_PEER@)
       # Measured by scripts/import_peer_bench.sh (~20 min), not here: its last table, as it is.
       bench=$root/out/import_peer_bench
