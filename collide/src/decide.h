@@ -1,4 +1,4 @@
-// The certified decision of one candidate surface pair (collide.h, "Certified decisions"): what the
+// The certified decision of one candidate surface pair (contact_classes.h, "Certified decisions"): what the
 // triangles prove about the exact faces, and the analytic certificate. Internal to cadclash::collide.
 #pragma once
 
@@ -145,7 +145,7 @@ struct DecideResult {
   bool cut = false;                         // the deadline stopped its refinement: no answer
 };
 
-// The decision stage (collide.h, "Certified decisions"), per options.decision. Refinements run in
+// The decision stage (contact_classes.h, "Certified decisions"), per options.decision. Refinements run in
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
 // is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface),
 // `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).

@@ -92,7 +92,7 @@ void run_pair(const Surface& sa, const PreparedPair& p, std::size_t begin, std::
 // Merges the outcome of a later block into an earlier one (blocks in ascending order of A's triangles).
 void merge_outcome(PairOutcome& into, PairOutcome&& later);
 
-// Crossing depth of two intersecting triangles (see "Penetrating" in collide.h).
+// Crossing depth of two intersecting triangles (see "Penetrating" in contact_classes.h).
 double crossing_depth(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
                       const Vec3& b2);
 

@@ -107,7 +107,7 @@ class PairResult:
     name and, for STEP faces, the ``#id`` of the ADVANCED_FACE. For containment the surface fields
     are None (the whole part). ``distance`` is the minimum triangle distance, 0 when intersecting
     (containment: ``math.inf`` when beyond the search margin); ``penetration`` is the crossing-depth
-    estimate (a lower bound in early-exit mode). See ``collide.h`` for the exact class definitions.
+    estimate (a lower bound in early-exit mode). See ``contact_classes.h`` for the exact class definitions.
     """
 
     contact: str                  # "penetrating", "touching", "clearance", "containment" or "undecided"
@@ -135,7 +135,7 @@ class PairResult:
     distance_lo: float = 0.0
     distance_hi: float = 0.0
     # Penetrating and touching pairs: "tolerance" when the tolerance alone holds the contact, "model
-    # uncertainty" when only the faces' ε does; None when the interval cannot tell (collide.h, ContactWithin).
+    # uncertainty" when only the faces' ε does; None when the interval cannot tell (contact_classes.h, ContactWithin).
     contact_within: Optional[str] = None
 
     @property

@@ -1,7 +1,7 @@
 // Certified decisions against the exact B-rep truth, and invariance (issue items 4 and 5).
 //
 // Truth (cadclash::truth): the exact face distance d* of every face pair, by BRepExtrema on the placed
-// faces; a pair is in contact when d* <= tolerance + εa + εb (collide.h, "Certified decisions").
+// faces; a pair is in contact when d* <= tolerance + εa + εb (contact_classes.h, "Certified decisions").
 // Reported: the pairs Scene::check classes Penetrating or Touching (clearance pairs are not contacts).
 // With the default options (decision Certified) and with decision Exact, at tolerances 1e-4 and
 // 0.025 mm, every scene must score 100% recall and 100% precision with no Undecided pair:

@@ -3,7 +3,7 @@
 // placed faces), and how a set of reported surface pairs scores against it. Library cadclash::truth
 // (tests/support); not part of the product.
 //
-// Contact is the library's own definition (collide.h, "Certified decisions"): two faces are in
+// Contact is the library's own definition (contact_classes.h, "Certified decisions"): two faces are in
 // contact when their exact distance d* <= T = tolerance + εa + εb, ε being each surface's model
 // uncertainty (Surface::uncertainty, or when that is 0 the single-precision bound 2^-24 of its part's
 // largest coordinate magnitude, as collide derives it). No extra slack.
