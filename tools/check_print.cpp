@@ -86,6 +86,10 @@ void print_summary(const Report& r, bool timings, std::ostream& os) {
     os << "time: " << fmt(r.timings.total * 1e3) << " ms (broad " << fmt(r.timings.broad * 1e3) << ", surfaces "
        << fmt(r.timings.surface_level * 1e3) << ", tessellation " << fmt(r.timings.tessellation * 1e3)
        << ", triangles " << fmt(r.timings.triangle_level * 1e3) << ")\n";
+  if (timings && r.counters.ambiguous_pairs + r.counters.decided_analytic + r.counters.decided_exact > 0)
+    os << "decision steps (ms, summed over threads): witnesses " << fmt(r.timings.decide_witness * 1e3) << ", depth "
+       << fmt(r.timings.decide_depth * 1e3) << ", refinement " << fmt(r.timings.decide_refine * 1e3) << ", hulls "
+       << fmt(r.timings.decide_hull * 1e3) << ", exact " << fmt(r.timings.decide_exact * 1e3) << '\n';
 }
 
 std::string stopped_text(const std::string& stopped_by) {

@@ -149,13 +149,14 @@ struct DecideResult {
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
 // is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface),
 // `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).
-// Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`.
+// Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`, and the
+// seconds each step took to `timings`' decide_* fields.
 // `eps` holds every surface's effective_uncertainty, `bvh` the tree of every surface with triangles.
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        std::vector<RefinedSurface>& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
-                                       CollideCounters& counters);
+                                       CollideCounters& counters, CollideTimings& timings);
 
 // decide_pairs in two halves (certified or exact decision), for a caller that starts each task's
 // decision as soon as its triangles are done, on the thread that did them: early(k) runs steps 1 to
@@ -176,7 +177,7 @@ class DecisionRun {
   DecisionRun& operator=(const DecisionRun&) = delete;
   void early(std::size_t k);
   void skip(std::size_t k);
-  std::vector<DecideResult> finish(CollideCounters& counters);
+  std::vector<DecideResult> finish(CollideCounters& counters, CollideTimings& timings);
   struct Impl;
 
  private:

@@ -2,6 +2,7 @@
 
 #include "team_loop.h"
 
+#include <chrono>
 #include <map>
 
 namespace cadclash::detail {
@@ -14,7 +15,7 @@ bool can_refine(const Model& model, SurfaceId s) {
 double refinement_deflection(const Surface& s) { return 0.1 * s.deflection; }
 
 std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfaces,
-                            std::vector<RefinedSurface>& cache, int threads) {
+                            std::vector<RefinedSurface>& cache, int threads, double* seconds) {
   std::map<PartId, std::vector<SurfaceId>> by_part;  // a source is thread-safe across parts only
   for (SurfaceId s : surfaces) {
     if (cache[s].attempted) continue;
@@ -24,8 +25,10 @@ std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfa
   std::vector<std::vector<SurfaceId>> work;
   for (auto& [part, ids] : by_part) work.push_back(std::move(ids));
   std::vector<std::size_t> meshed(work.size(), 0);
+  std::vector<double> took(work.size(), 0.0);
   const auto n = static_cast<std::ptrdiff_t>(work.size());
   dynamic_loop(n, threads, true, [&](std::ptrdiff_t w) {
+    const auto start = std::chrono::steady_clock::now();
     for (SurfaceId s : work[static_cast<std::size_t>(w)]) {
       const Surface& surf = model.surfaces[s];
       RefinedSurface& r = cache[s];
@@ -47,9 +50,12 @@ std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfa
       r.ok = !r.surface.mesh.triangles.empty();
       if (r.ok) r.bvh = build_surface_bvh(r.surface.mesh);
     }
+    took[static_cast<std::size_t>(w)] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
   std::size_t total = 0;
   for (std::size_t m : meshed) total += m;
+  if (seconds != nullptr)
+    for (double t : took) *seconds += t;
   return total;
 }
 

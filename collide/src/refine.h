@@ -30,9 +30,10 @@ double refinement_deflection(const Surface& s);
 // Fills cache[s] for every listed surface not attempted yet: surfaces that can be refined are meshed
 // by their source at refinement_deflection, in parallel across parts (a source serialises its own
 // part); the rest copy the model's triangles. Deterministic: each result depends on its surface only.
-// Returns the number of surfaces meshed. Precondition: cache.size() == model.surfaces.size().
+// Returns the number of surfaces meshed, and adds to `seconds` (when given) the time each part's
+// meshing took, summed over the threads. Precondition: cache.size() == model.surfaces.size().
 std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfaces,
-                            std::vector<RefinedSurface>& cache, int threads);
+                            std::vector<RefinedSurface>& cache, int threads, double* seconds = nullptr);
 
 // Surface `s` meshed at `deflection` by its source when it can be refined (not cached; for a pair
 // that needs a finer level than the cache holds), else the model's own triangles.

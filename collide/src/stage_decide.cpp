@@ -6,6 +6,7 @@
 #include "team_loop.h"
 
 #include <algorithm>
+#include <chrono>
 #include <atomic>
 #include <cassert>
 #include <thread>
@@ -55,6 +56,23 @@ void run_step(const std::vector<std::size_t>& ks, std::vector<Pending>& pending,
 
 }  // namespace
 
+// Seconds one task's steps took (CollideTimings' decide_* fields).
+struct StepSeconds {
+  double witness = 0.0, depth = 0.0, refine = 0.0, hull = 0.0, exact = 0.0;
+};
+
+// Runs f, adding the seconds it took to `into`.
+template <class F>
+auto timed(double& into, F f) {
+  const auto start = std::chrono::steady_clock::now();
+  struct Add {
+    double& into;
+    std::chrono::steady_clock::time_point start;
+    ~Add() { into += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+  } add{into, start};
+  return f();
+}
+
 // One decision run: its inputs, and each pair's state between the steps.
 struct DecisionRun::Impl {
   const Model& model;
@@ -71,6 +89,8 @@ struct DecisionRun::Impl {
   std::vector<CollideCounters> task_counters = std::vector<CollideCounters>(tasks.size());
   std::vector<char> state = std::vector<char>(tasks.size(), 0);  // EarlyState bits
   std::vector<DecideResult> answers = std::vector<DecideResult>(tasks.size());
+  std::vector<StepSeconds> seconds = std::vector<StepSeconds>(tasks.size());
+  double meshing = 0.0;  // refine_surfaces' time, summed over its threads (written by one thread at a time)
 
   bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
   FaceView view(SurfaceId f) const {
@@ -108,8 +128,8 @@ struct DecisionRun::Impl {
   void early(std::size_t k) {
     Pending p;
     CollideCounters c;
-    const bool ambiguous = early(k, p, c);
-    deepen(k, p, c);
+    const bool ambiguous = timed(seconds[k].witness, [&] { return early(k, p, c); });
+    timed(seconds[k].depth, [&] { deepen(k, p, c); });
     char st = ambiguous ? kAmbiguous : 0;
     if (p.settled || p.cut) {
       CollideCounters counts;
@@ -231,10 +251,13 @@ void refinement_step(Run& run, CollideCounters& counters) {
     return std::any_of(which.begin(), which.end(), [&](SurfaceId s) { return can_refine(model, s); });
   });
   if (!gaps.empty() && !run.deadline.expired())
-    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, run.tasks, gaps), run.refined, run.threads);
+    counters.refined_surfaces +=
+        refine_surfaces(model, refinable_faces(model, run.tasks, gaps), run.refined, run.threads, &run.meshing);
   run.step(gaps, [&](std::size_t k) {
-    refined_step(run.eps, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k], run.o,
-                 run.task_counters[k]);
+    timed(run.seconds[k].refine, [&] {
+      refined_step(run.eps, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k],
+                   run.o, run.task_counters[k]);
+    });
   });
 }
 
@@ -246,8 +269,13 @@ void exact_steps(Run& run, CollideCounters& counters) {
   run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
     Pending& p = run.pending[k];
     const bool certified = run.o.decision == DecisionMode::Certified;
-    if (certified && hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k])) return;
-    if (exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]) || !run.meshed(k)) return;
+    if (certified && timed(run.seconds[k].hull, [&] {
+          return hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k]);
+        }))
+      return;
+    if (timed(run.seconds[k].exact, [&] { return exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]); }) ||
+        !run.meshed(k))
+      return;
     // No exact geometry. Exact mode on triangles that are the surfaces: their verdict stands.
     const bool exact = triangles_are_exact(model, tasks[k].sa) && triangles_are_exact(model, tasks[k].sb);
     settle(p, verdict(p.d, p.threshold), exact ? DecidedBy::MeshExact : DecidedBy::Mesh, tasks[k].outcome,
@@ -256,10 +284,13 @@ void exact_steps(Run& run, CollideCounters& counters) {
   const std::vector<std::size_t> check =
       run.open([&](std::size_t k) { return run.pending[k].needs_lower && run.meshed(k); });
   if (!check.empty() && !run.deadline.expired())
-    counters.refined_surfaces += refine_surfaces(model, refinable_faces(model, tasks, check), run.refined, run.threads);
+    counters.refined_surfaces +=
+        refine_surfaces(model, refinable_faces(model, tasks, check), run.refined, run.threads, &run.meshing);
   run.step(check, [&](std::size_t k) {
-    corroborate(model, run.eps, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
-                run.task_counters[k]);
+    timed(run.seconds[k].exact, [&] {
+      corroborate(model, run.eps, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
+                  run.task_counters[k]);
+    });
   });
 }
 
@@ -278,7 +309,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
-                                       CollideCounters& counters) {
+                                       CollideCounters& counters, CollideTimings& timings) {
   if (o.decision == DecisionMode::Fast) {
     std::vector<DecideResult> results(tasks.size());
     for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
@@ -287,7 +318,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
   DecisionRun run(model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline);
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
   dynamic_loop(n, threads, true, [&](std::ptrdiff_t k) { run.early(static_cast<std::size_t>(k)); });
-  return run.finish(counters);
+  return run.finish(counters, timings);
 }
 
 DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
@@ -307,7 +338,7 @@ void DecisionRun::early(std::size_t k) { impl_->early(k); }
 
 void DecisionRun::skip(std::size_t k) { impl_->pending[k].cut = true; }
 
-std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
+std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters, CollideTimings& timings) {
   Run& run = *impl_;
   for (char st : run.state) counters.ambiguous_pairs += (st & kAmbiguous) != 0;
   if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
@@ -318,8 +349,16 @@ std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters) {
     if (!(run.state[k] & kAnswered) && depth_step_applies(run.model, run.tasks[k], run.pending[k])) late.push_back(k);
   dynamic_loop(static_cast<std::ptrdiff_t>(late.size()), run.threads, true, [&](std::ptrdiff_t i) {
     const std::size_t k = late[static_cast<std::size_t>(i)];
-    run.deepen(k, run.pending[k], run.task_counters[k]);
+    timed(run.seconds[k].depth, [&] { run.deepen(k, run.pending[k], run.task_counters[k]); });
   });
+  timings.decide_refine += run.meshing;
+  for (const StepSeconds& t : run.seconds) {
+    timings.decide_witness += t.witness;
+    timings.decide_depth += t.depth;
+    timings.decide_refine += t.refine;
+    timings.decide_hull += t.hull;
+    timings.decide_exact += t.exact;
+  }
   return collect(run, counters);
 }
 
@@ -421,7 +460,7 @@ void decision_stage(SceneData& s, QueryState& q) {
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
   std::vector<DecideResult> results =
       decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
-                   q.report.counters);
+                   q.report.counters, q.report.timings);
   conclude(q, results, task_of, /*by_task=*/false, meter);
 }
 
@@ -451,7 +490,7 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
   assert(q.first_task[q.cutoff] == ntasks);
   const std::vector<std::size_t> task_of = tasks_to_decide(model, q);  // what decide_pairs would be given
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
-  std::vector<DecideResult> all = run.finish(q.report.counters);  // every task's, task_of's among them
+  std::vector<DecideResult> all = run.finish(q.report.counters, q.report.timings);  // every task's, task_of's among them
   conclude(q, all, task_of, /*by_task=*/true, meter);
 }
 

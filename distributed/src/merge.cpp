@@ -118,6 +118,12 @@ MergedCheck merge_parts(const CheckPlan& plan, std::span<const PartialCheck> par
     r.timings.tessellation = std::max(r.timings.tessellation, pr.timings.tessellation);
     r.timings.triangle_level = std::max(r.timings.triangle_level, pr.timings.triangle_level);
     r.timings.total = std::max(r.timings.total, plan.seconds + pr.timings.total);
+    // The decision's steps: time summed over the pairs and threads, so over the ranks too.
+    r.timings.decide_witness += pr.timings.decide_witness;
+    r.timings.decide_depth += pr.timings.decide_depth;
+    r.timings.decide_refine += pr.timings.decide_refine;
+    r.timings.decide_hull += pr.timings.decide_hull;
+    r.timings.decide_exact += pr.timings.decide_exact;
   }
   merge_surfaces(plan, parts, model, history, out);
   r.model_memory = history.held;

@@ -82,10 +82,15 @@ SurfaceWork work_from(const json& j) {
   return w;
 }
 
-json timings_to(const CollideTimings& t) { return {t.broad, t.surface_level, t.tessellation, t.triangle_level, t.total}; }
+json timings_to(const CollideTimings& t) {
+  json j = json::array();
+  for (const TimingField& f : kTimingFields) j.push_back(t.*f.member);
+  return j;
+}
 CollideTimings timings_from(const json& j) {
-  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>(), j.at(3).get<double>(),
-          j.at(4).get<double>()};
+  CollideTimings t;
+  for (std::size_t k = 0; k < kTimingFields.size(); ++k) t.*kTimingFields[k].member = j.at(k).get<double>();
+  return t;
 }
 
 }  // namespace

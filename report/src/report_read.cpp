@@ -182,7 +182,11 @@ QueryReport read_query(const Json& j, const std::string& p) {
   if (j.contains("timings")) {
     const std::string pt = p + "/timings";
     CollideTimings t;
-    for (const TimingField& f : kTimingFields) t.*f.member = number(field(j["timings"], pt, f.name), pt + "/" + f.name);
+    for (std::size_t k = 0; k < kTimingFields.size(); ++k) {
+      const TimingField& f = kTimingFields[k];
+      if (k >= kStageTimings && !j["timings"].contains(f.name)) continue;  // written before it
+      t.*f.member = number(field(j["timings"], pt, f.name), pt + "/" + f.name);
+    }
     q.timings = t;
   }
   q.stopped_by = string_or_null(field(j, p, "stopped_by"), p + "/stopped_by");

@@ -56,7 +56,7 @@ QueryReport sample_query() {
   q.pairs = {touching, undecided, contained};
   std::uint64_t k = 1;
   for (const CounterField& f : kCounterFields) q.counters.*f.member = k++;
-  q.timings = CollideTimings{0.5, 0.25, 0.125, 1.0 / 3.0, 2.0};
+  q.timings = CollideTimings{0.5, 0.25, 0.125, 1.0 / 3.0, 2.0, 0.0625, 0.03125, 0.75, 0.375, 1.5};
   q.stopped_by = "memory budget";
   q.unexamined_pairs = {{"/a", "/c"}};
   q.memory_charged_bytes = 123456789;
@@ -110,6 +110,19 @@ TEST(ReportRoundTrip, HandMadeReportWithEveryOptionalField) {
   const ReportReadResult read_old = check_report_from_parsed(old);
   ASSERT_FALSE(read_old.error);
   EXPECT_EQ(read_old.report.query->model.total(), 0u);
+  // Written before the decision's step times: read as zeros, the stage times as written.
+  nlohmann::json before_steps = nlohmann::json::parse(text);
+  for (const char* f : {"decide_witness", "decide_depth", "decide_refine", "decide_hull", "decide_exact"})
+    before_steps["timings"].erase(f);
+  const ReportReadResult read_steps = check_report_from_parsed(before_steps);
+  ASSERT_FALSE(read_steps.error);
+  ASSERT_TRUE(read_steps.report.query->timings);
+  EXPECT_EQ(read_steps.report.query->timings->decide_witness, 0.0);
+  EXPECT_EQ(read_steps.report.query->timings->total, q.timings->total);
+  // The stage times stay required.
+  nlohmann::json no_total = nlohmann::json::parse(text);
+  no_total["timings"].erase("total");
+  EXPECT_TRUE(check_report_from_parsed(no_total).error);
   // Without timings: none written, and the rest unchanged.
   const std::string bare = check_report_text(sample_report(), {.timings = false});
   EXPECT_EQ(bare.find("\"timings\""), std::string::npos);

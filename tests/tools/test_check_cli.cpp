@@ -151,6 +151,24 @@ TEST(CheckCli, UncertaintySwitchAndItsSource) {
     for (const char* side : {"a", "b"}) EXPECT_EQ(p[side]["uncertainty_source"], "coordinates");
 }
 
+// Where the certified decision spent its time, per step, in the JSON timings and the table; none in
+// --fast, which decides nothing beyond the triangles.
+TEST(CheckCliAs1, DecisionStepTimes) {
+  const std::string step = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  const char* steps[] = {"decide_witness", "decide_depth", "decide_refine", "decide_hull", "decide_exact"};
+  const std::string json = tmp("steps.json");
+  Proc r = run("check " + step + " --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("decision steps (ms, summed over threads): witnesses "), std::string::npos) << r.out;
+  nlohmann::json t = nlohmann::json::parse(read(json))["timings"];
+  for (const char* f : steps) EXPECT_GE(t[f].get<double>(), 0.0) << f;
+  EXPECT_GT(t["decide_witness"].get<double>(), 0.0);  // as1's contacts are proved by witnesses
+  r = run("check " + step + " --fast --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  t = nlohmann::json::parse(read(json))["timings"];
+  for (const char* f : steps) EXPECT_EQ(t[f].get<double>(), 0.0) << f;
+}
+
 TEST(CheckCli, ReportIsByteIdenticalForAnyThreadCount) {
   for (const std::string variant : {"--parallel v1", "--parallel v2 --all-triangles", "--schedule static"}) {
     std::string first;

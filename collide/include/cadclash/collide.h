@@ -189,6 +189,13 @@ struct CollideCounters {
 
 struct CollideTimings {  // seconds; never part of a determinism comparison
   double broad = 0.0, surface_level = 0.0, tessellation = 0.0, triangle_level = 0.0, total = 0.0;
+  // Where the certified (or exact) decision spent its time, per step ("Certified decisions"),
+  // summed over the pairs and faces each worked on, on every thread (so together they may exceed
+  // the wall time of triangle_level, which includes them): the triangles' interval, the analytic
+  // bounds and the contact witnesses (steps 1 to 3c); the depth step; refinement (re-meshing
+  // faces finer and their triangles' intervals); the control hulls; OCCT's face distance and its
+  // corroboration by finer triangles. 0 in the fast mode.
+  double decide_witness = 0.0, decide_depth = 0.0, decide_refine = 0.0, decide_hull = 0.0, decide_exact = 0.0;
 };
 
 struct SurfacePairResult {

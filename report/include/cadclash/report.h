@@ -137,12 +137,19 @@ struct TimingField {
   const char* name;
   double CollideTimings::*member;
 };
-inline constexpr std::array<TimingField, 5> kTimingFields{{
+// The first kStageTimings are in every report with timings; the decide_* ones since 2026-11-28.
+inline constexpr std::size_t kStageTimings = 5;
+inline constexpr std::array<TimingField, 10> kTimingFields{{
     {"broad", &CollideTimings::broad},
     {"surface_level", &CollideTimings::surface_level},
     {"tessellation", &CollideTimings::tessellation},
     {"triangle_level", &CollideTimings::triangle_level},
     {"total", &CollideTimings::total},
+    {"decide_witness", &CollideTimings::decide_witness},
+    {"decide_depth", &CollideTimings::decide_depth},
+    {"decide_refine", &CollideTimings::decide_refine},
+    {"decide_hull", &CollideTimings::decide_hull},
+    {"decide_exact", &CollideTimings::decide_exact},
 }};
 
 // ---------------------------------------------------------------------------------------------
