@@ -57,15 +57,15 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
       ->check(CLI::NonNegativeNumber);
   cmd.add_option("--uncertainty", in.uncertainty,
                  "Where a CAD face's model uncertainty comes from: auto (the larger of its OCCT tolerance and "
-                 "the STEP file's declared uncertainty), occt (OCCT tolerances only), declared (the file's "
-                 "declared uncertainty where it has one), or a value in mm for every surface, meshes too")
+                 "the STEP file's declared uncertainty), occt (OCCT tolerances only), or a value in mm for "
+                 "every surface, meshes too (a CAD face keeps its OCCT tolerance when that is larger)")
       ->check(CLI::Validator(
           [](std::string& v) -> std::string {
-            if (v == "auto" || v == "occt" || v == "declared") return {};
+            if (v == "auto" || v == "occt") return {};
             const std::optional<double> x = uncertainty_value(v);
-            return x ? std::string() : "expected auto, occt, declared or a length in (0, 2^128] mm, got '" + v + "'";
+            return x ? std::string() : "expected auto, occt or a length in (0, 2^128] mm, got '" + v + "'";
           },
-          "auto|occt|declared|MM"))
+          "auto|occt|MM"))
       ->capture_default_str();
   cmd.add_flag("--repair", in.repair,
                "Repair mesh parts: merge equal points, drop degenerate and repeated triangles, orient, stitch");
@@ -122,7 +122,6 @@ ImportOptions import_options(const InputOptions& in) {
   options.reader_time_limit_seconds = in.import_time_limit;
   options.model_tolerance = in.model_tolerance;
   if (in.uncertainty == "occt") options.uncertainty = UncertaintyChoice::OcctTolerance;
-  else if (in.uncertainty == "declared") options.uncertainty = UncertaintyChoice::Declared;
   else if (const std::optional<double> v = uncertainty_value(in.uncertainty)) {
     options.uncertainty = UncertaintyChoice::Value;
     options.uncertainty_value = *v;

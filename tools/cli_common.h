@@ -26,7 +26,7 @@ struct InputOptions {
   bool lazy = false;
   bool no_isolation = false;
   double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
-  std::string uncertainty = "auto";  // auto | occt | declared | a value in mm (ImportOptions::uncertainty)
+  std::string uncertainty = "auto";  // auto | occt | a value in mm (ImportOptions::uncertainty)
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none
   std::string cache;               // directory of the import cache (ImportOptions::cache_dir); empty = none
   double cache_max_mb = 0.0;       // ImportOptions::cache_max_bytes in MiB; 0 = no limit

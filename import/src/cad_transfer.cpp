@@ -52,7 +52,7 @@ TopTools_IndexedMapOfShape document_faces(const Handle(TDocStd_Document)& doc) {
 void apply_declared_uncertainty(Model& m, double declared, UncertaintyChoice choice) {
   if (!(declared > 0.0) || choice == UncertaintyChoice::OcctTolerance || choice == UncertaintyChoice::Value) return;
   for (Surface& s : m.surfaces) {
-    if (choice == UncertaintyChoice::Declared || declared > s.uncertainty) {
+    if (declared > s.uncertainty) {
       s.uncertainty = declared;
       s.uncertainty_source = UncertaintySource::Declared;
     }

@@ -75,10 +75,12 @@ ImportResult import_one(const std::string& path, const ImportOptions& options) {
     const auto read_start = std::chrono::steady_clock::now();
     ImportResult r = read_any(path, options);
     for (Surface& s : r.model.surfaces) {
+      const bool brep = r.model.parts[s.part].source != nullptr;
       if (options.uncertainty == UncertaintyChoice::Value) {
+        if (brep && s.uncertainty > options.uncertainty_value) continue;  // its OCCT tolerance stands
         s.uncertainty = options.uncertainty_value;
         s.uncertainty_source = UncertaintySource::Given;
-      } else if (options.model_tolerance > 0.0 && !r.model.parts[s.part].source) {
+      } else if (options.model_tolerance > 0.0 && !brep) {
         s.uncertainty = options.model_tolerance;
         s.uncertainty_source = UncertaintySource::Given;
       }

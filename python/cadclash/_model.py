@@ -263,8 +263,8 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     (0: 2^-24 x the largest coordinate): faces within tolerance + both uncertainties touch.
     ``uncertainty`` (the CLI's ``--uncertainty``) says where a CAD face's uncertainty comes from:
     "auto" (the larger of its OCCT tolerance and the STEP file's declared uncertainty), "occt" (OCCT
-    tolerances only), "declared" (the file's declared uncertainty where it has one), or a length in mm
-    for every surface, meshes too (``Surface.uncertainty_source`` says which applied). ``cache``
+    tolerances only), or a length in mm for every surface, meshes too (a CAD face keeps its OCCT
+    tolerance when that is larger) (``Surface.uncertainty_source`` says which applied). ``cache``
     (a directory; the CLI's ``--cache``) keeps every file as imported, keyed by a SHA-256 of its bytes,
     path and these settings: a file loaded again unchanged comes back from it, the same model; a
     damaged entry is read again and named in a warning diagnostic. Several files form one scene,

@@ -62,7 +62,7 @@ struct LoadArgs {
   bool isolate = true;
   double time_limit = 0.0;
   double model_tolerance = 0.0;
-  std::string uncertainty = "auto";  // auto | occt | declared | value (then uncertainty_value)
+  std::string uncertainty = "auto";  // auto | occt | value (then uncertainty_value)
   double uncertainty_value = 0.0;
   std::string cache;  // ImportOptions::cache_dir; empty: none
   int threads = 0;    // the whole load on at most this many threads; 0: every core
@@ -91,14 +91,13 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   if (!(a.model_tolerance >= 0.0)) throw pyb::value_error("model_tolerance must be >= 0 mm (0: from the coordinates)");
   options.model_tolerance = a.model_tolerance;
   if (a.uncertainty == "occt") options.uncertainty = UncertaintyChoice::OcctTolerance;
-  else if (a.uncertainty == "declared") options.uncertainty = UncertaintyChoice::Declared;
   else if (a.uncertainty == "value") {
     if (!(a.uncertainty_value > 0.0 && a.uncertainty_value <= kMaxLength))
-      throw pyb::value_error("uncertainty must be 'auto', 'occt', 'declared' or a length in (0, 2^128] mm");
+      throw pyb::value_error("uncertainty must be 'auto', 'occt' or a length in (0, 2^128] mm");
     options.uncertainty = UncertaintyChoice::Value;
     options.uncertainty_value = a.uncertainty_value;
   } else if (a.uncertainty != "auto")
-    throw pyb::value_error("uncertainty must be 'auto', 'occt', 'declared' or a length in (0, 2^128] mm, not '" +
+    throw pyb::value_error("uncertainty must be 'auto', 'occt' or a length in (0, 2^128] mm, not '" +
                            a.uncertainty + "'");
   options.cache_dir = a.cache;
   options.parallel_files = checked_threads(a.threads);

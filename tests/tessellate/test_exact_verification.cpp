@@ -420,13 +420,15 @@ TEST(ModelUncertainty, FromTolerancesAndTheFilesDeclaredUncertainty) {
     EXPECT_EQ(occt_in.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty);
     EXPECT_EQ(uncertainty_source(occt_in.model.surfaces[k]), UncertaintySource::OcctTolerance);
   }
-  // The declared value even where it is below OCCT's tolerance (the plain file declares 1e-7).
-  ImportOptions declared_only;
-  declared_only.uncertainty = UncertaintyChoice::Declared;
-  const ImportResult declared_small = import_file(path, declared_only);
-  for (const Surface& s : declared_small.model.surfaces) {
-    EXPECT_EQ(s.uncertainty, 1e-7) << s.name;
-    EXPECT_EQ(uncertainty_source(s), UncertaintySource::Declared) << s.name;
+  // Never below a face's OCCT tolerance (at least 1e-7): a smaller value leaves the tolerance.
+  ImportOptions below;
+  below.uncertainty = UncertaintyChoice::Value;
+  below.uncertainty_value = 1e-9;
+  const ImportResult small = import_file(tmp, below);
+  ASSERT_EQ(small.model.surfaces.size(), plain.model.surfaces.size());
+  for (std::size_t k = 0; k < small.model.surfaces.size(); ++k) {
+    EXPECT_EQ(small.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty);
+    EXPECT_EQ(uncertainty_source(small.model.surfaces[k]), UncertaintySource::OcctTolerance);
   }
   // A value for every surface.
   ImportOptions given;

@@ -126,7 +126,7 @@ TEST(CheckCli, ModelToleranceWidensTouching) {
 // (JSON, table); a contact only that ε holds says so. Bad values are usage errors.
 TEST(CheckCli, UncertaintySwitchAndItsSource) {
   const std::string pair = data("box_a.obj") + " " + data("box_near.obj");
-  for (const char* bad : {"0", "-1", "nan", "inf", "1e39", "occ", "0.1mm", ""})
+  for (const char* bad : {"0", "-1", "nan", "inf", "1e39", "occ", "declared", "0.1mm", ""})
     EXPECT_EQ(run("check " + pair + " --uncertainty '" + bad + "'").code, 2) << bad;
   const std::string json = tmp("uncertainty.json");
   Proc r = run("check " + pair + " --uncertainty 0.3 --no-timings --json " + json);

@@ -63,12 +63,13 @@
 namespace cadclash {
 
 // Where a B-rep face's model uncertainty ε (Surface::uncertainty, uncertainty_source) is taken from.
+// A B-rep face's ε is never below its OCCT tolerance: the certified decision also takes ε as how far
+// the face's own vertices and edges may lie off its surface, which that tolerance bounds.
 enum class UncertaintyChoice : std::uint8_t {
   Auto,           // the larger of the face's OCCT tolerance and its STEP file's declared length uncertainty
   OcctTolerance,  // the face's OCCT tolerance alone (the file's declared uncertainty ignored)
-  Declared,       // the file's declared uncertainty where it declares one (even below the OCCT tolerance),
-                  // else the OCCT tolerance
-  Value,          // ImportOptions::uncertainty_value for every surface, B-rep and mesh
+  Value,          // ImportOptions::uncertainty_value for every surface, meshes too (a B-rep face whose
+                  // OCCT tolerance is larger keeps that)
 };
 
 struct ImportOptions {
@@ -98,7 +99,7 @@ struct ImportOptions {
   double model_tolerance = 0.0;
   // B-rep faces' model uncertainty (docs/report-schema.md, "Classes"): see UncertaintyChoice. With
   // Value, uncertainty_value (mm, > 0) is every surface's uncertainty, meshes' too (model_tolerance
-  // is then unused).
+  // is then unused), at least each B-rep face's OCCT tolerance.
   UncertaintyChoice uncertainty = UncertaintyChoice::Auto;
   double uncertainty_value = 0.0;
   // A directory for a persistent cache of imported files (made when missing); empty = no cache. One
