@@ -6,6 +6,7 @@ int main(int argc, char** argv) {
   CLI::App app{"cadclash: find intersecting and touching surfaces in CAD assemblies and meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "cadclash 0.1.0");
+  app.footer("Example: cadclash check assembly.step --json report.json   (cadclash check --help for its options)");
   cadclash::cli::register_info(app);
   cadclash::cli::register_tessellate(app);
   cadclash::cli::register_check(app);

@@ -162,6 +162,37 @@ std::string clash_heading(const ClashReview& r, const ReportClash& c) {
   return s.str();
 }
 
+std::string verdict_line(const ClashReview& r, bool complete) {
+  std::size_t by_status[5] = {0, 0, 0, 0, 0}, by_class[5] = {0, 0, 0, 0, 0}, approved = 0, current = 0;
+  for (const ReportClash& c : r.clashes) {
+    if (!current_clash(c)) continue;
+    ++current;
+    ++by_status[static_cast<int>(c.status)];
+    if (c.approval >= 0) ++approved;
+    else ++by_class[static_cast<int>(c.worst)];
+  }
+  std::ostringstream s;
+  s << "verdict: " << (complete ? "" : "PARTIAL: ");
+  if (current == 0) {
+    s << "no clashes";
+    return s.str();
+  }
+  s << current << " clash" << (current == 1 ? "" : "es") << " (";
+  const char* sep = "";
+  for (const ClashStatus st : {ClashStatus::New, ClashStatus::Active, ClashStatus::Changed})
+    if (by_status[static_cast<int>(st)] > 0) {
+      s << sep << by_status[static_cast<int>(st)] << " " << clash_status_name(st);
+      sep = ", ";
+    }
+  if (approved > 0) s << sep << approved << " approved";
+  s << "): " << by_class[static_cast<int>(ContactClass::Penetrating)] << " penetrating, "
+    << by_class[static_cast<int>(ContactClass::Touching)] << " touching";
+  for (const ContactClass c : {ContactClass::Containment, ContactClass::Clearance})
+    if (by_class[static_cast<int>(c)] > 0) s << ", " << by_class[static_cast<int>(c)] << " " << contact_class_name(c);
+  s << "; " << by_class[static_cast<int>(ContactClass::Undecided)] << " undecided";
+  return s.str();
+}
+
 void print_review(const ClashReview& r, std::ostream& os) {
   std::size_t n[5] = {0, 0, 0, 0, 0}, approved = 0;
   for (const ReportClash& c : r.clashes) {

@@ -60,6 +60,12 @@ std::string clash_heading(const ClashReview& r, const ReportClash& c);
 // The clash counts per status, the resolved clashes, and every stale or expired approval.
 void print_review(const ClashReview& r, std::ostream& os);
 
+// The one line a person reads first, the last of `cadclash check`'s output: "verdict: 32 clashes
+// (32 new): 0 penetrating, 32 touching; 0 undecided", the current clashes by their worst class
+// (containment and clearance named when there are any, approved ones counted apart), "PARTIAL" when
+// not every pair was examined.
+std::string verdict_line(const ClashReview& r, bool complete);
+
 // True when the table shows only one line per clash: stdout is a terminal and --expand was not given.
 bool collapse_clashes(const ReviewCliOptions& o);
 

@@ -243,6 +243,8 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
     report.import = import_report(imported);
     print_import_stages(imported, report, std::cout);
   }
+  // Last, the line a person reads first (a trajectory's steps each have their own).
+  if (primary && rows.empty() && report.review) std::cout << '\n' << verdict_line(*report.review, report.complete) << '\n';
   const nlohmann::json j = check_report_json(report, {.timings = !o.no_timings});
   if (primary && !o.json.empty()) {
     std::ofstream f(o.json, std::ios::binary);
@@ -382,6 +384,8 @@ void register_check(CLI::App& app) {
   auto o = std::make_shared<CheckOptions>();
   CLI::App* cmd = app.add_subcommand("check", "Report penetrating, touching, close and contained surface pairs");
   cmd->footer(
+      "Example: cadclash check assembly.step --json report.json --html report.html\n"
+      "  (every penetrating and touching surface pair, certified on the exact faces; the last line is the verdict)\n"
       "Exit codes: 0 the check ran; 1 input error; 2 usage error; 3 --fail-on-collision and a collision was found\n"
       "(even in a partial report); 4 a --time-budget or --memory-budget ran out: the report (table, --json) was\n"
       "written, marked PARTIAL, listing the instance pairs not examined.\n");

@@ -82,6 +82,25 @@ TEST(CheckCli, TableAndJsonReport) {
             j["pairs"].size());
 }
 
+// The last line of a check is its verdict: the clashes by worst class; the help shows an example.
+TEST(CheckCli, EndsWithTheVerdictAndHelpShowsAnExample) {
+  Proc r = run("check " + boxes() + " --clearance 0.6");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::string out = r.out;
+  while (!out.empty() && out.back() == '\n') out.pop_back();
+  const std::string last = out.substr(out.rfind('\n') + 1);
+  // The four boxes pairwise (the JSON review's clashes by class).
+  EXPECT_EQ(last, "verdict: 6 clashes (6 new): 3 penetrating, 2 touching, 1 clearance; 0 undecided") << r.out;
+  r = run("check " + data("box_a.obj") + " " + data("box_near.obj"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("verdict: no clashes"), std::string::npos) << r.out;
+  for (const char* help : {"--help", "check --help"}) {
+    r = run(help);
+    EXPECT_EQ(r.code, 0);
+    EXPECT_NE(r.out.find("Example: cadclash check assembly.step --json report.json"), std::string::npos) << help;
+  }
+}
+
 // --fast and --exact exclude each other; the modes are recorded; on meshes all three agree.
 TEST(CheckCli, DecisionModes) {
   EXPECT_EQ(run("check " + boxes() + " --fast --exact").code, 2);
