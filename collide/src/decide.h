@@ -33,6 +33,13 @@ Pose relative_pose(const Pose& pose_a, const Pose& pose_b);
 // kMinUncertainty (model.h).
 double effective_uncertainty(const Surface& s, double part_magnitude);
 
+// How far the points the decision takes as a face's (its triangles' vertices, points on its
+// analytic surface) may lie off the exact face: Surface::tolerance when set (never below
+// kMinUncertainty), else the surface's effective uncertainty `eps`.
+inline double face_slack(const Surface& s, double eps) {
+  return s.tolerance > 0.0 ? std::max(kMinUncertainty, s.tolerance) : eps;
+}
+
 // The touching threshold T = tolerance + εa + εb (effective uncertainties).
 inline double touch_threshold(double eps_a, double eps_b, double tolerance) { return tolerance + eps_a + eps_b; }
 
@@ -151,8 +158,10 @@ struct DecideResult {
 // `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`, and the
 // seconds each step took to `timings`' decide_* fields.
-// `eps` holds every surface's effective_uncertainty, `bvh` the tree of every surface with triangles.
+// `eps` holds every surface's effective_uncertainty (the contact band), `slack` its face_slack (how
+// far the points taken as the face's may lie off it), `bvh` the tree of every surface with triangles.
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+                                       std::span<const double> slack,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        std::vector<RefinedSurface>& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
@@ -169,7 +178,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 // its early().
 class DecisionRun {
  public:
-  DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+  DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps, std::span<const double> slack,
               std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
               OutlineCache& outlines, const CollideOptions& options, int threads, const Deadline& deadline);
   ~DecisionRun();

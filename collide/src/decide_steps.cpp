@@ -121,7 +121,7 @@ void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, 
 
 // A vertex's foot point on the other face's plane, cylinder or sphere proves contact when it lies
 // inside that face: the witness is checked against B's triangles through their tree.
-void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+void analytic_contact(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
                       const CollideOptions& o) {
   const Surface& a = fa.surface;
   const Surface& b = fb.surface;
@@ -130,14 +130,16 @@ void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView
   const Aabb box_a = own_box(a), box_b = own_box(b);
   // A's vertices on B's surface, in B's frame; then B's on A's, in A's frame.
   const Aabb region_b = box_b.intersection(pad_box(transform_box(box_a, t.t_ba()), p.threshold));
+  // A vertex of one face (within its slack of that face) whose foot on the other surface is within
+  // T - slack - r proves contact.
   std::optional<double> g = analytic_witness(b.analytic, b.mesh, fb.bvh, *fb.outline, b.deflection, a.mesh, t.t_ba(),
-                                             region_b, o.tolerance + eps[t.sb] - r, r);
-  double own = eps[t.sa];
+                                             region_b, p.threshold - slack[t.sa] - r, r);
+  double own = slack[t.sa];
   if (!g) {
     const Aabb region_a = box_a.intersection(pad_box(transform_box(box_b, t.t_ab()), p.threshold));
     g = analytic_witness(a.analytic, a.mesh, fa.bvh, *fa.outline, a.deflection, b.mesh, t.t_ab(), region_a,
-                         o.tolerance + eps[t.sa] - r, r);
-    own = eps[t.sb];
+                         p.threshold - slack[t.sb] - r, r);
+    own = slack[t.sb];
   }
   if (!g || !(own + *g + r <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, own + *g + r);
@@ -229,8 +231,8 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   const Part& pb = m.parts[b.part];
   if (!pa.source || !pb.source || !a.has_triangles || !b.has_triangles) return;
   // A vertex farther than this from the other face's triangles is beyond reach of its exact face.
-  const double limit_a = o.tolerance + eps[t.sb] + band;  // A's vertices, asked of B
-  const double limit_b = o.tolerance + eps[t.sa] + band;
+  const double limit_a = p.threshold - eps[t.sa] + band;  // A's vertices, asked of B (eps: the faces' slack)
+  const double limit_b = p.threshold - eps[t.sb] + band;
   std::vector<Candidate> tried;
   // One trial: the candidate's distance to the other exact face, bounded by a point of that face.
   auto proves = [&](const Candidate& cand) {

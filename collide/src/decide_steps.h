@@ -14,6 +14,11 @@
 
 namespace cadclash::detail {
 
+// In the steps below, `eps` is each face's slack (face_slack, decide.h): how far the points a step
+// takes as the face's (its triangles' vertices, points of its analytic surface) may lie off the exact
+// face. The contact threshold T = tolerance + εa + εb, with the surfaces' uncertainties, is
+// Pending::threshold, set by from_mesh (whose `eps` are those uncertainties).
+
 // Where one pair's decision stands between the steps.
 struct Pending {
   Interval d;

@@ -41,11 +41,14 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
     auto take = [&length](double x) { length = in_supported_range(x) ? std::max(length, std::abs(x)) : HUGE_VAL; };
     if (!part_box[p].isEmpty())
       for (int k = 0; k < 3; ++k) take(part_box[p].min()[k]), take(part_box[p].max()[k]);
-    for (SurfaceId s = first(p); s < end(p); ++s) take(model.surfaces[s].deflection), take(model.surfaces[s].uncertainty);
+    for (SurfaceId s = first(p); s < end(p); ++s) take(model.surfaces[s].deflection), take(model.surfaces[s].uncertainty), take(model.surfaces[s].tolerance);
   }
   eps.resize(model.surfaces.size());
-  for (SurfaceId s = 0; s < model.surfaces.size(); ++s)
+  slack.resize(model.surfaces.size());
+  for (SurfaceId s = 0; s < model.surfaces.size(); ++s) {
     eps[s] = effective_uncertainty(model.surfaces[s], part_norm[model.surfaces[s].part]);
+    slack[s] = face_slack(model.surfaces[s], eps[s]);
+  }
   bvh.resize(model.surfaces.size());
   bvh_ready.assign(model.surfaces.size(), 0);
   refined.resize(model.surfaces.size());

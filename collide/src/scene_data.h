@@ -61,6 +61,7 @@ struct SceneData {
   std::vector<double> part_norm;    // largest norm of a point of part_box (round-off bounds)
   std::vector<double> part_length;  // largest |coordinate| of part_box, deflection or uncertainty (range check)
   std::vector<double> eps;          // per surface: effective_uncertainty (decide.h)
+  std::vector<double> slack;        // per surface: face_slack (decide.h)
   std::vector<Aabb> world_box;      // per instance
   std::vector<char> dirty;
   std::vector<InstanceId> dirty_list;  // the instances with dirty set, in the order they were moved

@@ -77,7 +77,8 @@ auto timed(double& into, F f) {
 struct DecisionRun::Impl {
   const Model& model;
   std::span<const Pose> poses;
-  std::span<const double> eps;
+  std::span<const double> eps;    // the contact band's ε (T = tolerance + εa + εb)
+  std::span<const double> slack;  // how far a face's points may lie off it (face_slack)
   std::span<const SurfaceBvh> bvh;
   std::span<const DecideTask> tasks;
   std::vector<RefinedSurface>& refined;
@@ -166,7 +167,7 @@ bool DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
   // Steps 1 and 2: the triangles' interval and the surfaces' parameters, microseconds per pair.
   p = from_mesh(model, eps, t, o);
   const bool certified = o.decision == DecisionMode::Certified;
-  if (!p.settled && certified && meshed(k)) analytic(model, eps, t, p, o);
+  if (!p.settled && certified && meshed(k)) analytic(model, slack, t, p, o);
   const bool ambiguous = !p.settled;
   if (!certified || p.settled || !meshed(k)) return ambiguous;
   // Steps 2b to 3c: witnesses of contact, each a few point queries, in order until one settles it;
@@ -181,19 +182,19 @@ bool DecisionRun::Impl::early(std::size_t k, Pending& p, CollideCounters& c) {
   need_outline(t.sb);
   const FaceView a = view(t.sa), b = view(t.sb);
   // Step 2b: analytic contact witnesses, on the outlines.
-  analytic_contact(eps, t, a, b, p, o);
+  analytic_contact(slack, t, a, b, p, o);
   // Step 2c: faces crossing a plane of the other (sunk, pressed in): a point of the crossing. Only
   // where the triangles cross deeper than T: faces lying on each other or meeting at an edge cross
   // by round-off only, and the vertex witnesses prove those.
-  if (t.outcome->intersecting && t.outcome->crosses_threshold && next()) crossing_step(model, eps, t, a, b, p, o, c);
+  if (t.outcome->intersecting && t.outcome->crosses_threshold && next()) crossing_step(model, slack, t, a, b, p, o, c);
   // Step 2d: cylinders, cones and spheres tangent to a plane: their support point.
-  if (next()) tangent_step(model, eps, t, a, b, p, o, c);
+  if (next()) tangent_step(model, slack, t, a, b, p, o, c);
   // Step 3: witness vertices near the other face (a few exact point queries each).
-  if (next()) witness_step(model, eps, t, a, b, t.outcome, p.band, p, o, c);
+  if (next()) witness_step(model, slack, t, a, b, t.outcome, p.band, p, o, c);
   // Step 3b: faces meeting edge to edge (a curved edge tangent to another): one Newton each.
   if (next()) edge_witness_step(model, poses, t, a, b, p, o, c);
   // Step 3c: faces touching a plane at one point of a curved edge: the edge's extremum.
-  if (next()) edge_support_step(model, eps, t, a, b, p, o, c);
+  if (next()) edge_support_step(model, slack, t, a, b, p, o, c);
   return ambiguous;
 }
 
@@ -255,7 +256,7 @@ void refinement_step(Run& run, CollideCounters& counters) {
         refine_surfaces(model, refinable_faces(model, run.tasks, gaps), run.refined, run.threads, &run.meshing);
   run.step(gaps, [&](std::size_t k) {
     timed(run.seconds[k].refine, [&] {
-      refined_step(run.eps, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k],
+      refined_step(run.slack, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k],
                    run.o, run.task_counters[k]);
     });
   });
@@ -270,7 +271,7 @@ void exact_steps(Run& run, CollideCounters& counters) {
     Pending& p = run.pending[k];
     const bool certified = run.o.decision == DecisionMode::Certified;
     if (certified && timed(run.seconds[k].hull, [&] {
-          return hull_step(model, run.poses, run.eps, tasks[k], p, run.o, run.task_counters[k]);
+          return hull_step(model, run.poses, run.slack, tasks[k], p, run.o, run.task_counters[k]);
         }))
       return;
     if (timed(run.seconds[k].exact, [&] { return exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]); }) ||
@@ -288,7 +289,7 @@ void exact_steps(Run& run, CollideCounters& counters) {
         refine_surfaces(model, refinable_faces(model, tasks, check), run.refined, run.threads, &run.meshing);
   run.step(check, [&](std::size_t k) {
     timed(run.seconds[k].exact, [&] {
-      corroborate(model, run.eps, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
+      corroborate(model, run.slack, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
                   run.task_counters[k]);
     });
   });
@@ -306,6 +307,7 @@ std::vector<DecideResult> collect(Run& run, CollideCounters& counters) {
 }  // namespace
 
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+                                       std::span<const double> slack,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
@@ -315,13 +317,14 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
     for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
     return results;
   }
-  DecisionRun run(model, poses, eps, bvh, tasks, refined, outline_cache, o, threads, deadline);
+  DecisionRun run(model, poses, eps, slack, bvh, tasks, refined, outline_cache, o, threads, deadline);
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
   dynamic_loop(n, threads, true, [&](std::ptrdiff_t k) { run.early(static_cast<std::size_t>(k)); });
   return run.finish(counters, timings);
 }
 
 DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
+                         std::span<const double> slack,
                          std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                          std::vector<RefinedSurface>& refined, OutlineCache& outlines, const CollideOptions& o,
                          int threads, const Deadline& deadline) {
@@ -329,7 +332,7 @@ DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::s
   // Outlines are made on first need (step 2b) unless the Scene has them already.
   outlines.outline.resize(model.surfaces.size());
   outlines.ready.resize(model.surfaces.size(), 0);
-  impl_ = std::unique_ptr<Impl>(new Impl{model, poses, eps, bvh, tasks, refined, outlines, o, threads, deadline});
+  impl_ = std::unique_ptr<Impl>(new Impl{model, poses, eps, slack, bvh, tasks, refined, outlines, o, threads, deadline});
 }
 
 DecisionRun::~DecisionRun() = default;
@@ -459,7 +462,7 @@ void decision_stage(SceneData& s, QueryState& q) {
   for (std::size_t k : task_of) decide.push_back(decide_task(q, k, usable(model, q.tasks[k]) ? &q.outcomes[k] : nullptr));
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
   std::vector<DecideResult> results =
-      decide_pairs(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
+      decide_pairs(model, s.poses, s.eps, s.slack, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
                    q.report.counters, q.report.timings);
   conclude(q, results, task_of, /*by_task=*/false, meter);
 }
@@ -478,7 +481,7 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
   std::vector<DecideTask> decide;
   decide.reserve(ntasks);
   for (std::size_t k = 0; k < ntasks; ++k) decide.push_back(decide_task(q, k, nullptr));
-  DecisionRun run(model, s.poses, s.eps, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline);
+  DecisionRun run(model, s.poses, s.eps, s.slack, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline);
   triangle_level_stage(s, q, [&](std::size_t k) {
     if (q.task_cut[k] || q.outcomes[k].cut) {
       run.skip(k);  // cut by the deadline: no answer, as decision_stage leaves it

@@ -50,6 +50,7 @@ void put_surface(ByteWriter& w, const Surface& s) {
   put_vec(w, s.aabb.max());
   w.f64(s.deflection);
   w.f64(s.uncertainty);
+  w.f64(s.tolerance);
   w.u64(static_cast<std::uint64_t>(s.analytic.shape));
   put_vec(w, s.analytic.origin);
   put_vec(w, s.analytic.axis);
@@ -89,6 +90,7 @@ bool get_surface(ByteReader& r, Surface& s) {
   s.aabb = Aabb(lo, hi);
   s.deflection = r.f64();
   s.uncertainty = r.f64();
+  s.tolerance = r.f64();
   const std::uint64_t shape = r.u64();
   if (shape > static_cast<std::uint64_t>(SurfaceShape::Torus)) return false;
   s.analytic.shape = static_cast<SurfaceShape>(shape);

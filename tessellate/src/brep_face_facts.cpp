@@ -89,6 +89,7 @@ void describe_face(const TopoDS_Face& face, Surface& out) {
     tol = std::max(tol, BRep_Tool::Tolerance(TopoDS::Vertex(ex.Current())));
   out.uncertainty = std::max(out.uncertainty, tol);
   out.uncertainty_source = UncertaintySource::OcctTolerance;
+  out.tolerance = tol;
   try {
     const BRepAdaptor_Surface surface(face, Standard_False);  // part-local, as the triangles are
     out.analytic = analytic_of(surface);

@@ -145,6 +145,7 @@ SegmentReport segment_surfaces(Model& model, const SegmentOptions& options) {
         patch.deflection = parent.deflection;
         patch.uncertainty = parent.uncertainty;
         patch.uncertainty_source = parent.uncertainty_source;
+        patch.tolerance = parent.tolerance;
         patch.exact_triangles = parent.exact_triangles;
         patch.has_triangles = true;
         patch.mesh = extract_patch(parent.mesh, label, j);

@@ -155,6 +155,11 @@ struct Surface {
   // Where `uncertainty` came from; a surface whose uncertainty is 0 reports Coordinates whatever
   // this says (uncertainty_source below).
   UncertaintySource uncertainty_source = UncertaintySource::Given;
+  // How far the face's own vertices, edges and triangle nodes may lie off its exact surface: B-rep
+  // faces, the largest OCCT tolerance of the face, its edges and vertices (what `uncertainty` is
+  // unless the file declares more). The certified decision's bounds on a face's points use it; the
+  // contact band uses `uncertainty`. 0 (meshes, a Model built by hand) means `uncertainty`.
+  double tolerance = 0.0;
   // The triangles are the surface itself, not an approximation: mesh surfaces, and planar B-rep faces
   // bounded by straight edges (deflection 0). Pairs of such surfaces are decided on the triangles.
   bool exact_triangles = false;
