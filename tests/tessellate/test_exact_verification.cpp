@@ -411,25 +411,23 @@ TEST(ModelUncertainty, FromTolerancesAndTheFilesDeclaredUncertainty) {
   // The file's own 1e-7 is never above OCCT's tolerances (at least 1e-7): they stand.
   for (const Surface& s : plain.model.surfaces) EXPECT_EQ(uncertainty_source(s), UncertaintySource::OcctTolerance) << s.name;
 
-  // ImportOptions::uncertainty chooses the source. OCCT's tolerances alone: the declared 0.01 ignored.
-  ImportOptions occt;
+  // ImportOptions::uncertainty chooses the source. Each face keeps its OCCT tolerance with `o`.
+  auto keeps_tolerances = [&](const ImportOptions& o, const char* what) {
+    const ImportResult in = import_file(tmp, o);
+    ASSERT_EQ(in.model.surfaces.size(), plain.model.surfaces.size()) << what;
+    for (std::size_t k = 0; k < in.model.surfaces.size(); ++k) {
+      EXPECT_EQ(in.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty) << what;
+      EXPECT_EQ(in.model.surfaces[k].tolerance, plain.model.surfaces[k].uncertainty) << what;
+      EXPECT_EQ(uncertainty_source(in.model.surfaces[k]), UncertaintySource::OcctTolerance) << what;
+    }
+  };
+  ImportOptions occt;  // OCCT's tolerances alone: the declared 0.01 ignored
   occt.uncertainty = UncertaintyChoice::OcctTolerance;
-  const ImportResult occt_in = import_file(tmp, occt);
-  ASSERT_EQ(occt_in.model.surfaces.size(), plain.model.surfaces.size());
-  for (std::size_t k = 0; k < occt_in.model.surfaces.size(); ++k) {
-    EXPECT_EQ(occt_in.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty);
-    EXPECT_EQ(uncertainty_source(occt_in.model.surfaces[k]), UncertaintySource::OcctTolerance);
-  }
-  // Never below a face's OCCT tolerance (at least 1e-7): a smaller value leaves the tolerance.
-  ImportOptions below;
+  keeps_tolerances(occt, "occt");
+  ImportOptions below;  // never below a face's OCCT tolerance (at least 1e-7)
   below.uncertainty = UncertaintyChoice::Value;
   below.uncertainty_value = 1e-9;
-  const ImportResult small = import_file(tmp, below);
-  ASSERT_EQ(small.model.surfaces.size(), plain.model.surfaces.size());
-  for (std::size_t k = 0; k < small.model.surfaces.size(); ++k) {
-    EXPECT_EQ(small.model.surfaces[k].uncertainty, plain.model.surfaces[k].uncertainty);
-    EXPECT_EQ(uncertainty_source(small.model.surfaces[k]), UncertaintySource::OcctTolerance);
-  }
+  keeps_tolerances(below, "1e-9");
   // A value for every surface.
   ImportOptions given;
   given.uncertainty = UncertaintyChoice::Value;
