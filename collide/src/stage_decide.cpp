@@ -6,9 +6,9 @@
 #include "team_loop.h"
 
 #include <algorithm>
-#include <chrono>
 #include <atomic>
 #include <cassert>
+#include <chrono>
 #include <thread>
 
 namespace cadclash::detail {
@@ -145,8 +145,9 @@ struct DecisionRun::Impl {
   }
   // Steps 1 to 3c into p and c; whether steps 1 and 2 left the task open (ambiguous).
   bool early(std::size_t k, Pending& p, CollideCounters& c);
-  // A contact of two planar faces whose triangles cross deeper than T: proved penetrating on the
-  // exact planes where it can be (depth_step), whichever step proved the contact.
+  // A contact of a planar face with another whose triangles cross it deeper than T: proved
+  // penetrating on the exact surfaces where it can be (depth_step), whichever step proved the
+  // contact. Past the deadline the pair is cut, as any unfinished step leaves it.
   void deepen(std::size_t k, Pending& p, CollideCounters& c) {
     if (!depth_step_applies(model, tasks[k], p)) return;
     if (deadline.expired()) {
