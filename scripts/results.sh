@@ -124,10 +124,14 @@ relink() { sed -E 's#\]\(([^/():]+\.(svg|png))\)#](results/\1)#g' "$1"; }
 demote() { awk '/^```/ { code = !code } !code && /^#/ { $0 = "##" $0 } { print }'; }
 
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
+# The one-screen summary that opens the page: this run's figures beside their peers'.
+python3 "$root/scripts/results_summary.py" "$out" "$(date -u '+%Y-%m-%d %H:%M UTC')" "$commit" \
+  "$cpu, $(nproc) vCPUs" >"$out/summary.md"
 
 page=$root/docs/results.md
 while IFS= read -r line || [ -n "$line" ]; do
   case "$line" in
+    @SUMMARY@) cat "$out/summary.md" ;;
     @MACHINE@)
       echo "- date: $(date -u '+%Y-%m-%d %H:%M UTC')"
       echo "- commit: $commit"
