@@ -7,6 +7,7 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepLib.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Tool.hxx>
 #include <BRep_Builder.hxx>
 #include <ShapeFix_Face.hxx>
 #include <Standard_Failure.hxx>
@@ -20,6 +21,7 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <exception>
@@ -82,14 +84,18 @@ void store_plane_pcurves(const std::vector<TopoDS_Face>& faces) {
 
 // Healing: only faces BRepCheck rejects are touched, one at a time, so face indices and the file's
 // entity ids stay attached to the same faces. Per face: 1 when it was healed.
-std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& impl, std::vector<Diagnostic>& diagnostics) {
+// Faces marked in `far` (a vertex past the supported range: dropped with an error once their exact
+// boxes are taken) are neither checked nor healed.
+std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& impl, const std::vector<char>& far,
+                                     std::vector<Diagnostic>& diagnostics) {
   const std::size_t n = impl.faces.size();
   std::vector<char> healed(n, 0);
+  const bool any_far = std::any_of(far.begin(), far.end(), [](char c) { return c != 0; });
   // One check of the whole part, and the faces one by one only when it fails. A part holding a face
   // with many wires (a board plate with its holes) is checked face by face at once: the whole
   // part's check would compare all of that face's wires pairwise, and only faces are healed here,
   // so the faces' verdicts decide the same.
-  const bool by_face = std::any_of(impl.faces.begin(), impl.faces.end(), detail::face_has_many_wires);
+  const bool by_face = any_far || std::any_of(impl.faces.begin(), impl.faces.end(), detail::face_has_many_wires);
   bool whole_valid = false;
   if (!by_face) {
     try {
@@ -99,7 +105,7 @@ std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& 
   }
   if (whole_valid) return healed;
   for (std::size_t i = 0; i < n; ++i) {
-    if (detail::face_is_valid(impl.faces[i])) continue;
+    if (far[i] || detail::face_is_valid(impl.faces[i])) continue;
     healed[i] = heal_face(impl.faces[i]) ? 1 : 0;
     const bool fixed = healed[i] != 0 && detail::face_is_valid(impl.faces[i]);
     diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl.entity_ids[i],
@@ -222,7 +228,15 @@ void prepare_part(const BrepPartInput& in, const TessellationOptions& options, P
   impl.entity_ids.resize(n, -1);
   for (std::size_t i = 0; i < n && i < in.tags.size(); ++i) impl.entity_ids[i] = in.tags[i].entity_id;
 
-  const std::vector<char> healed = heal_invalid_faces(in, impl, w.diagnostics);
+  // A face with a vertex past the supported range is dropped below (drop_faces_outside_range): no
+  // BRepCheck warning about a face that is not kept.
+  std::vector<char> far(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (TopExp_Explorer ex(impl.faces[i], TopAbs_VERTEX); ex.More() && !far[i]; ex.Next()) {
+      const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(ex.Current()));
+      far[i] = !in_supported_range(std::max({std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())}));
+    }
+  const std::vector<char> healed = heal_invalid_faces(in, impl, far, w.diagnostics);
   store_plane_pcurves(impl.faces);
 
   impl.boxes.resize(n);
