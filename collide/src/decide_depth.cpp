@@ -217,7 +217,13 @@ std::optional<std::pair<Vec3, Vec3>> clip(const Vec3& e0, const Vec3& e1, const 
 std::vector<Vec3> crossings(const Side& q, const Side& p, const Aabb& region) {
   std::vector<Vec3> out;
   const TriangleMesh& mesh = q.f.surface.mesh;
-  for (const auto& tri : mesh.triangles) {
+  // Only triangles near the region: through q's tree, with the region mapped into q's frame (a box
+  // enclosing it). Ascending, so the points come in triangle order as from a scan of all of them.
+  std::vector<std::uint32_t> near;
+  std::uint64_t tests = 0;
+  query_surface_bvh(q.f.bvh, mesh, transform_box(region, *q.to_own), near, tests);
+  for (const std::uint32_t k : near) {
+    const auto& tri = mesh.triangles[k];
     const Vec3 v[3] = {*q.to_a * mesh.vertices[tri[0]], *q.to_a * mesh.vertices[tri[1]], *q.to_a * mesh.vertices[tri[2]]};
     double h[3];
     for (int k = 0; k < 3; ++k) h[k] = p.n.dot(v[k] - p.o);
