@@ -37,8 +37,8 @@ import json, sys
 out = sys.argv[1]
 def key(p):
     return (p["a"]["instance"], p["b"]["instance"], p["a"].get("step_id"), p["b"].get("step_id"))
-print("| board (KiCad models, declared uncertainty 0.01 mm) | tolerance | mode | pairs | penetrating | touching | undecided | within the tolerance | only within the uncertainty | either | query ms |")
-print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+print("| board (KiCad models, declared uncertainty 0.01 mm) | tolerance | mode | pairs | penetrating | touching | undecided | within the tolerance | only within the uncertainty | either | query ms | end to end s (import + query) |")
+print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 notes = []
 for name, seat, tol in (("seated", "0.05 mm above", "0.04"), ("sunk", "0.025 mm into the board", "0")):
     runs = {}
@@ -50,8 +50,9 @@ for name, seat, tol in (("seated", "0.05 mm above", "0.04"), ("sunk", "0.025 mm 
         label = {"auto": "certified, uncertainty from the file", "occt": "certified, OCCT tolerances only",
                  "fast": "--fast (triangles, no uncertainty)"}[mode]
         q = 1000 * j["timings"]["total"] if "timings" in j else float("nan")
+        e2e = j["import_timings"]["seconds"] + q / 1000 if "import_timings" in j else float("nan")
         print(f"| {seat} | {tol} | {label} | {s['pairs']} | {s['penetrating']} | {s['touching']} | {s['undecided']} | "
-              f"{w.get('tolerance', 0)} | {w.get('model uncertainty', 0)} | {w.get('unknown', 0)} | {q:.0f} |")
+              f"{w.get('tolerance', 0)} | {w.get('model uncertainty', 0)} | {w.get('unknown', 0)} | {q:.0f} | {e2e:.2f} |")
     if name == "sunk":
         cert = {key(p): p for p in runs["auto"]["pairs"]}
         deep = [p for p in runs["fast"]["pairs"] if p["class"] == "penetrating" and p["penetration"] > 0.02]

@@ -28,26 +28,19 @@ constexpr double kParallel = 0.99996;
 std::vector<Vec3> plane_crossings(const TriangleMesh& mesh, const Vec3& n, const Vec3& o, const Aabb& region) {
   std::vector<Vec3> out;
   for (const auto& tri : mesh.triangles) {
-    const Vec3* v[3] = {&mesh.vertices[tri[0]], &mesh.vertices[tri[1]], &mesh.vertices[tri[2]]};
+    const Vec3* const v[3] = {&mesh.vertices[tri[0]], &mesh.vertices[tri[1]], &mesh.vertices[tri[2]]};
     Aabb box;
     for (const Vec3* p : v) box.extend(*p);
     if (!box.intersects(region)) continue;
     double h[3];
     for (int k = 0; k < 3; ++k) h[k] = n.dot(*v[k] - o);
-    if (!(std::min({h[0], h[1], h[2]}) < 0.0 && std::max({h[0], h[1], h[2]}) > 0.0)) continue;
+    const auto ends = plane_cut(v, h);
+    if (!ends) continue;
     // A triangle (nearly) parallel to the plane crosses it by round-off or by its chord's sag: faces
     // lying on the plane or tangent to it, which the witness steps prove; no crossing curve to follow.
     const Vec3 normal = (*v[1] - *v[0]).cross(*v[2] - *v[0]);
     if (!(std::abs(normal.dot(n)) < kParallel * normal.norm())) continue;
-    Vec3 ends[2];
-    int found = 0;
-    for (int k = 0; k < 3 && found < 2; ++k) {
-      const int l = (k + 1) % 3;
-      if ((h[k] < 0.0) == (h[l] < 0.0)) continue;  // this edge stays on one side (or ends on the plane)
-      const double s = h[k] / (h[k] - h[l]);
-      ends[found++] = *v[k] + s * (*v[l] - *v[k]);
-    }
-    if (found == 2) out.push_back(0.5 * (ends[0] + ends[1]));
+    out.push_back(0.5 * ((*ends)[0] + (*ends)[1]));
   }
   return out;
 }
@@ -60,7 +53,7 @@ struct Proof {
 };
 
 std::optional<Proof> cross_plane(const Part&, SurfaceId, const Part& part_q, SurfaceId sq, FaceView fp, FaceView fq,
-                                 double eps_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
+                                 double slack_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
                                  CollideCounters& c) {
   const Surface& P = fp.surface;
   const Surface& Q = fq.surface;
@@ -73,7 +66,7 @@ std::optional<Proof> cross_plane(const Part&, SurfaceId, const Part& part_q, Sur
   const std::vector<Vec3> xs = plane_crossings(Q.mesh, n, plane.origin, region);
   // The plane's foot of a point of Q, inside P's face: then |height| bounds the point's distance to it.
   auto on_p = [&](const Vec3& y, double h) { return inside_face(fp, to_p * (y - h * n), r); };
-  const double headroom = threshold - eps_q - r;
+  const double headroom = threshold - slack_q - r;
   if (!(headroom > 0.0)) return std::nullopt;
   const std::uint32_t local = part_q.source ? sq - part_q.first_surface : 0;
   // A point y of Q's surface (within `rounding`) whose foot on P's plane is inside P: its distance to
@@ -82,12 +75,12 @@ std::optional<Proof> cross_plane(const Part&, SurfaceId, const Part& part_q, Sur
   std::size_t asked = 0;
   auto bound = [&](const Vec3& y, double h, double rounding, bool on_triangles) -> std::optional<double> {
     if (!(std::abs(h) + rounding <= headroom) || !on_p(y, h)) return std::nullopt;
-    if (inside_face(fq, y, rounding + r, on_triangles)) return eps_q + std::abs(h) + rounding + r;
+    if (inside_face(fq, y, rounding + r, on_triangles)) return slack_q + std::abs(h) + rounding + r;
     if (!part_q.source || ++asked > kMaxClassifierTrials) return std::nullopt;
     ++c.witness_queries;
     const std::optional<double> d = part_q.source->point_distance(local, y);
     if (!d) return std::nullopt;
-    return eps_q + *d + std::abs(h) + rounding + r;
+    return slack_q + *d + std::abs(h) + rounding + r;
   };
   // A planar face's triangles lie on its plane: a crossing point is a point of that face's surface.
   if (Q.analytic.shape == SurfaceShape::Plane || Q.exact_triangles) {
@@ -160,12 +153,12 @@ std::optional<Vec3> support_point(const AnalyticSurface& q, const Vec3& d, const
 // P's face lies on a plane, Q's on a cylinder, cone or sphere that may touch it (tangent). The
 // support point toward the plane near Q's lowest vertices, inside both faces, bounds d*.
 std::optional<Proof> touch_plane(const Part& part_p, SurfaceId sp, const Part& part_q, SurfaceId sq, FaceView fp,
-                                 FaceView fq, double eps_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
+                                 FaceView fq, double slack_q, const Pose& to_q, const Pose& to_p, double r, double threshold,
                                  CollideCounters& c) {
   const Surface& Q = fq.surface;
   const AnalyticSurface plane = transform_analytic(fp.surface.analytic, to_q);
   const Vec3 n = plane.axis.normalized();
-  const double headroom = threshold - eps_q - r;
+  const double headroom = threshold - slack_q - r;
   if (!(headroom > 0.0) || Q.mesh.vertices.empty()) return std::nullopt;
   // Q's vertices nearest the plane (by |height|), a few.
   std::vector<std::pair<double, std::uint32_t>> low;
@@ -195,7 +188,7 @@ std::optional<Proof> touch_plane(const Part& part_p, SurfaceId sp, const Part& p
     if (!off_q) continue;
     if (!inside_face(fp, to_p * (*x - h * n), r)) to_face_p = ask(part_p, sp, to_p * *x);
     if (!to_face_p) continue;
-    const double hi = eps_q + *off_q + *to_face_p + r;
+    const double hi = slack_q + *off_q + *to_face_p + r;
     if (hi <= threshold) return Proof{hi, exact ? DecidedBy::Exact : DecidedBy::Analytic};
   }
   return std::nullopt;
@@ -205,12 +198,12 @@ std::optional<Proof> touch_plane(const Part& part_p, SurfaceId sp, const Part& p
 // flat lying on its rim). The extremum toward the plane of Q's edge near its lowest outline points,
 // whose foot lies inside P, bounds d*.
 std::optional<Proof> edge_on_plane(const Part& part_p, SurfaceId sp, const Part& part_q, SurfaceId sq, FaceView fp,
-                                   FaceView fq, double eps_q, const Pose& to_q, const Pose& to_p, double r,
+                                   FaceView fq, double slack_q, const Pose& to_q, const Pose& to_p, double r,
                                    double threshold, CollideCounters& c) {
   if (!part_q.source || fq.outline == nullptr || fq.outline->empty()) return std::nullopt;
   const AnalyticSurface plane = transform_analytic(fp.surface.analytic, to_q);
   const Vec3 n = plane.axis.normalized();
-  const double headroom = threshold - eps_q - r;
+  const double headroom = threshold - slack_q - r;
   if (!(headroom > 0.0)) return std::nullopt;
   std::vector<std::pair<double, Vec3>> low;
   for (const auto& e : fq.outline->segments)
@@ -235,7 +228,7 @@ std::optional<Proof> edge_on_plane(const Part& part_p, SurfaceId sp, const Part&
       to_face_p = part_p.source->point_distance(sp - part_p.first_surface, to_p * x->point);
       if (!to_face_p) continue;
     }
-    const double hi = eps_q + *to_face_p + x->rounding + r;
+    const double hi = slack_q + *to_face_p + x->rounding + r;
     if (hi <= threshold) return Proof{hi, DecidedBy::Exact};
   }
   return std::nullopt;
@@ -249,7 +242,7 @@ bool touches_plane(const Surface& s) {
 // Runs `side` (one of the functions above) with A's face as the plane, then with B's, for the faces
 // `other_ok` accepts on the other side, and settles the pair in contact on the first proof.
 template <class Side>
-void prove_against_plane(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void prove_against_plane(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                          Pending& p, const CollideOptions& o, CollideCounters& c, bool (*other_ok)(const Surface&),
                          Side side) {
   if (t.outcome == nullptr || !fa.surface.has_triangles || !fb.surface.has_triangles) return;
@@ -257,9 +250,9 @@ void prove_against_plane(const Model& m, std::span<const double> eps, const Deci
   const Part& pb = m.parts[fb.surface.part];
   std::optional<Proof> proof;
   if (fa.surface.analytic.shape == SurfaceShape::Plane && other_ok(fb.surface))
-    proof = side(pa, t.sa, pb, t.sb, fa, fb, eps[t.sb], t.t_ba(), t.t_ab(), t.roundoff, p.threshold, c);
+    proof = side(pa, t.sa, pb, t.sb, fa, fb, slack[t.sb], t.t_ba(), t.t_ab(), t.roundoff, p.threshold, c);
   if (!proof && fb.surface.analytic.shape == SurfaceShape::Plane && other_ok(fa.surface))
-    proof = side(pb, t.sb, pa, t.sa, fb, fa, eps[t.sa], t.t_ab(), t.t_ba(), t.roundoff, p.threshold, c);
+    proof = side(pb, t.sb, pa, t.sa, fb, fa, slack[t.sa], t.t_ab(), t.t_ba(), t.roundoff, p.threshold, c);
   if (!proof || !(proof->hi <= p.threshold)) return;
   p.d.hi = std::min(p.d.hi, proof->hi);
   settle(p, Verdict::Contact, proof->by, t.outcome, o.clearance);
@@ -269,20 +262,20 @@ bool any_face(const Surface&) { return true; }
 
 }  // namespace
 
-void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void tangent_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                   Pending& p, const CollideOptions& o, CollideCounters& c) {
-  prove_against_plane(m, eps, t, fa, fb, p, o, c, touches_plane, touch_plane);
+  prove_against_plane(m, slack, t, fa, fb, p, o, c, touches_plane, touch_plane);
 }
 
-void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void edge_support_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                        Pending& p, const CollideOptions& o, CollideCounters& c) {
-  prove_against_plane(m, eps, t, fa, fb, p, o, c, any_face, edge_on_plane);
+  prove_against_plane(m, slack, t, fa, fb, p, o, c, any_face, edge_on_plane);
 }
 
-void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void crossing_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                    Pending& p, const CollideOptions& o, CollideCounters& c) {
   if (t.outcome == nullptr || !t.outcome->intersecting) return;
-  prove_against_plane(m, eps, t, fa, fb, p, o, c, any_face, cross_plane);
+  prove_against_plane(m, slack, t, fa, fb, p, o, c, any_face, cross_plane);
 }
 
 }  // namespace cadclash::detail

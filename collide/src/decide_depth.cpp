@@ -224,19 +224,13 @@ std::vector<Vec3> crossings(const Side& q, const Side& p, const Aabb& region) {
   query_surface_bvh(q.f.bvh, mesh, transform_box(region, *q.to_own), near, tests);
   for (const std::uint32_t k : near) {
     const auto& tri = mesh.triangles[k];
-    const Vec3 v[3] = {*q.to_a * mesh.vertices[tri[0]], *q.to_a * mesh.vertices[tri[1]], *q.to_a * mesh.vertices[tri[2]]};
+    const Vec3 w[3] = {*q.to_a * mesh.vertices[tri[0]], *q.to_a * mesh.vertices[tri[1]], *q.to_a * mesh.vertices[tri[2]]};
+    const Vec3* const v[3] = {&w[0], &w[1], &w[2]};
     double h[3];
-    for (int k = 0; k < 3; ++k) h[k] = p.n.dot(v[k] - p.o);
-    if (!(std::min({h[0], h[1], h[2]}) < 0.0 && std::max({h[0], h[1], h[2]}) > 0.0)) continue;
-    Vec3 ends[2];
-    int found = 0;
-    for (int k = 0; k < 3 && found < 2; ++k) {
-      const int l = (k + 1) % 3;
-      if ((h[k] < 0.0) == (h[l] < 0.0)) continue;
-      ends[found++] = v[k] + (h[k] / (h[k] - h[l])) * (v[l] - v[k]);
-    }
-    if (found < 2) continue;
-    if (const auto part = clip(ends[0], ends[1], region)) out.push_back(0.5 * (part->first + part->second));
+    for (int k = 0; k < 3; ++k) h[k] = p.n.dot(w[k] - p.o);
+    const auto ends = plane_cut(v, h);
+    if (!ends) continue;
+    if (const auto part = clip((*ends)[0], (*ends)[1], region)) out.push_back(0.5 * (part->first + part->second));
   }
   return out;
 }

@@ -13,15 +13,15 @@ namespace cadclash::detail {
 
 namespace {
 
-// Whether the face's triangles (points of the face, up to its uncertainty) lie in the box of its
+// Whether the face's triangles (points of the face, up to its slack) lie in the box of its
 // patches' control points, as they must when the patches hold the face: a check of the source's
 // conversion, not a proof of it. Faces without triangles pass.
-bool patches_hold_triangles(const Surface& s, const SurfaceSource::BezierPatches& patches, double eps) {
+bool patches_hold_triangles(const Surface& s, const SurfaceSource::BezierPatches& patches, double slack) {
   if (!s.has_triangles) return true;
   Aabb box;
   for (const auto& p : patches.patches)
     for (const Vec3& q : p.points) box.extend(q);
-  const Aabb padded = pad_box(box, eps + patches.rounding + kRelativePad * (1.0 + box_magnitude(box)));
+  const Aabb padded = pad_box(box, slack + patches.rounding + kRelativePad * (1.0 + box_magnitude(box)));
   for (const Vec3& v : s.mesh.vertices)
     if (!padded.contains(v)) return false;
   return true;
@@ -76,7 +76,7 @@ std::optional<Vec3> crossing_near(const SurfaceSource& src_a, std::uint32_t loca
 
 }  // namespace
 
-bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> eps, const DecideTask& t,
+bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> slack, const DecideTask& t,
                Pending& p, const CollideOptions& o, CollideCounters& c) {
   // A face without triangles is decided on the exact distance (its interval is [d*, d*]).
   if (t.outcome == nullptr) return false;
@@ -90,16 +90,16 @@ bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const doub
   if (!patches_a) return false;
   const auto patches_b = pb.source->bezier_patches(local_b);
   if (!patches_b) return false;
-  if (!patches_hold_triangles(a, *patches_a, eps[t.sa]) || !patches_hold_triangles(b, *patches_b, eps[t.sb]))
+  if (!patches_hold_triangles(a, *patches_a, slack[t.sa]) || !patches_hold_triangles(b, *patches_b, slack[t.sb]))
     return false;
   PatchGapOptions go;
   // The faces are within ε of their surfaces: the surfaces must be more than T + εa + εb apart.
-  const double eps_ab = eps[t.sa] + eps[t.sb] + t.roundoff;
-  go.threshold = p.threshold + eps_ab;
+  const double slack_ab = slack[t.sa] + slack[t.sb] + t.roundoff;
+  go.threshold = p.threshold + slack_ab;
   go.pose_magnitude = poses[t.ia].translation().norm() + poses[t.ib].translation().norm();
   const PatchGap found = patch_gap(*patches_a, *patches_b, t.t_ab(), go);
   if (found.gap) {
-    const double lb = *found.gap - eps_ab;
+    const double lb = *found.gap - slack_ab;
     if (!(lb > p.threshold)) return false;
     p.d.lo = std::max(p.d.lo, lb);
     settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);

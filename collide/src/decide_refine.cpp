@@ -37,14 +37,14 @@ namespace {
 
 // The interval of two faces' triangles (finer ones), tightened by the plane, cylinder or sphere of
 // either side: a part standing off a flat face by more than the other face's band is proved apart.
-Interval finer_interval(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+Interval finer_interval(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
                         const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band) {
   band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
   const double reach = p.threshold + band;
   out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab(), t.t_ba(), reach, o.clearance, c);
   Interval d = mesh_interval(out, band, reach);
   if (!out.intersecting)
-    d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, eps[t.sa], eps[t.sb], t, p.threshold));
+    d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, slack[t.sa], slack[t.sb], t, p.threshold));
   d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
   if (d.lo > d.hi) d.lo = d.hi;  // cannot happen for sound bounds; keep the interval ordered
   return d;
@@ -53,11 +53,11 @@ Interval finer_interval(std::span<const double> eps, const DecideTask& t, FaceVi
 }  // namespace
 
 // Step 4: the same interval on finer triangles (of the faces faces_to_refine picked).
-void refined_step(std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+void refined_step(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
                   const CollideOptions& o, CollideCounters& c) {
   PairOutcome out;
   double band = 0.0;
-  p.d = finer_interval(eps, t, fa, fb, p, o, c, out, band);
+  p.d = finer_interval(slack, t, fa, fb, p, o, c, out, band);
   p.fine = std::move(out);
   p.band = band;
   settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &*p.fine, o.clearance);
@@ -68,16 +68,16 @@ void refined_step(std::span<const double> eps, const DecideTask& t, FaceView fa,
 
 // Corroborates an exact value above T: the finer triangles' lower bound proves the pair apart, their
 // upper bound or a witness on them proves it in contact (BRepExtrema missed), else it stays open.
-void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void corroborate(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                  Pending& p, const CollideOptions& o, CollideCounters& c) {
   // The surfaces' parameters first (exact mode has not asked them yet): a lower bound for free.
-  if (t.outcome != nullptr) analytic(m, eps, t, p, o);
-  if (!p.settled && !p.fine) refined_step(eps, t, fa, fb, p, o, c);
+  if (t.outcome != nullptr) analytic(m, slack, t, p, o);
+  if (!p.settled && !p.fine) refined_step(slack, t, fa, fb, p, o, c);
   // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
   // its corroboration; it is reported as decided by the exact faces.
   if (p.settled && p.exact) p.by = DecidedBy::Exact;
   if (p.settled || !p.fine) return;
-  witness_step(m, eps, t, fa, fb, &*p.fine, p.band, p, o, c);
+  witness_step(m, slack, t, fa, fb, &*p.fine, p.band, p, o, c);
   if (p.settled || !p.exact) return;
   // Deeper, for this pair alone: a band below half the exact value's margin over T proves it apart
   // if OCCT's value is right (and shows the contact if OCCT missed it). Not below a hundredth of the
@@ -98,9 +98,9 @@ void corroborate(const Model& m, std::span<const double> eps, const DecideTask& 
   const FaceView da = deeper(t.sa, fa, ka), db = deeper(t.sb, fb, kb);
   PairOutcome out;
   double band = 0.0;
-  p.d = finer_interval(eps, t, da, db, p, o, c, out, band);
+  p.d = finer_interval(slack, t, da, db, p, o, c, out, band);
   settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
-  if (!p.settled) witness_step(m, eps, t, da, db, &out, band, p, o, c);
+  if (!p.settled) witness_step(m, slack, t, da, db, &out, band, p, o, c);
 }
 
 }  // namespace cadclash::detail

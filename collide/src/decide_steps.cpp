@@ -58,7 +58,7 @@ Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask&
 // A lower bound on the exact faces' distance from their planes, cylinders and spheres: the two
 // surfaces' parameters, and each one's triangles kept off the other's surface (0 when none helps).
 // `a`, `b` are the model's faces or finer copies of them (same analytic surface and box).
-double analytic_bound(const Surface& a, const Surface& b, double eps_a, double eps_b, const DecideTask& t,
+double analytic_bound(const Surface& a, const Surface& b, double slack_a, double slack_b, const DecideTask& t,
                       double threshold) {
   const double r = t.roundoff;
   double lb = 0.0;
@@ -69,19 +69,19 @@ double analytic_bound(const Surface& a, const Surface& b, double eps_a, double e
   if (region.isEmpty()) {
     lb = box_distance(own_box(a), box_b);  // the boxes enclose the exact faces
   } else if (auto g = analytic_pair_gap(a.analytic, transform_analytic(b.analytic, t.t_ab()), region)) {
-    lb = std::max(lb, *g - eps_a - eps_b - r);
+    lb = std::max(lb, *g - slack_a - slack_b - r);
   }
   // The triangles' gap is searched up to twice what proving "apart" needs (farther triangles are
   // skipped and count as that reach), so a gap that proves it is never cut short.
   if (b.has_triangles) {
-    const double reach = 2.0 * (threshold + b.deflection + r + eps_a);
+    const double reach = 2.0 * (threshold + b.deflection + r + slack_a);
     if (auto g = analytic_gap(a.analytic, b.mesh, t.t_ab(), own_box(a), reach))
-      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - eps_a);
+      lb = std::max(lb, std::min(*g, reach) - b.deflection - r - slack_a);
   }
   if (a.has_triangles) {
-    const double reach = 2.0 * (threshold + a.deflection + r + eps_b);
+    const double reach = 2.0 * (threshold + a.deflection + r + slack_b);
     if (auto g = analytic_gap(b.analytic, a.mesh, t.t_ba(), own_box(b), reach))
-      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - eps_b);
+      lb = std::max(lb, std::min(*g, reach) - a.deflection - r - slack_b);
   }
   return lb;
 }
@@ -92,7 +92,7 @@ namespace {
 // points): the hull's height over the plane bounds the face's distance to the plane, whatever the
 // face's triangles, with no band at all. A part standing off a flat face by less than its triangles'
 // deflection is proved apart without refining it.
-double hull_bound(const Model& m, std::span<const double> eps, const DecideTask& t) {
+double hull_bound(const Model& m, std::span<const double> slack, const DecideTask& t) {
   double lb = 0.0;
   for (int side = 0; side < 2; ++side) {
     const SurfaceId sp = side == 0 ? t.sa : t.sb, sq = side == 0 ? t.sb : t.sa;
@@ -103,7 +103,7 @@ double hull_bound(const Model& m, std::span<const double> eps, const DecideTask&
     const auto range = part_q.source->height_range(sq - part_q.first_surface, plane.origin, plane.axis.normalized());
     if (!range) continue;
     const double gap = (*range)[0] > 0.0 ? (*range)[0] : (*range)[1] < 0.0 ? -(*range)[1] : 0.0;
-    lb = std::max(lb, gap - eps[t.sa] - eps[t.sb] - t.roundoff);
+    lb = std::max(lb, gap - slack[t.sa] - slack[t.sb] - t.roundoff);
   }
   return lb;
 }
@@ -111,9 +111,9 @@ double hull_bound(const Model& m, std::span<const double> eps, const DecideTask&
 }  // namespace
 
 // Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
-void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o) {
-  double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], eps[t.sa], eps[t.sb], t, p.threshold);
-  if (!(lb > p.threshold)) lb = std::max(lb, hull_bound(m, eps, t));
+void analytic(const Model& m, std::span<const double> slack, const DecideTask& t, Pending& p, const CollideOptions& o) {
+  double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], slack[t.sa], slack[t.sb], t, p.threshold);
+  if (!(lb > p.threshold)) lb = std::max(lb, hull_bound(m, slack, t));
   if (!(lb > p.threshold)) return;
   p.d.lo = std::max(p.d.lo, lb);
   settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);
@@ -222,7 +222,7 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles) {
 // surface and its edges); when its exact distance to the other face is within tolerance + that
 // face's ε (after the mapping's round-off), the faces are within T. Candidates are the vertices of
 // either face near the other's triangles, nearest first; one success settles it.
-void witness_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView fa, FaceView fb,
+void witness_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb,
                   const PairOutcome* out, double band, Pending& p, const CollideOptions& o, CollideCounters& c) {
   if (out == nullptr) return;
   const Surface& a = fa.surface;
@@ -231,8 +231,8 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
   const Part& pb = m.parts[b.part];
   if (!pa.source || !pb.source || !a.has_triangles || !b.has_triangles) return;
   // A vertex farther than this from the other face's triangles is beyond reach of its exact face.
-  const double limit_a = p.threshold - eps[t.sa] + band;  // A's vertices, asked of B (eps: the faces' slack)
-  const double limit_b = p.threshold - eps[t.sb] + band;
+  const double limit_a = p.threshold - slack[t.sa] + band;  // A's vertices, asked of B
+  const double limit_b = p.threshold - slack[t.sb] + band;
   std::vector<Candidate> tried;
   // One trial: the candidate's distance to the other exact face, bounded by a point of that face.
   auto proves = [&](const Candidate& cand) {
@@ -242,7 +242,7 @@ void witness_step(const Model& m, std::span<const double> eps, const DecideTask&
     const Part& asked = cand.of_a ? pb : pa;
     const FaceView& face = cand.of_a ? fb : fa;
     const std::uint32_t local = (cand.of_a ? t.sb : t.sa) - asked.first_surface;
-    const double own = (cand.of_a ? eps[t.sa] : eps[t.sb]) + t.roundoff;
+    const double own = (cand.of_a ? slack[t.sa] : slack[t.sb]) + t.roundoff;
     // The foot point on the other face's surface, kept when that face's triangles put it inside; a
     // foot outside is mostly on the face's boundary (faces meeting along an edge), where a point of
     // its edge curves answers; last, the source's exact classifier decides (ten times the cost).

@@ -7,6 +7,7 @@
 #include "cadclash/geometry.h"
 #include "surface_bvh.h"
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <span>
@@ -14,10 +15,10 @@
 
 namespace cadclash::detail {
 
-// In the steps below, `eps` is each face's slack (face_slack, decide.h): how far the points a step
-// takes as the face's (its triangles' vertices, points of its analytic surface) may lie off the exact
-// face. The contact threshold T = tolerance + εa + εb, with the surfaces' uncertainties, is
-// Pending::threshold, set by from_mesh (whose `eps` are those uncertainties).
+// In the steps below, `slack` is each face's face_slack (decide.h): how far the points a step takes
+// as the face's (its triangles' vertices, points of its analytic surface) may lie off the exact face.
+// The contact threshold T = tolerance + εa + εb, with the surfaces' uncertainties `eps`, is
+// Pending::threshold, set by from_mesh.
 
 // Where one pair's decision stands between the steps.
 struct Pending {
@@ -52,12 +53,12 @@ inline Aabb own_box(const Surface& s) { return pad_box(s.aabb.isEmpty() ? mesh_a
 Pending from_mesh(const Model& m, std::span<const double> eps, const DecideTask& t, const CollideOptions& o);
 
 // Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off (apart).
-void analytic(const Model& m, std::span<const double> eps, const DecideTask& t, Pending& p, const CollideOptions& o);
+void analytic(const Model& m, std::span<const double> slack, const DecideTask& t, Pending& p, const CollideOptions& o);
 
 // Step 2b: a vertex of one face on the other face's plane, cylinder or sphere, its foot point
 // provably inside that face (analytic_witness): the faces are within εA + g + r (contact).
 // Precondition: both views carry their outline.
-void analytic_contact(std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b, Pending& p,
+void analytic_contact(std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                       const CollideOptions& o);
 
 // True when `x`, a point of face `f`'s exact surface (its part frame), lies inside the face by its
@@ -70,8 +71,24 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles = fa
 // parts), a point of one face on the other's plane, inside both faces (contact): on a planar face the
 // crossing of its triangles with the plane; on a curved one Newton (SurfaceSource::surface_point)
 // from there onto the curve where its surface meets the plane.
-void crossing_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+void crossing_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b,
                    Pending& p, const CollideOptions& o, CollideCounters& c);
+
+// Where a triangle (vertices v) crosses a plane, given the vertices' signed heights h over it: the
+// two ends of the crossing segment, or nothing when the triangle does not reach both open sides.
+inline std::optional<std::array<Vec3, 2>> plane_cut(const Vec3* const (&v)[3], const double (&h)[3]) {
+  if (!(std::min({h[0], h[1], h[2]}) < 0.0 && std::max({h[0], h[1], h[2]}) > 0.0)) return std::nullopt;
+  std::array<Vec3, 2> ends;
+  int found = 0;
+  for (int k = 0; k < 3 && found < 2; ++k) {
+    const int l = (k + 1) % 3;
+    if ((h[k] < 0.0) == (h[l] < 0.0)) continue;  // this edge stays on one side (or ends on the plane)
+    const double s = h[k] / (h[k] - h[l]);
+    ends[static_cast<std::size_t>(found++)] = *v[k] + s * (*v[l] - *v[k]);
+  }
+  if (found < 2) return std::nullopt;
+  return ends;
+}
 
 // After a contact is proved: a planar face and a planar, cylindrical or other exact face whose
 // triangles cross deeper than T (the band hides whether the faces do) are proved penetrating on
@@ -89,13 +106,13 @@ bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p);
 
 // Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface
 // nearest the plane (closed form, near its lowest vertices), inside both faces, proves contact.
-void tangent_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+void tangent_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b,
                   Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // Step 3: witness vertices (contact): vertices of each face near the other face's triangles, asked
 // of the other exact face (SurfaceSource::point_distance), nearest first. `a`, `b` are the model's
 // faces or finer ones (same part and index); `out` their outcome, `band` its band.
-void witness_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+void witness_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b,
                   const PairOutcome* out, double band, Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // Step 3b: an edge witness (contact): where the faces' outlines come closest, a point on an edge of
@@ -107,13 +124,13 @@ void edge_witness_step(const Model& m, std::span<const Pose> poses, const Decide
 // Step 3c: a face touching the other face's plane at one point of a curved edge: that edge's
 // extremum toward the plane (SurfaceSource::edge_support), its foot inside the plane's face,
 // proves contact.
-void edge_support_step(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+void edge_support_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b,
                        Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // A lower bound on d* from the faces' planes, cylinders and spheres: the two surfaces' parameters,
 // and each one's triangles kept off the other's surface (0 when none helps). `a`, `b` are the
 // model's faces or finer copies of them (same analytic surface and box).
-double analytic_bound(const Surface& a, const Surface& b, double eps_a, double eps_b, const DecideTask& t,
+double analytic_bound(const Surface& a, const Surface& b, double slack_a, double slack_b, const DecideTask& t,
                       double threshold);
 
 // Step 4 and 6 helpers. A plane, cylinder or sphere bounds the distance to the other face's
@@ -130,7 +147,7 @@ FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::
 
 // Step 4: the interval on finer triangles `a`, `b` (finer_view), tightened by either face's plane,
 // cylinder or sphere against the other's triangles.
-void refined_step(std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b, Pending& p,
+void refined_step(std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                   const CollideOptions& o, CollideCounters& c);
 
 // Step 5a (certified): the two faces' surfaces as Bézier control hulls (SurfaceSource::bezier_patches),
@@ -138,7 +155,7 @@ void refined_step(std::span<const double> eps, const DecideTask& t, FaceView a, 
 // "apart" (decided_by Analytic) without OCCT's search. Where the pieces do not separate, a point of
 // A's surface there, within T of both faces (SurfaceSource::point_distance), proves contact
 // (decided_by Exact). True when it settled the pair.
-bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> eps, const DecideTask& t,
+bool hull_step(const Model& m, std::span<const Pose> poses, std::span<const double> slack, const DecideTask& t,
                Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // Step 5: the exact faces' distance (SurfaceSource::exact_distance). False when they have none.
@@ -147,7 +164,7 @@ bool exact_step(const Model& m, std::span<const Pose> poses, const DecideTask& t
 
 // Step 6: an exact value above T corroborated (apart) or contradicted (contact) by finer triangles
 // `a`, `b` (finer_view), and for this pair alone by triangles finer still.
-void corroborate(const Model& m, std::span<const double> eps, const DecideTask& t, FaceView a, FaceView b,
+void corroborate(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b,
                  Pending& p, const CollideOptions& o, CollideCounters& c);
 
 // Settles `p` when `v` decides, with the class it implies (penetrating only when `o` proves it).

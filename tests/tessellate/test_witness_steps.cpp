@@ -329,26 +329,29 @@ TEST(DepthWitness, FacesCrossingDeeperThanTheUncertaintyArePenetrating) {
 // which the two planes prove (their faces' points lie within the OCCT tolerance of them), with no
 // finer triangles and no OCCT distance; its sides cross the top deeper than T (penetrating).
 TEST(FaceSlack, PlanesProveAGapBeyondTheDeclaredUncertaintyWithoutRefining) {
-  Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(), BRepPrimAPI_MakeBox(6, 4, 5).Shape()}, 0.1);
-  for (Surface& s : m.surfaces) {
-    EXPECT_GT(s.tolerance, 0.0);
-    EXPECT_LT(s.tolerance, 1e-3);
-    s.uncertainty = 0.01;
+  for (const Pose& where : {Pose::Identity(), moved(Vec3(1e6, -3e5, 2e4), 0.7)}) {
+    Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(), BRepPrimAPI_MakeBox(6, 4, 5).Shape()}, 0.1);
+    for (Surface& s : m.surfaces) {
+      EXPECT_GT(s.tolerance, 0.0);
+      EXPECT_LT(s.tolerance, 1e-3);
+      s.uncertainty = 0.01;
+    }
+    place(m, 0, "/disk", where);
+    place(m, 1, "/part", where * moved(Vec3(-3, -2, 2 - 0.025), 0.3));
+    const Outcome r = check_pair(m, 0.0);
+    const std::string what = "at " + std::to_string(where.translation().x());
+    EXPECT_EQ(r.report.counters.refined_surfaces, 0u) << what;
+    EXPECT_EQ(r.report.counters.exact_queries, 0u) << what;
+    EXPECT_EQ(r.report.counters.undecided, 0u) << what;
+    int sides = 0;
+    for (const SurfacePairResult& p : r.report.pairs) {
+      const Surface& b = m.surfaces[p.surface_b];
+      EXPECT_GT(b.aabb.sizes().z(), 4.0) << what << ": only the side faces meet the disk's top, not " << b.name;
+      EXPECT_EQ(p.contact, ContactClass::Penetrating) << what << " " << b.name;
+      ++sides;
+    }
+    EXPECT_EQ(sides, 4) << what;
   }
-  place(m, 0, "/disk", Pose::Identity());
-  place(m, 1, "/part", moved(Vec3(-3, -2, 2 - 0.025), 0.3));
-  const Outcome r = check_pair(m, 0.0);
-  EXPECT_EQ(r.report.counters.refined_surfaces, 0u);
-  EXPECT_EQ(r.report.counters.exact_queries, 0u);
-  EXPECT_EQ(r.report.counters.undecided, 0u);
-  int sides = 0;
-  for (const SurfacePairResult& p : r.report.pairs) {
-    const Surface& b = m.surfaces[p.surface_b];
-    EXPECT_GT(b.aabb.sizes().z(), 4.0) << "only the side faces meet the disk's top, not " << b.name;
-    EXPECT_EQ(p.contact, ContactClass::Penetrating) << b.name;
-    ++sides;
-  }
-  EXPECT_EQ(sides, 4);
 }
 
 // A torus (no analytic certificate of its own) lying 0.02 mm above a disk (a plane bounded by a
