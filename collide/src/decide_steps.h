@@ -150,7 +150,7 @@ FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::
 void refined_step(std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                   const CollideOptions& o, CollideCounters& c);
 
-// Step 5a (certified): the two faces' surfaces as Bézier control hulls (SurfaceSource::bezier_patches),
+// Step 3d (certified, before refinement): the two faces' surfaces as Bézier control hulls (SurfaceSource::bezier_patches),
 // halved until every pair of pieces is farther apart than T (patch_gap.h): a lower bound on d*, so
 // "apart" (decided_by Analytic) without OCCT's search. Where the pieces do not separate, a point of
 // A's surface there, within T of both faces (SurfaceSource::point_distance), proves contact

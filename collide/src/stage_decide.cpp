@@ -263,18 +263,24 @@ void refinement_step(Run& run, CollideCounters& counters) {
   });
 }
 
-// Steps 5 and 6: the exact faces for what is still open (certified: their control hulls first), and
-// exact values above T corroborated (or contradicted) by finer triangles.
+// Step 3d (certified): the faces' control hulls, before any face is meshed again. A bounded search
+// of a few microseconds to milliseconds per pair, where refinement re-meshes a whole face (the board
+// under a component, thousands of triangles, for each wall standing off it by less than its band).
+void hull_pass(Run& run) {
+  run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
+    timed(run.seconds[k].hull, [&] {
+      hull_step(run.model, run.poses, run.slack, run.tasks[k], run.pending[k], run.o, run.task_counters[k]);
+    });
+  });
+}
+
+// Steps 5 and 6: the exact faces for what is still open, and exact values above T corroborated (or
+// contradicted) by finer triangles.
 void exact_steps(Run& run, CollideCounters& counters) {
   const Model& model = run.model;
   const auto& tasks = run.tasks;
   run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
     Pending& p = run.pending[k];
-    const bool certified = run.o.decision == DecisionMode::Certified;
-    if (certified && timed(run.seconds[k].hull, [&] {
-          return hull_step(model, run.poses, run.slack, tasks[k], p, run.o, run.task_counters[k]);
-        }))
-      return;
     if (timed(run.seconds[k].exact, [&] { return exact_step(model, run.poses, tasks[k], p, run.o, run.task_counters[k]); }) ||
         !run.meshed(k))
       return;
@@ -345,7 +351,10 @@ void DecisionRun::skip(std::size_t k) { impl_->pending[k].cut = true; }
 std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters, CollideTimings& timings) {
   Run& run = *impl_;
   for (char st : run.state) counters.ambiguous_pairs += (st & kAmbiguous) != 0;
-  if (run.o.decision == DecisionMode::Certified) refinement_step(run, counters);
+  if (run.o.decision == DecisionMode::Certified) {
+    hull_pass(run);
+    refinement_step(run, counters);
+  }
   exact_steps(run, counters);
   // The contacts steps 4 to 6 proved, as early() does for its own.
   std::vector<std::size_t> late;

@@ -15,7 +15,15 @@
 #include <Extrema_GenLocateExtPS.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_BezierSurface.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <Geom_BezierCurve.hxx>
+#include <Geom_Circle.hxx>
 #include <Geom_ElementarySurface.hxx>
+#include <Geom_Ellipse.hxx>
+#include <Geom_Line.hxx>
+#include <Geom_SurfaceOfLinearExtrusion.hxx>
+#include <Geom_SurfaceOfRevolution.hxx>
+#include <Geom_TrimmedCurve.hxx>
 #include <Geom_RectangularTrimmedSurface.hxx>
 #include <GeomConvert.hxx>
 #include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
@@ -399,6 +407,26 @@ void face_bounds(const TopoDS_Face& face, const Handle(Geom_Surface)& s, double&
   else if (v2 - v1 >= s->VPeriod()) v2 = v1 + s->VPeriod();
 }
 
+// A curve GeomConvert turns into a B-spline without approximating it (an offset curve, for
+// example, it approximates).
+bool curve_converts_exactly(Handle(Geom_Curve) c) {
+  while (!c.IsNull() && c->IsKind(STANDARD_TYPE(Geom_TrimmedCurve))) c = Handle(Geom_TrimmedCurve)::DownCast(c)->BasisCurve();
+  return !c.IsNull() && (c->IsKind(STANDARD_TYPE(Geom_Line)) || c->IsKind(STANDARD_TYPE(Geom_Circle)) ||
+                         c->IsKind(STANDARD_TYPE(Geom_Ellipse)) || c->IsKind(STANDARD_TYPE(Geom_BSplineCurve)) ||
+                         c->IsKind(STANDARD_TYPE(Geom_BezierCurve)));
+}
+
+// Surfaces GeomConvert::SurfaceToBSplineSurface converts exactly once trimmed to the face's
+// parameter bounds: the elementary ones, and surfaces of revolution and of linear extrusion swept
+// from a curve that converts exactly (KiCad's exports draw many component walls as those).
+bool converts_exactly(const Handle(Geom_Surface)& s) {
+  if (!Handle(Geom_ElementarySurface)::DownCast(s).IsNull()) return true;
+  if (const auto r = Handle(Geom_SurfaceOfRevolution)::DownCast(s); !r.IsNull()) return curve_converts_exactly(r->BasisCurve());
+  if (const auto e = Handle(Geom_SurfaceOfLinearExtrusion)::DownCast(s); !e.IsNull())
+    return curve_converts_exactly(e->BasisCurve());
+  return false;
+}
+
 }  // namespace
 
 std::optional<SurfaceSource::BezierPatches> face_bezier_patches(const TopoDS_Face& face) {
@@ -411,7 +439,7 @@ std::optional<SurfaceSource::BezierPatches> face_bezier_patches(const TopoDS_Fac
   } else {
     Handle(Geom_BSplineSurface) b = Handle(Geom_BSplineSurface)::DownCast(surface);
     if (b.IsNull()) {
-      if (Handle(Geom_ElementarySurface)::DownCast(surface).IsNull()) return std::nullopt;
+      if (!converts_exactly(surface)) return std::nullopt;
       double u1 = 0.0, u2 = 0.0, v1 = 0.0, v2 = 0.0;
       face_bounds(face, surface, u1, u2, v1, v2);
       if (!(u1 < u2 && v1 < v2) || !std::isfinite(u2 - u1) || !std::isfinite(v2 - v1)) return std::nullopt;

@@ -6,7 +6,7 @@
 // checked for its verdict first and then for what it cost (no OCCT face-face query where the
 // geometry gives a cheaper proof): a wrong verdict fails, and so does a proof that silently falls
 // back to the expensive path.
-#include "built_parts.h"
+#include "witness_scene.h"
 #include "cadclash/collide.h"
 #include "cadclash/tessellate.h"
 
@@ -33,28 +33,11 @@
 namespace cadclash {
 namespace {
 
-Model build(const std::vector<TopoDS_Shape>& shapes, double deflection) {
-  TessellationOptions t;
-  t.linear_deflection = deflection;
-  testing::Built b = testing::build_parts(shapes, t, false);
-  EXPECT_TRUE(b.complete);
-  return std::move(b.model);
-}
-
-void place(Model& m, PartId part, const std::string& path, const Pose& pose) {
-  Instance in;
-  in.path = path;
-  in.part = part;
-  in.pose = pose;
-  m.instances.push_back(in);
-}
-
-Pose moved(const Vec3& offset, double angle_z = 0.0) {
-  Pose p = Pose::Identity();
-  p.translate(offset);
-  p.rotate(Eigen::AngleAxisd(angle_z, Vec3::UnitZ()));
-  return p;
-}
+using testing::build;
+using testing::check_pair;
+using testing::moved;
+using testing::Outcome;
+using testing::place;
 
 // surface_point: on a cylinder of radius 3 (axis z), the foot of (5, 0, 4) is (3, 0, 4) with the
 // normal ±x, whatever the face's boundary; boundary_distance is an upper bound on the distance to
@@ -241,22 +224,6 @@ TEST(SurfacePoint, FootOnPlacedElementaryFacesIsTheExactFoot) {
   }
 }
 
-struct Outcome {
-  Report report;
-  bool contact = false;  // some pair of the two instances is reported touching or penetrating
-};
-
-Outcome check_pair(Model& m, double tolerance) {
-  Scene scene(m);
-  CollideOptions o;
-  o.tolerance = tolerance;
-  o.threads = 1;
-  Outcome out{scene.check(o)};
-  for (const SurfacePairResult& p : out.report.pairs)
-    out.contact |= p.contact == ContactClass::Touching || p.contact == ContactClass::Penetrating;
-  return out;
-}
-
 // Sunk by less than a deflection: every vertex of the sunk part is that depth off the seat, so no
 // vertex witnesses the contact. The crossing does: planar faces by their triangles (decided
 // analytic), a cylinder by Newton on the curve where it meets the plane. Never OCCT's face-face
@@ -352,30 +319,6 @@ TEST(FaceSlack, PlanesProveAGapBeyondTheDeclaredUncertaintyWithoutRefining) {
     }
     EXPECT_EQ(sides, 4) << what;
   }
-}
-
-// A torus (no analytic certificate of its own) lying 0.02 mm above a disk (a plane bounded by a
-// circle, so its triangles have a band too), meshed at 0.1 mm: the bands hide the gap, and finer
-// triangles of both would still. The disk's plane against the torus's finer triangles proves it
-// apart: one refined face (the torus; the plane is not refined), no OCCT query. At tolerance 0.03
-// the two touch.
-TEST(RefinedAnalytic, StandOffOverAPlaneIsProvedByRefiningTheOtherFaceOnly) {
-  Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(), BRepPrimAPI_MakeTorus(6, 1.5).Shape()}, 0.1);
-  place(m, 0, "/disk", Pose::Identity());
-  const double gap = 0.02;
-  place(m, 1, "/ring", moved(Vec3(1, -2, 2 + 1.5 + gap), 0.2));
-  ASSERT_GT(m.surfaces[m.parts[1].first_surface].deflection, gap / 2) << "the torus's mesh alone must not tell";
-  double disk_deflection = 0.0;
-  for (std::uint32_t i = 0; i < m.parts[0].surface_count; ++i)
-    if (m.surfaces[i].analytic.shape == SurfaceShape::Plane) disk_deflection = std::max(disk_deflection, m.surfaces[i].deflection);
-  ASSERT_GT(disk_deflection, gap) << "the disk's band alone hides the gap";
-  const Outcome apart = check_pair(m, 1e-4);
-  EXPECT_FALSE(apart.contact);
-  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
-  EXPECT_EQ(apart.report.counters.refined_surfaces, 1u);
-  EXPECT_EQ(apart.report.counters.undecided, 0u);
-  const Outcome touching = check_pair(m, 0.03);
-  EXPECT_TRUE(touching.contact);
 }
 
 // Tangent to a flat face: a cylinder lying on its side and a sphere resting on it touch along a line

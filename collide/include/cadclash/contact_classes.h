@@ -66,20 +66,23 @@ namespace cadclash {
 //             two edge curves) — faces meeting edge to edge, as a curved edge tangent to a straight one;
 //             then, against a plane, the extremum toward it of the other face's edge near its lowest
 //             outline points (SurfaceSource::edge_support) — a disk or a bolt's flat lying on its rim;
-//   refined   where finer triangles could show a gap (the triangles stay apart by more than T plus
-//             the finer band), the faces re-tessellated at a tenth of their deflection by their
-//             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
-//             cylinder or sphere of either face against the other's finer triangles; a face of those
-//             shapes is not refined when the other face is not one (its surface bounds the gap);
 //   hull      (certified) both faces' surfaces as rational Bézier patches (SurfaceSource::bezier_patches:
-//             B-spline and Bézier surfaces, planes, cylinders, cones, spheres and tori), halved where
+//             B-spline and Bézier surfaces, planes, cylinders, cones, spheres, tori, and surfaces of
+//             revolution and extrusion swept from lines, conics, B-spline or Bézier curves), halved where
 //             they bend until a plane puts every pair of pieces' control points more than T + εa + εb
 //             apart: a lower bound on d* (apart, decided_by Analytic) — a bolt drifting a micrometre
 //             off its hole's axis, far inside every band; where pieces will not separate, a point of
 //             A's surface there, or where A's surface crosses B's next to it (B's signed height from
 //             SurfaceSource::surface_point, bisected on A's surface), within T of both faces
 //             (SurfaceSource::point_distance) proves contact (decided_by Exact). A bounded search (at
-//             most 16,384 pairs of pieces);
+//             most 16,384 pairs of pieces), so it comes before any face is meshed again: a wall of a
+//             component standing off a board by less than its triangles' band is proved apart without
+//             re-meshing the board;
+//   refined   where finer triangles could show a gap (the triangles stay apart by more than T plus
+//             the finer band), the faces re-tessellated at a tenth of their deflection by their
+//             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
+//             cylinder or sphere of either face against the other's finer triangles; a face of those
+//             shapes is not refined when the other face is not one (its surface bounds the gap);
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
 //   depth     (after any of the above proved contact) a planar face and a planar, cylindrical or

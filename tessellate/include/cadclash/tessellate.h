@@ -168,8 +168,10 @@ class BrepSource final : public SurfaceSource {
                                                     const Vec3& normal) const override;
 
   // GeomConvert's Bézier patches of the face's B-spline or Bézier surface (trimmed ones unwrapped), or
-  // of its plane, cylinder, cone, sphere or torus over the face's parameter bounds; placed by the face's
-  // location. nullopt for other surfaces, for non-positive weights and beyond 1024 patches.
+  // of its plane, cylinder, cone, sphere, torus, or surface of revolution or linear extrusion swept
+  // from a line, circle, ellipse, B-spline or Bézier curve (exact conversions only) over the face's
+  // parameter bounds; placed by the face's location. nullopt for other surfaces, for non-positive
+  // weights and beyond 1024 patches.
   std::optional<BezierPatches> bezier_patches(std::uint32_t local_index) const override;
 
   // Newton (first and second derivatives of BRepAdaptor_Curve) on the edge nearest `near`.
