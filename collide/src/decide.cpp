@@ -368,7 +368,7 @@ std::optional<double> analytic_witness(const AnalyticSurface& an_b, const Triang
     const Candidate& c = best[k];
     // Both must hold; the outline (a few segment tests when the last answer's neighbours hold) first.
     if (near_outline(outline_b, c.foot, 2.0 * delta_b + slack)) continue;
-    if (point_mesh_distance(bvh_b, mesh_b, c.foot, delta_b + slack) <= delta_b + slack) return c.g;
+    if (point_near_mesh(bvh_b, mesh_b, c.foot, delta_b + slack)) return c.g;
   }
   return std::nullopt;
 }

@@ -215,7 +215,7 @@ bool inside_face(FaceView f, const Vec3& x, double slack, bool on_triangles) {
   if (f.outline == nullptr || f.outline->empty()) return false;
   const double delta = f.surface.deflection;
   return !near_outline(*f.outline, x, 2.0 * delta + slack) &&
-         (on_triangles || point_mesh_distance(f.bvh, f.surface.mesh, x, delta + slack) <= delta + slack);
+         (on_triangles || point_near_mesh(f.bvh, f.surface.mesh, x, delta + slack));
 }
 
 // A vertex of a face lies on its own exact face (within that face's ε: the mesher puts nodes on the

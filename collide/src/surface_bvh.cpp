@@ -3,6 +3,7 @@
 #include "cadclash/geometry.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -188,15 +189,25 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
   if (bvh.node_count > 0) sort_indices(out, start, bvh.items);  // without a tree the scan is in order
 }
 
-double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
+namespace {
+
+// The nearest triangle's distance from p among those whose box comes within `reach`, stopping
+// once one is within `enough` (then some triangle is that near, not necessarily the nearest; its
+// index in `found`).
+double nearest_triangle(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach, double enough,
+                        std::uint32_t* found = nullptr) {
   double best = std::numeric_limits<double>::infinity();
   auto visit = [&](std::uint32_t t) {
-    if (triangle_box(mesh, t).exteriorDistance(p) > std::min(best, reach)) return;
+    if (triangle_box(mesh, t).exteriorDistance(p) > std::min(best, reach)) return false;
     const auto& tri = mesh.triangles[t];
     best = std::min(best, point_triangle_distance(p, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]));
+    if (!(best <= enough)) return false;
+    if (found != nullptr) *found = t;
+    return true;
   };
   if (bvh.node_count == 0) {
-    for (std::uint32_t t = 0; t < bvh.items; ++t) visit(t);
+    for (std::uint32_t t = 0; t < bvh.items; ++t)
+      if (visit(t)) break;
     return best;
   }
   // Nearer child first: the best so far shrinks sooner and prunes more. The minimum is the same in
@@ -214,7 +225,8 @@ double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, cons
     if (std::sqrt(e.d2) > std::min(best, reach)) continue;
     const SurfaceBvh::Node& node = bvh.nodes[e.node];
     if (const std::uint32_t count = node.count(); count > 0) {
-      for (std::uint32_t i = node.first(); i < node.first() + count; ++i) visit(bvh.item(i));
+      for (std::uint32_t i = node.first(); i < node.first() + count; ++i)
+        if (visit(bvh.item(i))) return best;
     } else {
       const Entry left{node.first(), bvh.node_box(bvh.nodes[node.first()]).squaredExteriorDistance(p)};
       const Entry right{node.first() + 1, bvh.node_box(bvh.nodes[node.first() + 1]).squaredExteriorDistance(p)};
@@ -224,6 +236,43 @@ double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, cons
     }
   }
   return best;
+}
+
+}  // namespace
+
+double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
+  return nearest_triangle(bvh, mesh, p, reach, -std::numeric_limits<double>::infinity());
+}
+
+bool point_near_mesh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach) {
+  // Points asked one after another often lie in one triangle (the depth step's bisection walks a
+  // line across a board's long planar triangles, asking of two faces in turn): the triangle found
+  // last for this mesh (among the last few meshes asked) is tried first. Any triangle within reach
+  // gives the answer; a hint that misses (or is stale: only its index is kept) costs one test.
+  struct Hint {
+    const TriangleMesh* mesh = nullptr;
+    std::uint32_t triangle = 0;
+  };
+  thread_local std::array<Hint, 4> hints;
+  thread_local std::size_t next = 0;
+  for (const Hint& h : hints) {
+    if (h.mesh != &mesh || h.triangle >= mesh.triangles.size()) continue;
+    const auto& tri = mesh.triangles[h.triangle];
+    if (point_triangle_distance(p, mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]) <= reach)
+      return true;
+    break;
+  }
+  std::uint32_t found = 0;
+  if (!(nearest_triangle(bvh, mesh, p, reach, reach, &found) <= reach)) return false;
+  Hint* slot = nullptr;
+  for (Hint& h : hints)
+    if (h.mesh == &mesh) slot = &h;
+  if (slot == nullptr) {
+    slot = &hints[next];
+    next = (next + 1) % hints.size();
+  }
+  *slot = {&mesh, found};
+  return true;
 }
 
 }  // namespace cadclash::detail

@@ -155,4 +155,9 @@ void query_surface_bvh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Aa
 // pruned, so a result <= reach is the distance to the whole mesh.
 double point_mesh_distance(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach);
 
+// Whether some triangle of `mesh` lies within `reach` of `p` (point_mesh_distance(...) <= reach),
+// stopping at the first one found: a point inside a face asks this of thousands of triangles
+// whose boxes all contain it (a board's top face).
+bool point_near_mesh(const SurfaceBvh& bvh, const TriangleMesh& mesh, const Vec3& p, double reach);
+
 }  // namespace cadclash::detail

@@ -22,6 +22,7 @@ using detail::Verdict;
 using detail::verdict;
 using detail::build_surface_bvh;
 using detail::point_mesh_distance;
+using detail::point_near_mesh;
 using detail::SurfaceBvh;
 
 Pose random_pose(std::mt19937_64& rng, double offset) {
@@ -255,6 +256,54 @@ TEST(PointMeshDistance, EqualsBruteForceWithinTheReach) {
   EXPECT_GT(within, 100);
   EXPECT_GT(beyond, 100);
   EXPECT_EQ(point_mesh_distance(SurfaceBvh{}, TriangleMesh{}, Vec3::Zero(), 1.0), std::numeric_limits<double>::infinity());
+}
+
+// point_near_mesh (the "inside a face" tests' question) answers what the brute-force minimum says,
+// also when points come one after another near each other (its hints: the triangle found last per
+// mesh) and alternate between two meshes, and when a hint's mesh is replaced by a smaller one.
+TEST(PointNearMesh, AgreesWithTheBruteForceMinimum) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  auto soup = [&](int n) {
+    TriangleMesh mesh;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 c(u(rng), u(rng), 0.1 * u(rng));
+      const auto v = static_cast<std::uint32_t>(mesh.vertices.size());
+      mesh.vertices.insert(mesh.vertices.end(), {c, c + Vec3(3.0, 0.1, 0.2), c + Vec3(0.2, 2.5, -0.1)});
+      mesh.triangles.push_back({v, v + 1, v + 2});
+    }
+    return mesh;
+  };
+  std::vector<TriangleMesh> meshes{soup(300), soup(40)};
+  auto brute = [](const TriangleMesh& mesh, const Vec3& p) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const auto& t : mesh.triangles)
+      d = std::min(d, triangle_distance(p, p, p, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]));
+    return d;
+  };
+  int yes = 0, no = 0;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<SurfaceBvh> trees;
+    for (const TriangleMesh& mesh : meshes) trees.push_back(build_surface_bvh(mesh));
+    for (int k = 0; k < 300; ++k) {
+      // A walk: each point near the last, asked of both meshes in turn.
+      const Vec3 start(u(rng), u(rng), 0.3 * u(rng));
+      for (int step = 0; step < 6; ++step) {
+        const Vec3 p = start + 0.05 * step * Vec3(1.0, 0.5, 0.1);
+        for (std::size_t m = 0; m < meshes.size(); ++m)
+          for (double reach : {0.02, 0.3}) {
+            const bool near = point_near_mesh(trees[m], meshes[m], p, reach);
+            EXPECT_EQ(near, brute(meshes[m], p) <= reach) << round << ' ' << k << ' ' << step << ' ' << m;
+            ++(near ? yes : no);
+          }
+      }
+    }
+    // The same addresses, fewer triangles: stale hints must not be read past the end.
+    meshes[0] = soup(5);
+  }
+  EXPECT_GT(yes, 500);
+  EXPECT_GT(no, 500);
+  EXPECT_FALSE(point_near_mesh(SurfaceBvh{}, TriangleMesh{}, Vec3::Zero(), 1.0));
 }
 
 // The outline's tree answers what a scan over every segment answers, near and far from the origin,
