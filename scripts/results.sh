@@ -113,6 +113,8 @@ for name, r in rows.items():
 PY
 echo "results: the model-uncertainty band on real-part boards (scripts/uncertainty_bench.sh)"
 bash "$root/scripts/uncertainty_bench.sh" "$build" "$out/uncertainty" >"$out/uncertainty.md"
+echo "results: certified against --fast on real-part boards (scripts/boards_bench.sh)"
+bash "$root/scripts/boards_bench.sh" "$build" "$out/boards" "$out/uncertainty" >"$out/boards.md"
 elapsed=$(( $(date +%s) - start ))
 
 # Plots next to the page; links in the embedded tables point there.
@@ -149,6 +151,7 @@ while IFS= read -r line || [ -n "$line" ]; do
     @PIPELINE_ORACLE@) cat "$out/pipeline.md" ;;
     @SCALE@) cat "$out/scale.md" ;;
     @UNCERTAINTY_BAND@) cat "$out/uncertainty.md" ;;
+    @BOARDS@) cat "$out/boards.md" ;;
     @IMPORT_PEER@)
       # Measured by scripts/import_peer_bench.sh (~20 min), not here: its last table, as it is.
       bench=$root/out/import_peer_bench
