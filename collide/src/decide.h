@@ -154,7 +154,7 @@ struct DecideResult {
 
 // The decision stage (contact_classes.h, "Certified decisions"), per options.decision. Refinements run in
 // parallel, each answer depending on its pair alone; results come back in task order, so the report
-// is the same for any thread count. `refined` is the Scene's cache of finer faces (one per surface),
+// is the same for any thread count. `refined` is the Scene's cache of finer faces and parts of faces,
 // `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`, and the
 // seconds each step took to `timings`' decide_* fields.
@@ -163,7 +163,7 @@ struct DecideResult {
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const double> slack,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                                       std::vector<RefinedSurface>& refined, OutlineCache& outlines,
+                                       RefineCache& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
                                        CollideCounters& counters, CollideTimings& timings);
 
@@ -179,7 +179,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 class DecisionRun {
  public:
   DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps, std::span<const double> slack,
-              std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks, std::vector<RefinedSurface>& refined,
+              std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks, RefineCache& refined,
               OutlineCache& outlines, const CollideOptions& options, int threads, const Deadline& deadline);
   ~DecisionRun();
   DecisionRun(const DecisionRun&) = delete;

@@ -5,6 +5,8 @@
 #include "decide_steps.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace cadclash::detail {
 
@@ -33,18 +35,26 @@ FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::
   return FaceView{m.surfaces[s], bvh[s]};
 }
 
+Aabb reach_region(const DecideTask& t, const Surface& a, const Surface& b, bool of_a, double margin) {
+  const Aabb other = of_a ? transform_box(own_box(b), t.t_ab()) : transform_box(own_box(a), t.t_ba());
+  return (of_a ? own_box(a) : own_box(b)).intersection(pad_box(other, margin));
+}
+
 namespace {
 
 // The interval of two faces' triangles (finer ones), tightened by the plane, cylinder or sphere of
 // either side: a part standing off a flat face by more than the other face's band is proved apart.
 Interval finer_interval(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
-                        const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band) {
+                        const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band,
+                        double outside = std::numeric_limits<double>::infinity()) {
   band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
   const double reach = p.threshold + band;
   out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab(), t.t_ba(), reach, o.clearance, c);
   Interval d = mesh_interval(out, band, reach);
   if (!out.intersecting)
     d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, slack[t.sa], slack[t.sb], t, p.threshold));
+  // The triangles of a region stand for the faces' points there; the points outside are farther.
+  d.lo = std::min(d.lo, outside);
   d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
   if (d.lo > d.hi) d.lo = d.hi;  // cannot happen for sound bounds; keep the interval ordered
   return d;
@@ -54,16 +64,18 @@ Interval finer_interval(std::span<const double> slack, const DecideTask& t, Face
 
 // Step 4: the same interval on finer triangles (of the faces faces_to_refine picked).
 void refined_step(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
-                  const CollideOptions& o, CollideCounters& c) {
+                  const CollideOptions& o, CollideCounters& c, double outside) {
   PairOutcome out;
   double band = 0.0;
-  p.d = finer_interval(slack, t, fa, fb, p, o, c, out, band);
-  p.fine = std::move(out);
+  p.d = finer_interval(slack, t, fa, fb, p, o, c, out, band, outside);
   p.band = band;
-  settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &*p.fine, o.clearance);
+  settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &out, o.clearance);
   // A contact proved on finer triangles is penetrating only when they prove it.
-  if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(*p.fine, p.threshold, band))
+  if (p.settled && p.cls == ContactClass::Touching && certainly_penetrating(out, p.threshold, band))
     p.cls = ContactClass::Penetrating;
+  // Later steps read the finer outcome against the finer whole faces (finer_view): an outcome on a
+  // region's triangles is not kept for them.
+  if (std::isinf(outside)) p.fine = std::move(out);
 }
 
 // Corroborates an exact value above T: the finer triangles' lower bound proves the pair apart, their

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -144,11 +145,17 @@ bool refinement_can_separate(const Model& m, const DecideTask& t, const Pending&
 // The finer copy of face `s` when refinement made one, else the model's face.
 FaceView finer_view(const Model& m, std::span<const SurfaceBvh> bvh, const std::vector<RefinedSurface>& cache,
                     SurfaceId s);
+// Where face a (of_a) or b of task t can come within `margin` of the other face: its own box and
+// the other's mapped into its part frame and grown by `margin` (part-local; empty when farther).
+Aabb reach_region(const DecideTask& t, const Surface& a, const Surface& b, bool of_a, double margin);
 
-// Step 4: the interval on finer triangles `a`, `b` (finer_view), tightened by either face's plane,
-// cylinder or sphere against the other's triangles.
+// Step 4: the interval on finer triangles `a`, `b` (finer_view, or a region of a large face: then
+// `outside` is a lower bound on the distance of the face's points outside the region to the other
+// face, and caps the interval's bottom), tightened by either face's plane, cylinder or sphere
+// against the other's triangles.
 void refined_step(std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
-                  const CollideOptions& o, CollideCounters& c);
+                  const CollideOptions& o, CollideCounters& c,
+                  double outside = std::numeric_limits<double>::infinity());
 
 // Step 3d (certified, before refinement): the two faces' surfaces as Bézier control hulls (SurfaceSource::bezier_patches),
 // halved until every pair of pieces is farther apart than T (patch_gap.h): a lower bound on d*, so

@@ -6,6 +6,12 @@
 #include "narrow_phase.h"
 #include "surface_bvh.h"
 
+#include <array>
+#include <compare>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -21,6 +27,36 @@ struct RefinedSurface {
   Diagnostic error;       // why the source could not mesh it finer (when !ok)
 };
 
+// Parts of faces meshed finer for the pairs that reach them (refine_region), by surface and the
+// region snapped to a grid of power-of-two cells, so pairs whose regions snap alike share one.
+struct RegionKey {
+  SurfaceId surface = kInvalidId;
+  int scale = 0;                      // cells of 2^scale mm
+  std::array<std::int64_t, 3> cell{}; // the region's lowest cell; it spans two cells per axis
+  auto operator<=>(const RegionKey&) const = default;
+};
+
+// What refinement keeps for later pairs and queries: finer whole faces (one slot per surface) and
+// finer parts of large faces. Regions are made by the pairs' threads; the map is guarded.
+struct RefineCache {
+  std::vector<RefinedSurface> surfaces;
+  std::mutex region_mutex;
+  std::map<RegionKey, std::shared_ptr<const RefinedSurface>> regions;
+  std::vector<std::uint32_t> regions_made;  // per surface: regions meshed so far (a query's work: the change)
+};
+
+// Whether face `s` is refined only near the other face of a pair (`region`, part-local): a large
+// face (thousands of triangles) of which the pair reaches a small part.
+bool refines_by_region(const Surface& s, const Aabb& region);
+
+// The part of face `s` inside `region` (part-local; snapped outward to the cache's grid) meshed at
+// refinement_deflection(s) by its source (SurfaceSource::triangulate_region), made once per snapped
+// region and kept in `cache` (counted in regions_made). Null when the source cannot mesh a region.
+// Adds the seconds the meshing took to `seconds`. Deterministic: the result depends on the face and
+// the snapped region only. Precondition: cache.regions_made.size() == model.surfaces.size().
+std::shared_ptr<const RefinedSurface> refine_region(const Model& model, SurfaceId s, const Aabb& region,
+                                                    RefineCache& cache, double& seconds);
+
 // Refinement helps only where a band exists and a source can mesh finer.
 bool can_refine(const Model& model, SurfaceId s);
 
@@ -30,10 +66,11 @@ double refinement_deflection(const Surface& s);
 // Fills cache[s] for every listed surface not attempted yet: surfaces that can be refined are meshed
 // by their source at refinement_deflection, in parallel across parts (a source serialises its own
 // part); the rest copy the model's triangles. Deterministic: each result depends on its surface only.
-// Returns the number of surfaces meshed, and adds to `seconds` (when given) the time each part's
-// meshing took, summed over the threads. Precondition: cache.size() == model.surfaces.size().
-std::size_t refine_surfaces(const Model& model, std::span<const SurfaceId> surfaces,
-                            std::vector<RefinedSurface>& cache, int threads, double* seconds = nullptr);
+// Appends the surfaces it meshed to `meshed` (ascending), and adds to `seconds` (when given) the
+// time each part's meshing took, summed over the threads. Precondition: cache.size() ==
+// model.surfaces.size().
+void refine_surfaces(const Model& model, std::span<const SurfaceId> surfaces, std::vector<RefinedSurface>& cache,
+                     int threads, std::vector<SurfaceId>& meshed, double* seconds = nullptr);
 
 // Surface `s` meshed at `deflection` by its source when it can be refined (not cached; for a pair
 // that needs a finer level than the cache holds), else the model's own triangles.

@@ -31,7 +31,10 @@ void narrow_stages(SceneData& s, QueryState& q) {
   surface_level_stage(s, q);  // which of their surfaces can meet
   time.surface_level = seconds_since(t);
   if (q.note_refined)
-    for (SurfaceId sid : q.needed) q.refined_before.push_back(s.refined[sid].attempted ? 1 : 0);
+    for (SurfaceId sid : q.needed) {
+      q.refined_before.push_back(s.refined.surfaces[sid].attempted ? 1 : 0);
+      q.regions_before.push_back(s.refined.regions_made[sid]);
+    }
   t = std::chrono::steady_clock::now();
   tessellation_stage(s, q);  // triangles and BVHs for exactly those surfaces
   time.tessellation = seconds_since(t);

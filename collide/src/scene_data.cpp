@@ -51,7 +51,8 @@ SceneData::SceneData(Model& m, SceneSelection sel) : model(m), selection(std::mo
   }
   bvh.resize(model.surfaces.size());
   bvh_ready.assign(model.surfaces.size(), 0);
-  refined.resize(model.surfaces.size());
+  refined.surfaces.resize(model.surfaces.size());
+  refined.regions_made.resize(model.surfaces.size(), 0);
   noted_deflection.assign(model.surfaces.size(), -1.0);
   noted_triangles.assign(model.surfaces.size(), kUntessellatedCost);
   first_need.resize(model.surfaces.size());

@@ -69,7 +69,7 @@ struct SceneData {
   InstanceTree instance_tree;          // built by the first broad phase with a small selection side
   std::vector<SurfaceBvh> bvh;
   std::vector<char> bvh_ready;
-  std::vector<RefinedSurface> refined;  // finer faces made for refinement, kept for later queries
+  RefineCache refined;  // finer faces and parts of faces made for refinement, kept for later queries
   OutlineCache outlines;                // surfaces' outlines made by the decision stage, likewise
   std::vector<char> in_a, in_b;
   // Per surface: the deflection another process tessellated it at (Scene::note_deflection); < 0: none.
@@ -149,6 +149,7 @@ struct QueryState {
   // query's decisions (only those surfaces can be refined by them). Filled when `note_refined`.
   bool note_refined = false;
   std::vector<char> refined_before;
+  std::vector<std::uint32_t> regions_before;  // per needed surface: RefineCache::regions_made before the query
   std::uint32_t cutoff = 0;                // pairs from here on do not fit the memory budget
 
   // Lazy tessellation: what this query asked for, made, and built (released past the cutoff).

@@ -63,13 +63,14 @@ std::vector<SurfaceWork> surface_work(const detail::SceneData& s, detail::QueryS
   }
   assert(q.failed.size() == q.report.diagnostics.size());
   for (std::size_t i = 0; i < q.failed.size(); ++i) at(q.failed[i]).error = q.report.diagnostics[i];
-  // refine_surfaces counts a face when its source meshed it finer than its triangles. The decisions
-  // refine only their tasks' faces, all of them in `needed`.
-  assert(q.refined_before.size() == q.needed.size());
+  // A face counts when its source meshed it, or a part of it, finer than its triangles. The
+  // decisions refine only their tasks' faces, all of them in `needed`.
+  assert(q.refined_before.size() == q.needed.size() && q.regions_before.size() == q.needed.size());
   for (std::size_t i = 0; i < q.needed.size(); ++i) {
     const SurfaceId sid = q.needed[i];
-    if (!q.refined_before[i] && s.refined[sid].attempted &&
-        s.refined[sid].surface.deflection < model.surfaces[sid].deflection)
+    if ((!q.refined_before[i] && s.refined.surfaces[sid].attempted &&
+         s.refined.surfaces[sid].surface.deflection < model.surfaces[sid].deflection) ||
+        s.refined.regions_made[sid] > q.regions_before[i])
       at(sid).refined = true;
   }
   std::vector<SurfaceWork> out;

@@ -9,6 +9,8 @@
 #include <atomic>
 #include <cassert>
 #include <chrono>
+#include <limits>
+#include <memory>
 #include <thread>
 
 namespace cadclash::detail {
@@ -28,14 +30,15 @@ std::vector<std::size_t> select(const std::vector<char>& state, const std::vecto
   return out;
 }
 
-// The faces refinement helps for the listed tasks (faces_to_refine), each once, ascending.
+// The faces refinement helps for the listed tasks (faces_to_refine), each once, ascending, but
+// those `regional` says a task refines near the other face only.
+template <class Regional>
 std::vector<SurfaceId> refinable_faces(const Model& model, std::span<const DecideTask> tasks,
-                                       const std::vector<std::size_t>& ks) {
+                                       const std::vector<std::size_t>& ks, Regional regional) {
   std::vector<SurfaceId> faces;
-  for (std::size_t k : ks) {
-    const std::vector<SurfaceId> which = faces_to_refine(model, tasks[k]);
-    faces.insert(faces.end(), which.begin(), which.end());
-  }
+  for (std::size_t k : ks)
+    for (SurfaceId s : faces_to_refine(model, tasks[k]))
+      if (!regional(k, s)) faces.push_back(s);
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   return faces;
@@ -81,7 +84,7 @@ struct DecisionRun::Impl {
   std::span<const double> slack;  // how far a face's points may lie off it (face_slack)
   std::span<const SurfaceBvh> bvh;
   std::span<const DecideTask> tasks;
-  std::vector<RefinedSurface>& refined;
+  RefineCache& refined;
   OutlineCache& outlines;
   const CollideOptions& o;
   int threads;
@@ -92,13 +95,14 @@ struct DecisionRun::Impl {
   std::vector<DecideResult> answers = std::vector<DecideResult>(tasks.size());
   std::vector<StepSeconds> seconds = std::vector<StepSeconds>(tasks.size());
   double meshing = 0.0;  // refine_surfaces' time, summed over its threads (written by one thread at a time)
+  std::vector<SurfaceId> refined_faces;  // faces this run meshed finer, whole or in part (each counted once)
 
   bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
   FaceView view(SurfaceId f) const {
     const Outline& outline = outlines.outline[f];
     return FaceView{model.surfaces[f], bvh[f], outline.empty() ? nullptr : &outline};
   }
-  FaceView finer(SurfaceId f) const { return finer_view(model, bvh, refined, f); }
+  FaceView finer(SurfaceId f) const { return finer_view(model, bvh, refined.surfaces, f); }
   // The open pairs that satisfy `keep`.
   template <class Keep>
   std::vector<std::size_t> open(Keep keep) const { return select(state, pending, keep); }
@@ -243,22 +247,63 @@ namespace {
 
 using Run = DecisionRun::Impl;
 
+// A pair's finer parts of its large faces (refines_by_region), and how far the faces' points outside
+// them are from the other face at least.
+struct Regions {
+  std::shared_ptr<const RefinedSurface> a, b;
+  double outside = std::numeric_limits<double>::infinity();
+};
+
 // Step 4: finer triangles shrink the band tenfold: they can prove a gap the triangles see (apart),
-// not a contact within T (far below any band): crossing or touching triangles go on.
-void refinement_step(Run& run, CollideCounters& counters) {
+// not a contact within T (far below any band): crossing or touching triangles go on. A large face
+// of which the pair reaches a small part (a board's top face near one pin) is meshed finer only
+// there, by the pair's thread; other faces whole, once for every pair that needs them.
+void refinement_step(Run& run) {
   const Model& model = run.model;
+  const auto& tasks = run.tasks;
   const std::vector<std::size_t> gaps = run.open([&](std::size_t k) {
-    if (!run.meshed(k) || !refinement_can_separate(model, run.tasks[k], run.pending[k])) return false;
-    const std::vector<SurfaceId> which = faces_to_refine(model, run.tasks[k]);
+    if (!run.meshed(k) || !refinement_can_separate(model, tasks[k], run.pending[k])) return false;
+    const std::vector<SurfaceId> which = faces_to_refine(model, tasks[k]);
     return std::any_of(which.begin(), which.end(), [&](SurfaceId s) { return can_refine(model, s); });
   });
-  if (!gaps.empty() && !run.deadline.expired())
-    counters.refined_surfaces +=
-        refine_surfaces(model, refinable_faces(model, run.tasks, gaps), run.refined, run.threads, &run.meshing);
+  if (gaps.empty()) return;
+  // Where the faces can come within reach of each other: points of a face outside its region lie
+  // farther than `outside` from the other face (the boxes enclose the exact faces; the mapping
+  // rounds by at most the pair's round-off), far past T.
+  std::vector<Regions> regions(tasks.size());
+  std::vector<std::uint32_t> made_before(run.refined.regions_made);
   run.step(gaps, [&](std::size_t k) {
+    const DecideTask& t = tasks[k];
+    const Pending& p = run.pending[k];
+    const Surface& a = model.surfaces[t.sa];
+    const Surface& b = model.surfaces[t.sb];
+    const double margin = 2.0 * (p.threshold + p.band) + 4.0 * t.roundoff;
+    double took = 0.0;
+    for (SurfaceId s : faces_to_refine(model, t)) {
+      if (!can_refine(model, s)) continue;
+      const Aabb region = reach_region(t, a, b, s == t.sa, margin);
+      if (!refines_by_region(model.surfaces[s], region)) continue;
+      (s == t.sa ? regions[k].a : regions[k].b) = refine_region(model, s, region, run.refined, took);
+    }
+    if (regions[k].a || regions[k].b) regions[k].outside = margin - 2.0 * t.roundoff;
+    run.seconds[k].refine += took;
+  });
+  for (SurfaceId s = 0; s < made_before.size(); ++s)
+    if (run.refined.regions_made[s] > made_before[s]) run.refined_faces.push_back(s);
+  const auto by_region = [&](std::size_t k, SurfaceId s) {
+    return static_cast<bool>(s == tasks[k].sa ? regions[k].a : regions[k].b);
+  };
+  if (!run.deadline.expired())
+    refine_surfaces(model, refinable_faces(model, tasks, gaps, by_region), run.refined.surfaces, run.threads,
+                    run.refined_faces, &run.meshing);
+  run.step(gaps, [&](std::size_t k) {
+    const Regions& r = regions[k];
+    auto view = [&](SurfaceId s, const std::shared_ptr<const RefinedSurface>& part) {
+      return part ? FaceView{part->surface, part->bvh} : run.finer(s);
+    };
     timed(run.seconds[k].refine, [&] {
-      refined_step(run.slack, run.tasks[k], run.finer(run.tasks[k].sa), run.finer(run.tasks[k].sb), run.pending[k],
-                   run.o, run.task_counters[k]);
+      refined_step(run.slack, tasks[k], view(tasks[k].sa, r.a), view(tasks[k].sb, r.b), run.pending[k], run.o,
+                   run.task_counters[k], r.outside);
     });
   });
 }
@@ -276,7 +321,7 @@ void hull_pass(Run& run) {
 
 // Steps 5 and 6: the exact faces for what is still open, and exact values above T corroborated (or
 // contradicted) by finer triangles.
-void exact_steps(Run& run, CollideCounters& counters) {
+void exact_steps(Run& run) {
   const Model& model = run.model;
   const auto& tasks = run.tasks;
   run.step(run.open([](std::size_t) { return true; }), [&](std::size_t k) {
@@ -292,8 +337,8 @@ void exact_steps(Run& run, CollideCounters& counters) {
   const std::vector<std::size_t> check =
       run.open([&](std::size_t k) { return run.pending[k].needs_lower && run.meshed(k); });
   if (!check.empty() && !run.deadline.expired())
-    counters.refined_surfaces +=
-        refine_surfaces(model, refinable_faces(model, tasks, check), run.refined, run.threads, &run.meshing);
+    refine_surfaces(model, refinable_faces(model, tasks, check, [](std::size_t, SurfaceId) { return false; }),
+                    run.refined.surfaces, run.threads, run.refined_faces, &run.meshing);
   run.step(check, [&](std::size_t k) {
     timed(run.seconds[k].exact, [&] {
       corroborate(model, run.slack, tasks[k], run.finer(tasks[k].sa), run.finer(tasks[k].sb), run.pending[k], run.o,
@@ -316,7 +361,7 @@ std::vector<DecideResult> collect(Run& run, CollideCounters& counters) {
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                                        std::span<const double> slack,
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                                       std::vector<RefinedSurface>& refined, OutlineCache& outline_cache,
+                                       RefineCache& refined, OutlineCache& outline_cache,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
                                        CollideCounters& counters, CollideTimings& timings) {
   if (o.decision == DecisionMode::Fast) {
@@ -333,7 +378,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
 DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
                          std::span<const double> slack,
                          std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
-                         std::vector<RefinedSurface>& refined, OutlineCache& outlines, const CollideOptions& o,
+                         RefineCache& refined, OutlineCache& outlines, const CollideOptions& o,
                          int threads, const Deadline& deadline) {
   assert(o.decision != DecisionMode::Fast);
   // Outlines are made on first need (step 2b) unless the Scene has them already.
@@ -353,9 +398,13 @@ std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters, Collide
   for (char st : run.state) counters.ambiguous_pairs += (st & kAmbiguous) != 0;
   if (run.o.decision == DecisionMode::Certified) {
     hull_pass(run);
-    refinement_step(run, counters);
+    refinement_step(run);
   }
-  exact_steps(run, counters);
+  exact_steps(run);
+  // Faces meshed finer, whole or in part, by steps 4 and 6: each once.
+  std::sort(run.refined_faces.begin(), run.refined_faces.end());
+  counters.refined_surfaces += static_cast<std::uint64_t>(
+      std::unique(run.refined_faces.begin(), run.refined_faces.end()) - run.refined_faces.begin());
   // The contacts steps 4 to 6 proved, as early() does for its own.
   std::vector<std::size_t> late;
   for (std::size_t k = 0; k < run.tasks.size(); ++k)

@@ -4,6 +4,7 @@
 
 #include "cadclash/geometry.h"
 
+#include <BRepAlgoAPI_Common.hxx>
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
@@ -11,9 +12,13 @@
 #include <gp_Pnt.hxx>
 
 #include <Standard_Failure.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopLoc_Location.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 
+#include <algorithm>
 #include <cassert>
 #include <mutex>
 #include <shared_mutex>
@@ -80,6 +85,63 @@ bool BrepSource::triangulate(std::uint32_t local_index, double deflection, Trian
   if (!ok) {
     error = Diagnostic{Severity::Error, impl_->source_file, 0, impl_->entity_ids[local_index],
                        "face " + std::to_string(local_index) + " of part '" + impl_->part_name +
+                           "' could not be tessellated (" + why + ")"};
+  }
+  return ok;
+}
+
+bool BrepSource::triangulate_region(std::uint32_t local_index, double deflection, const Aabb& region,
+                                    TriangleMesh& out, double& achieved_deflection, Diagnostic& error) {
+  assert(local_index < impl_->faces.size() && deflection > 0.0 && !region.isEmpty());
+  std::string why;
+  bool ok = false;
+  out = TriangleMesh{};
+  achieved_deflection = 0.0;
+  if (local_index < impl_->outside_range.size() && impl_->outside_range[local_index]) {
+    why = "it was dropped: outside the supported range";
+  } else {
+    // Read-only on the part: the Boolean works on a copy (shared geometry, own topology) and is told
+    // not to touch its arguments; BRepMesh writes into the copy's pieces only.
+    std::shared_lock<std::shared_mutex> lock(impl_->mutex);
+    try {
+      const TopoDS_Shape face = BRepBuilderAPI_Copy(impl_->faces[local_index], Standard_False, Standard_False).Shape();
+      const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(region.min().x(), region.min().y(), region.min().z()),
+                                                   gp_Pnt(region.max().x(), region.max().y(), region.max().z()))
+                                   .Shape();
+      BRepAlgoAPI_Common common;
+      TopTools_ListOfShape args, tools;
+      args.Append(face);
+      tools.Append(box);
+      common.SetArguments(args);
+      common.SetTools(tools);
+      common.SetNonDestructive(Standard_True);
+      common.SetRunParallel(Standard_False);
+      common.Build();
+      if (!common.IsDone() || common.HasErrors()) {
+        why = "the Boolean common with the region failed";
+      } else {
+        ok = true;
+        for (TopExp_Explorer x(common.Shape(), TopAbs_FACE); x.More() && ok; x.Next()) {
+          TriangleMesh piece;
+          double got = 0.0;
+          ok = detail::mesh_face_to(TopoDS::Face(x.Current()), deflection, impl_->angular_deflection,
+                                    impl_->verify_deflection, piece, got, why);
+          if (!ok) break;
+          const auto base = static_cast<std::uint32_t>(out.vertices.size());
+          out.vertices.insert(out.vertices.end(), piece.vertices.begin(), piece.vertices.end());
+          for (auto t : piece.triangles) out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+          achieved_deflection = std::max(achieved_deflection, got);
+        }
+      }
+    } catch (const Standard_Failure& e) {
+      why = std::string("OCCT failed: ") + e.GetMessageString();
+      ok = false;
+    }
+  }
+  if (!ok) {
+    out = TriangleMesh{};
+    error = Diagnostic{Severity::Error, impl_->source_file, 0, impl_->entity_ids[local_index],
+                       "part of face " + std::to_string(local_index) + " of part '" + impl_->part_name +
                            "' could not be tessellated (" + why + ")"};
   }
   return ok;

@@ -5,7 +5,9 @@
 #include "witness_scene.h"
 
 #include "cadclash/collide.h"
+#include "cadclash/geometry.h"
 #include "cadclash/tessellate.h"
+#include "surface_bvh.h"
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -16,7 +18,9 @@
 #include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepPrimAPI_MakeRevol.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
+#include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <TopoDS_Compound.hxx>
 #include <GC_MakeArcOfEllipse.hxx>
 #include <Geom_SurfaceOfLinearExtrusion.hxx>
 #include <Geom_SurfaceOfRevolution.hxx>
@@ -26,6 +30,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -173,6 +179,133 @@ TEST(RefinedAnalytic, APinNearTheRimOfItsHoleIsProvedApartByRefiningTheBoard) {
   Model near = m;
   near.instances[1].pose = pin_at(chord.sagitta + 0.004);
   EXPECT_TRUE(check_pair(near, 1e-4).contact);
+}
+
+// A source that counts what refinement asks of the one it wraps (whole faces, parts of faces).
+class CountingSource final : public SurfaceSource {
+ public:
+  explicit CountingSource(std::shared_ptr<SurfaceSource> inner) : inner_(std::move(inner)) {}
+  std::atomic<int> whole{0}, regions{0};
+
+  bool triangulate(std::uint32_t i, double d, TriangleMesh& out, double& a, Diagnostic& e) override {
+    ++whole;
+    return inner_->triangulate(i, d, out, a, e);
+  }
+  bool triangulate_region(std::uint32_t i, double d, const Aabb& r, TriangleMesh& out, double& a, Diagnostic& e) override {
+    ++regions;
+    return inner_->triangulate_region(i, d, r, out, a, e);
+  }
+  double default_deflection() const override { return inner_->default_deflection(); }
+  std::optional<double> point_distance(std::uint32_t i, const Vec3& p) const override { return inner_->point_distance(i, p); }
+  std::optional<SurfacePoint> surface_point(std::uint32_t i, const Vec3& p) const override { return inner_->surface_point(i, p); }
+  std::optional<std::array<double, 2>> height_range(std::uint32_t i, const Vec3& o, const Vec3& n) const override {
+    return inner_->height_range(i, o, n);
+  }
+  std::optional<BezierPatches> bezier_patches(std::uint32_t i) const override { return inner_->bezier_patches(i); }
+  std::optional<SurfacePoint> edge_support(std::uint32_t i, const Vec3& d, const Vec3& near) const override {
+    return inner_->edge_support(i, d, near);
+  }
+  std::optional<double> boundary_distance(std::uint32_t i, const Vec3& p) const override {
+    return inner_->boundary_distance(i, p);
+  }
+  std::optional<double> edge_distance(std::uint32_t a, const Pose& pa, const SurfaceSource& other, std::uint32_t b,
+                                      const Pose& pb, const Vec3& na, const Vec3& nb) const override {
+    return inner_->edge_distance(a, pa, unwrap(other), b, pb, na, nb);
+  }
+  std::optional<double> exact_distance(std::uint32_t a, const Pose& pa, const SurfaceSource& other, std::uint32_t b,
+                                       const Pose& pb, double max_distance, double enough) const override {
+    return inner_->exact_distance(a, pa, unwrap(other), b, pb, max_distance, enough);
+  }
+
+ private:
+  static const SurfaceSource& unwrap(const SurfaceSource& s) {
+    const auto* c = dynamic_cast<const CountingSource*>(&s);
+    return c != nullptr ? *c->inner_ : s;
+  }
+  std::shared_ptr<SurfaceSource> inner_;
+};
+
+// A board of 144 drilled holes (its top face thousands of triangles) and a square pin in one of
+// them, a corner 0.003 mm farther from the rim than the deepest chord there: as above, only finer
+// triangles of the board's top face prove the pin apart, and only near the pin are they made
+// (SurfaceSource::triangulate_region; the whole face is never meshed again).
+TEST(RegionalRefinement, APinInABoardOfManyHolesRefinesTheBoardOnlyNearIt) {
+  const double r = 1.0;
+  TopoDS_Compound drills;
+  BRep_Builder builder;
+  builder.MakeCompound(drills);
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      builder.Add(drills, BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(6 + 8 * i, 6 + 8 * j, -1), gp_Dir(0, 0, 1)), r, 4).Shape());
+  const TopoDS_Shape board = BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(100, 100, 2).Shape(), drills).Shape();
+  const Vec3 centre(46, 54, 2);  // hole (5, 6)
+  const Chord chord = deepest_chord(build({board}, 0.1), 2.0, centre, r);
+  ASSERT_GT(chord.sagitta, 0.004);
+  const double corner = r - chord.sagitta - 0.003, half = corner / std::sqrt(2.0);
+  const TopoDS_Shape pin = BRepPrimAPI_MakeBox(gp_Pnt(-half, -half, -2), 2 * half, 2 * half, 6).Shape();
+  Model m = build({board, pin}, 0.1);
+  std::size_t top_triangles = 0;
+  for (std::uint32_t i = 0; i < m.parts[0].surface_count; ++i)
+    if (m.surfaces[i].aabb.min().z() > 1.9) top_triangles = m.surfaces[i].mesh.triangles.size();
+  ASSERT_GT(top_triangles, 2000u) << "the board's top face must be large enough to refine near the pin only";
+  auto counting = std::make_shared<CountingSource>(m.parts[0].source);
+  m.parts[0].source = counting;
+  place(m, 0, "/board", Pose::Identity());
+  const Vec3 dir(std::cos(chord.angle), std::sin(chord.angle), 0.0);
+  place(m, 1, "/pin", moved(Vec3(centre.x(), centre.y(), 0), chord.angle - std::numbers::pi / 4));
+  const Outcome apart = check_pair(m, 1e-4);
+  EXPECT_FALSE(apart.contact);
+  EXPECT_GE(apart.report.counters.decided_refined, 1u);
+  EXPECT_GE(apart.report.counters.refined_surfaces, 1u);
+  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
+  EXPECT_EQ(apart.report.counters.undecided, 0u);
+  EXPECT_GE(counting->regions.load(), 1);
+  EXPECT_EQ(counting->whole.load(), 0);
+  // Pushed past the rim: contact, whatever was refined.
+  Model near = m;
+  near.instances[1].pose = moved(Vec3(centre.x(), centre.y(), 0) + (chord.sagitta + 0.004) * dir,
+                                 chord.angle - std::numbers::pi / 4);
+  EXPECT_TRUE(check_pair(near, 1e-4).contact);
+}
+
+// triangulate_region meshes the part of a face inside a box: a cylinder's side within a box across
+// part of it. The region's triangles lie on the face (their vertices on the cylinder, in the box) and
+// cover every point of the face in the box (points of the exact cylinder there lie within the
+// achieved deflection of them); a box the face misses gives no triangles.
+TEST(RegionalRefinement, TriangulateRegionCoversThePartOfTheFaceInTheBox) {
+  Model m = build({BRepPrimAPI_MakeCylinder(5, 10).Shape()}, 0.1);
+  auto* src = dynamic_cast<BrepSource*>(m.parts[0].source.get());
+  ASSERT_NE(src, nullptr);
+  std::uint32_t side = kInvalidId;
+  for (std::uint32_t i = 0; i < m.parts[0].surface_count; ++i)
+    if (m.surfaces[i].analytic.shape == SurfaceShape::Cylinder) side = i;
+  ASSERT_NE(side, kInvalidId);
+  const Aabb box(Vec3(3, -2, 4), Vec3(6, 2, 6));
+  TriangleMesh part;
+  double achieved = 0.0;
+  Diagnostic error;
+  ASSERT_TRUE(src->triangulate_region(side, 0.01, box, part, achieved, error)) << error.message;
+  ASSERT_FALSE(part.triangles.empty());
+  EXPECT_LE(achieved, 0.01 + 1e-12);
+  for (const Vec3& v : part.vertices) {
+    EXPECT_NEAR(std::hypot(v.x(), v.y()), 5.0, 1e-6);
+    EXPECT_TRUE(pad_box(box, 1e-6).contains(v));
+  }
+  // Points of the exact face in the box: within the achieved deflection of the region's triangles.
+  const detail::SurfaceBvh tree = detail::build_surface_bvh(part);
+  int inside = 0;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 10; ++j) {
+      const double a = -0.5 + i * 0.025, z = 4.0 + 0.2 * j;
+      const Vec3 x(5.0 * std::cos(a), 5.0 * std::sin(a), z);
+      if (!box.contains(x)) continue;
+      ++inside;
+      EXPECT_TRUE(detail::point_near_mesh(tree, part, x, achieved + 1e-9)) << a << ' ' << z;
+    }
+  EXPECT_GT(inside, 100);
+  TriangleMesh none;
+  ASSERT_TRUE(src->triangulate_region(side, 0.01, Aabb(Vec3(20, 20, 20), Vec3(21, 21, 21)), none, achieved, error));
+  EXPECT_TRUE(none.triangles.empty());
 }
 
 }  // namespace

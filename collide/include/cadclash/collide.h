@@ -179,7 +179,7 @@ struct CollideCounters {
   std::uint64_t decided_mesh = 0, decided_mesh_exact = 0, decided_analytic = 0, decided_refined = 0,
                 decided_exact = 0, undecided = 0;
   std::uint64_t ambiguous_pairs = 0;    // pairs the triangles' interval could not decide
-  std::uint64_t refined_surfaces = 0;   // faces re-tessellated for refinement by this query
+  std::uint64_t refined_surfaces = 0;   // faces re-tessellated finer (whole, or near a pair) by this query
   std::uint64_t exact_queries = 0;      // SurfaceSource::exact_distance calls
   std::uint64_t witness_queries = 0;    // SurfaceSource surface_point, boundary_distance, point_distance,
                                         // edge_distance and edge_support calls (witnesses, crossings)

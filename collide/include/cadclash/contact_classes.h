@@ -82,7 +82,13 @@ namespace cadclash {
 //             the finer band), the faces re-tessellated at a tenth of their deflection by their
 //             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
 //             cylinder or sphere of either face against the other's finer triangles; a face of those
-//             shapes is not refined when the other face is not one (its surface bounds the gap);
+//             shapes is not refined when the other face is not one (its surface bounds the gap). A
+//             large face (2,000 triangles and more) of which the pair's reach is a small part (a
+//             quarter of its box's diagonal at most) is re-tessellated only there
+//             (SurfaceSource::triangulate_region: a board's top face near one pin), by the pair's
+//             thread, once per region (regions snap to a grid of power-of-two cells, so neighbouring
+//             pairs share them); its points outside lie farther than 2 (T + the band) from the
+//             other face, which caps the interval's bottom;
 //   exact     SurfaceSource::exact_distance (OCCT BRepExtrema on the placed faces; the search stops at
 //             the first two points within T), interval [d*, d*].
 //   depth     (after any of the above proved contact) a planar face and a planar, cylindrical or

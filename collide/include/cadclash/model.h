@@ -215,6 +215,20 @@ class SurfaceSource {
   virtual bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                            double& achieved_deflection, Diagnostic& error) = 0;
 
+  // Triangulates only the part of surface `local_index` inside `region` (an axis-aligned box in the
+  // part's local frame) with a deflection no larger than `deflection` > 0: every point of the surface
+  // inside the region lies within the achieved deflection of the triangles written, and every point of
+  // them within it of the surface (they may reach past the region; none when the surface misses it).
+  // For a refinement that only the neighbourhood of another face needs (a board's top face near one
+  // pin). Returns false, with `error`, when the source cannot mesh a region: then the caller meshes the
+  // whole surface. Thread-safe for concurrent calls on any parts; the default cannot.
+  virtual bool triangulate_region(std::uint32_t local_index, double deflection, const Aabb& region, TriangleMesh& out,
+                                  double& achieved_deflection, Diagnostic& error) {
+    (void)local_index, (void)deflection, (void)region, (void)out, (void)achieved_deflection;
+    error = Diagnostic{Severity::Error, "", 0, -1, "this source cannot mesh part of a surface"};
+    return false;
+  }
+
   // The deflection the part was loaded with (absolute, mm): what triangulate() meshes at when given
   // deflection <= 0, so what a query assumes for a lazy surface not tessellated yet. 0 when unknown.
   virtual double default_deflection() const { return 0.0; }

@@ -152,6 +152,12 @@ class BrepSource final : public SurfaceSource {
   bool triangulate(std::uint32_t local_index, double deflection, TriangleMesh& out,
                    double& achieved_deflection, Diagnostic& error) override;
 
+  // The face's common part with the region's box (BRepAlgoAPI_Common on a copy, the arguments left
+  // as they were), each face of it meshed by BRepMesh at `deflection` as triangulate() meshes a
+  // refinement; concurrent calls run side by side (they read the part's faces only).
+  bool triangulate_region(std::uint32_t local_index, double deflection, const Aabb& region, TriangleMesh& out,
+                          double& achieved_deflection, Diagnostic& error) override;
+
   // An upper bound on the distance from `point` (part-local) to the face, realised by a point of the
   // face: the foot point of a Newton projection started at the nearest node of the face's triangles,
   // when the face classifier puts it inside the face (microseconds); else BRepExtrema_DistShapeShape
