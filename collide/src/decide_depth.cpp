@@ -227,7 +227,7 @@ std::vector<Vec3> crossings(const Side& q, const Side& p, const Aabb& region) {
     const Vec3 w[3] = {*q.to_a * mesh.vertices[tri[0]], *q.to_a * mesh.vertices[tri[1]], *q.to_a * mesh.vertices[tri[2]]};
     const Vec3* const v[3] = {&w[0], &w[1], &w[2]};
     double h[3];
-    for (int k = 0; k < 3; ++k) h[k] = p.n.dot(w[k] - p.o);
+    for (int j = 0; j < 3; ++j) h[j] = p.n.dot(w[j] - p.o);
     const auto ends = plane_cut(v, h);
     if (!ends) continue;
     if (const auto part = clip((*ends)[0], (*ends)[1], region)) out.push_back(0.5 * (part->first + part->second));

@@ -95,7 +95,7 @@ struct DecisionRun::Impl {
   std::vector<DecideResult> answers = std::vector<DecideResult>(tasks.size());
   std::vector<StepSeconds> seconds = std::vector<StepSeconds>(tasks.size());
   double meshing = 0.0;  // refine_surfaces' time, summed over its threads (written by one thread at a time)
-  std::vector<SurfaceId> refined_faces;  // faces this run meshed finer, whole or in part (each counted once)
+  std::vector<SurfaceId> refined_faces{};  // faces this run meshed finer, whole or in part (each counted once)
 
   bool meshed(std::size_t k) const { return tasks[k].outcome != nullptr; }
   FaceView view(SurfaceId f) const {
