@@ -40,6 +40,30 @@ std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> r
 // Precondition: k < rows.size().
 Diagnostic steps_not_checked(std::span<const TrajectoryRow> rows, std::size_t k, const std::string& file);
 
+// ---------------------------------------------------------------------------------------------
+// Motion between steps
+// ---------------------------------------------------------------------------------------------
+// Between two consecutive poses a and b of an instance, its motion for s in [0, 1] is the rigid
+// motion with translation (1 - s) t_a + s t_b (linear) and rotation slerp(q_a, q_b, s): along the
+// shorter arc (q and -q are one rotation), at constant angular speed, about an axis fixed relative to
+// a: a screw-like motion. A point p of the part (part-local) is at R(s) p + t(s).
+
+// The pose at fraction s of the motion from a to b (s = 0: a's rotation and translation, s = 1:
+// b's, each up to its quaternion's rounding). Preconditions: a and b are rigid (orthonormal linear
+// parts); 0 <= s <= 1.
+Pose interpolate_pose(const Pose& a, const Pose& b, double s);
+
+// The angle (radians, in [0, pi]) the motion from a to b turns through.
+double motion_angle(const Pose& a, const Pose& b);
+
+// An upper bound on how far any point of `box` (part-local) moves while s runs over [s0, s1] of
+// the motion from a to b: (s1 - s0) (|t_b - t_a| + angle * the largest |p| over the box), since a
+// point moves at speed |t_b - t_a| + angle |p| at most. Computed with its rounding: it also covers
+// the rounding of the poses interpolate_pose computes (a few units in the last place of |p| + |t|),
+// so a point of the box placed by interpolate_pose(a, b, s) for s in [s0, s1] lies within it of the
+// same point placed by interpolate_pose(a, b, s0). Preconditions: 0 <= s0 <= s1 <= 1; box not empty.
+double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, double s1);
+
 struct StepResult {
   std::int64_t step = 0;
   Report report;

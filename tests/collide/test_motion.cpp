@@ -1,0 +1,103 @@
+// Motion between the steps of a path (trajectory.h): the interpolated poses and the bound on how far
+// a part's points travel over a stretch of the motion.
+#include "cadclash/trajectory.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace cadclash {
+namespace {
+
+Pose pose(const Vec3& axis, double angle, const Vec3& t) {
+  Pose p = Pose::Identity();
+  p.linear() = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+  p.translation() = t;
+  return p;
+}
+
+double rotation_between(const Pose& a, const Pose& b) {
+  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+}
+
+// s = 0 and s = 1 give the two poses (translations exactly, rotations to a few ulps); in between
+// the rotation turns at constant speed along the shorter arc: 350 degrees about z is -10 degrees.
+TEST(Motion, EndsShorterArcAndConstantSpeed) {
+  const Pose a = pose(Vec3(1, 2, 3), 0.7, Vec3(10, -20, 5e5)), b = pose(Vec3(-2, 1, 0.5), 2.1, Vec3(12, -19, 5e5 + 3));
+  EXPECT_EQ(interpolate_pose(a, b, 0.0).translation(), a.translation());
+  EXPECT_EQ(interpolate_pose(a, b, 1.0).translation(), b.translation());
+  EXPECT_LT((interpolate_pose(a, b, 0.0).linear() - a.linear()).norm(), 1e-14);
+  EXPECT_LT((interpolate_pose(a, b, 1.0).linear() - b.linear()).norm(), 1e-14);
+  const double total = motion_angle(a, b);
+  EXPECT_NEAR(total, rotation_between(a, b), 1e-12);
+  for (double s : {0.1, 0.25, 0.5, 0.9})
+    EXPECT_NEAR(rotation_between(a, interpolate_pose(a, b, s)), s * total, 1e-12) << s;
+  const Pose id = Pose::Identity(), turned = pose(Vec3::UnitZ(), 350.0 * std::numbers::pi / 180.0, Vec3::Zero());
+  EXPECT_NEAR(motion_angle(id, turned), 10.0 * std::numbers::pi / 180.0, 1e-14);
+  const Pose mid = interpolate_pose(id, turned, 0.5);
+  EXPECT_NEAR(std::atan2(mid.linear()(1, 0), mid.linear()(0, 0)), -5.0 * std::numbers::pi / 180.0, 1e-14);
+  // A tiny turn keeps its digits (acos of the quaternion's w would not).
+  const Pose tiny = pose(Vec3(0, 1, 1), 3e-9, Vec3::Zero());
+  EXPECT_NEAR(motion_angle(id, tiny), 3e-9, 1e-22);
+}
+
+// The bound holds for every point of the box over every stretch, with random motions near the
+// origin and a million millimetres out, rotations about far axes included; and it is not loose: a
+// pure translation travels it all, a pure turn its arc.
+TEST(Motion, TravelBoundHoldsAndIsTight) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);
+  int checked = 0;
+  for (double offset : {0.0, 1e3, 1e6})
+    for (int k = 0; k < 200; ++k) {
+      const Vec3 c(offset * u(rng), offset * u(rng), offset * u(rng));
+      const Pose a = pose(Vec3(u(rng), u(rng), u(rng)), 3.0 * u(rng), c + Vec3(u(rng), u(rng), u(rng)));
+      // b: a turn of up to a half turn about an axis up to 50 mm off the part, then a small shift.
+      const Vec3 pivot = c + 50.0 * Vec3(u(rng), u(rng), u(rng));
+      const Eigen::AngleAxisd spin(std::numbers::pi * unit(rng), Vec3(u(rng), u(rng), u(rng)).normalized());
+      Pose b = a;
+      b.linear() = spin.toRotationMatrix() * a.linear();
+      b.translation() = pivot + spin.toRotationMatrix() * (a.translation() - pivot) + Vec3(u(rng), u(rng), u(rng));
+      const Aabb box(Vec3(-5, -3, -1) + Vec3(u(rng), u(rng), u(rng)), Vec3(4, 6, 2) + Vec3(u(rng), u(rng), u(rng)));
+      double s0 = unit(rng), s1 = unit(rng);
+      if (s0 > s1) std::swap(s0, s1);
+      const double bound = travel_bound(a, b, box, s0, s1);
+      const Pose p0 = interpolate_pose(a, b, s0);
+      for (int i = 0; i < 20; ++i) {
+        const double s = s0 + (s1 - s0) * unit(rng);
+        const Pose ps = interpolate_pose(a, b, s);
+        for (int j = 0; j < 9; ++j) {
+          const Vec3 p = j < 8 ? box.corner(static_cast<Aabb::CornerType>(j))
+                               : Vec3(box.min() + (box.max() - box.min()).cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+          EXPECT_LE((ps * p - p0 * p).norm(), bound) << offset << ' ' << k;
+          ++checked;
+        }
+      }
+    }
+  EXPECT_GT(checked, 100000);
+  // Stretches far shorter than a step a million millimetres out: the motion itself moves the points
+  // by less than the computed poses' rounding, which the bound covers too.
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 c = 1e6 * Vec3(u(rng), u(rng), u(rng));
+    const Pose a = pose(Vec3(u(rng), u(rng), u(rng)), 3.0 * u(rng), c);
+    const Pose b = pose(Vec3(u(rng), u(rng), u(rng)), 3.0 * u(rng), c + Vec3(u(rng), u(rng), u(rng)));
+    const Aabb box(Vec3(-100, -100, -100), Vec3(100, 100, 100));
+    const double s0 = unit(rng), s1 = std::min(1.0, s0 + 1e-15 * unit(rng));
+    const double bound = travel_bound(a, b, box, s0, s1);
+    const Vec3 p = box.corner(static_cast<Aabb::CornerType>(k % 8));
+    EXPECT_LE((interpolate_pose(a, b, s1) * p - interpolate_pose(a, b, s0) * p).norm(), bound) << k;
+  }
+  // Tight: a translation by (3, 4, 0) travels 5 over the whole motion; a turn by 90 degrees about z
+  // moves the corner (4, 4, 0) along an arc of length pi/2 * |corner| = the bound.
+  const Aabb box(Vec3(-4, -4, 0), Vec3(4, 4, 0));
+  const Pose id = Pose::Identity();
+  EXPECT_NEAR(travel_bound(id, pose(Vec3::UnitZ(), 0.0, Vec3(3, 4, 0)), box, 0.0, 1.0), 5.0, 1e-12);
+  EXPECT_NEAR(travel_bound(id, pose(Vec3::UnitZ(), std::numbers::pi / 2, Vec3::Zero()), box, 0.25, 0.75),
+              0.5 * std::numbers::pi / 2 * std::sqrt(32.0), 1e-12);
+}
+
+}  // namespace
+}  // namespace cadclash
