@@ -40,11 +40,7 @@
 namespace cadclash {
 namespace {
 
-using testing::build;
-using testing::check_pair;
-using testing::moved;
-using testing::Outcome;
-using testing::place;
+using namespace testing;  // build, place, moved, check_pair, Outcome (witness_scene.h)
 
 // An elliptic prism: its wall is a surface of linear extrusion of an ellipse.
 TopoDS_Shape elliptic_prism() {

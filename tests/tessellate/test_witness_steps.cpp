@@ -33,11 +33,7 @@
 namespace cadclash {
 namespace {
 
-using testing::build;
-using testing::check_pair;
-using testing::moved;
-using testing::Outcome;
-using testing::place;
+using namespace testing;  // build, place, moved, check_pair, Outcome (witness_scene.h)
 
 // surface_point: on a cylinder of radius 3 (axis z), the foot of (5, 0, 4) is (3, 0, 4) with the
 // normal ±x, whatever the face's boundary; boundary_distance is an upper bound on the distance to
