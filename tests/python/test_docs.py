@@ -10,3 +10,15 @@ def test_worked_example(as1_path, monkeypatch):  # as1_path: skips without data/
                               optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
     assert result.attempted > 10
     assert result.failed == 0
+
+
+def test_readme_python_block(as1_path, monkeypatch):
+    """The README's Python lines, run where the sample assembly is: they load it and find its pairs."""
+    import re
+    text = (SOURCE_DIR / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert len(blocks) == 1
+    monkeypatch.chdir(as1_path.parent)
+    scope = {}
+    exec(compile(blocks[0], "README.md", "exec"), scope)
+    assert len(scope["report"].pairs) > 0
