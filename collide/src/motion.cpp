@@ -6,6 +6,10 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
+#include <utility>
+#include <vector>
 
 namespace cadclash {
 namespace {
@@ -60,6 +64,128 @@ double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, do
   const double t = std::max(a.translation().norm(), b.translation().norm());
   const double poses = 2.0 * 64.0 * kUnit * (reach + t);
   return (s1 - s0) * speed * (1.0 + 16.0 * kUnit) + poses;
+}
+
+}  // namespace cadclash
+
+namespace cadclash {
+namespace {
+
+using PairKey = std::pair<InstanceId, InstanceId>;
+
+// The instance pairs a report has in contact (penetrating, touching, containment), and whether it
+// is partial or undecided somewhere (then it proves nothing for its undecided pairs).
+struct Contacts {
+  std::set<PairKey> contact;
+  std::set<PairKey> open;  // in contact or undecided: not cleared
+  bool complete = true;
+};
+
+Contacts contacts_of(const Report& r) {
+  Contacts c;
+  c.complete = r.complete;
+  for (const SurfacePairResult& p : r.pairs) {
+    const PairKey k{p.instance_a, p.instance_b};
+    if (p.contact == ContactClass::Clearance) continue;
+    c.open.insert(k);
+    if (p.contact != ContactClass::Undecided) c.contact.insert(k);
+  }
+  return c;
+}
+
+}  // namespace
+
+MotionResult check_motion(Scene& scene, const Model& model, std::span<const InstanceId> moving,
+                          std::span<const Pose> from, std::span<const Pose> to, const CollideOptions& options,
+                          const MotionOptions& motion) {
+  assert(moving.size() == from.size() && moving.size() == to.size() && motion.resolution > 0.0);
+  // Each moving instance's part box (part-local): its surfaces' boxes.
+  std::vector<Aabb> boxes(moving.size());
+  for (std::size_t i = 0; i < moving.size(); ++i) {
+    const Part& part = model.parts[model.instances[moving[i]].part];
+    for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s)
+      boxes[i].extend(model.surfaces[s].aabb.isEmpty() ? mesh_aabb(model.surfaces[s].mesh) : model.surfaces[s].aabb);
+  }
+  MotionResult out;
+  auto place = [&](double s) {
+    for (std::size_t i = 0; i < moving.size(); ++i) scene.set_pose(moving[i], interpolate_pose(from[i], to[i], s));
+  };
+  auto check = [&](double s, double tolerance) {
+    place(s);
+    CollideOptions o = options;
+    o.tolerance = tolerance;
+    o.clearance = 0.0;
+    ++out.checks;
+    return contacts_of(scene.check(o));
+  };
+  std::map<double, Contacts> at;  // the static check at T, by s
+  auto contacts_at = [&](double s) -> const Contacts& {
+    auto it = at.find(s);
+    if (it == at.end()) it = at.emplace(s, check(s, options.tolerance)).first;
+    return it->second;
+  };
+  std::map<PairKey, std::vector<MotionSpan>> spans;
+  // Depth first, the earlier half first: spans come out in ascending order. Each stretch carries
+  // the pairs it still has to settle (all of them at the start: an empty set means all).
+  struct Stretch {
+    double s0, s1;
+    std::set<PairKey> pairs;
+    bool all;
+  };
+  std::vector<Stretch> stack{{0.0, 1.0, {}, true}};
+  while (!stack.empty()) {
+    Stretch st = std::move(stack.back());
+    stack.pop_back();
+    auto concerns = [&](const PairKey& k) { return st.all || st.pairs.count(k) > 0; };
+    const bool budget = out.checks + 3 <= motion.max_checks;
+    std::set<PairKey> suspect;
+    if (budget) {
+      // A pair moves apart or together by at most its two sides' travel: at most the two largest.
+      double first = 0.0, second = 0.0;
+      for (std::size_t i = 0; i < moving.size(); ++i) {
+        if (boxes[i].isEmpty()) continue;
+        const double t = travel_bound(from[i], to[i], boxes[i], st.s0, st.s1);
+        if (t > first) second = std::exchange(first, t);
+        else second = std::max(second, t);
+      }
+      const Contacts grown = check(st.s0, options.tolerance + first + second);
+      if (grown.complete) {
+        for (const PairKey& k : grown.open)
+          if (concerns(k)) suspect.insert(k);
+      } else {
+        out.complete = false;
+      }
+      if (grown.complete && suspect.empty()) continue;  // free over the whole stretch
+    }
+    if (!budget || out.complete == false) {
+      // No proof: every pair it concerns keeps the stretch (all pairs: those seen in contact or open
+      // anywhere so far, and the search is incomplete).
+      out.complete = false;
+      std::set<PairKey> keep = st.pairs;
+      if (st.all)
+        for (const auto& [s, c] : at) keep.insert(c.open.begin(), c.open.end());
+      for (const PairKey& k : keep) spans[k].push_back({st.s0, st.s1, false});
+      continue;
+    }
+    const Contacts& c0 = contacts_at(st.s0);
+    const Contacts& c1 = contacts_at(st.s1);
+    std::set<PairKey> halve;
+    for (const PairKey& k : suspect) {
+      if (c0.contact.count(k) && c1.contact.count(k)) spans[k].push_back({st.s0, st.s1, true});
+      else if (st.s1 - st.s0 <= motion.resolution) spans[k].push_back({st.s0, st.s1, false});
+      else halve.insert(k);
+    }
+    if (halve.empty()) continue;
+    const double mid = 0.5 * (st.s0 + st.s1);
+    stack.push_back({mid, st.s1, halve, false});
+    stack.push_back({st.s0, mid, std::move(halve), false});
+  }
+  place(1.0);
+  for (auto& [k, v] : spans) {
+    std::sort(v.begin(), v.end(), [](const MotionSpan& x, const MotionSpan& y) { return x.s0 < y.s0; });
+    out.pairs.push_back({k.first, k.second, std::move(v)});
+  }
+  return out;
 }
 
 }  // namespace cadclash

@@ -64,6 +64,47 @@ double motion_angle(const Pose& a, const Pose& b);
 // same point placed by interpolate_pose(a, b, s0). Preconditions: 0 <= s0 <= s1 <= 1; box not empty.
 double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, double s1);
 
+// One stretch of motion checked continuously: the instances `moving` go from poses `from` to `to`
+// (interpolate_pose; the others stay where the scene has them), and every instance pair the scene
+// checks is proved out of contact over the whole stretch or listed with the parts of it where it
+// may be in contact. Contact is a static check's (penetrating, touching or containment, certified
+// on the exact faces within T = tolerance + the faces' uncertainties); no time between two checks
+// is called free unless proved.
+//
+// How: a stretch [s0, s1] is free for a pair when the certified check at s0 with the tolerance grown
+// by the two largest travel_bounds of the moving instances over it proves the pair apart (each side
+// moves at most its own). Pairs it cannot clear are halved, down to `resolution`; a part of the
+// stretch where the pair is proved in contact at both ends is not halved further (in between it is
+// not proved either way). Contact that begins and ends between two steps, a part passing through a
+// thin plate, is found: such a stretch is never cleared.
+struct MotionOptions {
+  double resolution = 1e-3;      // width of the spans a contact may begin or end in, as a fraction of the stretch (> 0)
+  std::size_t max_checks = 4096;  // static checks at most; past it the open spans are listed as they are
+};
+struct MotionSpan {
+  double s0 = 0.0, s1 = 0.0;
+  // Proved in contact at s0 and at s1 (between: not proved either way); otherwise s1 - s0 <=
+  // resolution and a contact may begin, end or hold there (or the search stopped: MotionResult).
+  bool contact_at_ends = false;
+};
+struct PairMotion {
+  InstanceId a = kInvalidId, b = kInvalidId;  // a < b
+  std::vector<MotionSpan> spans;               // ascending, disjoint
+};
+struct MotionResult {
+  std::vector<PairMotion> pairs;  // by (a, b); a pair not listed is out of contact over the whole stretch
+  std::size_t checks = 0;         // static checks run
+  bool complete = true;           // false: max_checks ran out, the spans of the unfinished parts are listed whole
+};
+
+// Checks one stretch continuously (see above) and leaves the moving instances at `to`. Uses the
+// scene's selection and `options` (its tolerance and decision; its budgets apply to each static check,
+// and a partial check clears nothing). Preconditions: moving, from and to have one entry per
+// moving instance; the poses are rigid; resolution > 0.
+MotionResult check_motion(Scene& scene, const Model& model, std::span<const InstanceId> moving,
+                          std::span<const Pose> from, std::span<const Pose> to, const CollideOptions& options,
+                          const MotionOptions& motion = {});
+
 struct StepResult {
   std::int64_t step = 0;
   Report report;
