@@ -42,33 +42,40 @@ void expect_spans(const MotionResult& r, double lo, double hi, double before, do
 // The cube falls through the plate within one step: at both ends it is clear (a discrete check sees
 // nothing); in between it passes through z in [0, 1] for s in [0.4, 0.7] (bottom 5 - 10 s, top 7 - 10 s).
 TEST(ContinuousMotion, APartPassingThroughAThinPlateBetweenTwoStepsIsFound) {
-  PlateAndCube f;
-  Scene scene(f.m);
-  const Pose from = translation(9, 9, 5), to = translation(9, 9, -5);
-  scene.set_pose(f.cube, from);
-  EXPECT_TRUE(scene.check().pairs.empty());
-  scene.set_pose(f.cube, to);
-  EXPECT_TRUE(scene.check().pairs.empty());
-  MotionOptions mo;
-  mo.resolution = 1e-3;
-  const InstanceId moving[] = {f.cube};
-  const Pose a[] = {from}, b[] = {to};
-  const MotionResult r = check_motion(scene, f.m, moving, a, b, {}, mo);
-  EXPECT_TRUE(r.complete);
-  ASSERT_EQ(r.pairs.size(), 1u);
-  expect_spans(r, 0.4, 0.7, 0.4 - 2 * mo.resolution, 0.7 + 2 * mo.resolution);
-  // The spans where the contact begins and ends are at most the resolution wide; the rest of the
-  // contact is proved at the ends of its spans.
-  for (const MotionSpan& s : r.pairs[0].spans)
-    if (!s.contact_at_ends) EXPECT_LE(s.s1 - s.s0, mo.resolution + 1e-15);
-  // The scene is left at the stretch's end.
-  EXPECT_TRUE(scene.pose(f.cube).isApprox(to));
-  // Beside the plate, the same fall touches nothing: no pair, proved on a handful of checks.
-  const Pose beside_a[] = {translation(30, 9, 5)}, beside_b[] = {translation(30, 9, -5)};
-  const MotionResult clear = check_motion(scene, f.m, moving, beside_a, beside_b, {}, mo);
-  EXPECT_TRUE(clear.pairs.empty());
-  EXPECT_TRUE(clear.complete);
-  EXPECT_LT(clear.checks, 64u);
+  // The same wherever the whole scene is placed: as built, and turned and moved 10^6 mm away.
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1e6, -4e5, 3e5));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  for (const Pose& where : {Pose::Identity(), far}) {
+    PlateAndCube f;
+    Scene scene(f.m);
+    scene.set_pose(f.plate, where);
+    const Pose from = where * translation(9, 9, 5), to = where * translation(9, 9, -5);
+    scene.set_pose(f.cube, from);
+    EXPECT_TRUE(scene.check().pairs.empty());
+    scene.set_pose(f.cube, to);
+    EXPECT_TRUE(scene.check().pairs.empty());
+    MotionOptions mo;
+    mo.resolution = 1e-3;
+    const InstanceId moving[] = {f.cube};
+    const Pose a[] = {from}, b[] = {to};
+    const MotionResult r = check_motion(scene, f.m, moving, a, b, {}, mo);
+    EXPECT_TRUE(r.complete);
+    ASSERT_EQ(r.pairs.size(), 1u);
+    expect_spans(r, 0.4, 0.7, 0.4 - 2 * mo.resolution, 0.7 + 2 * mo.resolution);
+    // The spans where the contact begins and ends are at most the resolution wide; the rest of the
+    // contact is proved at the ends of its spans.
+    for (const MotionSpan& s : r.pairs[0].spans)
+      if (!s.contact_at_ends) EXPECT_LE(s.s1 - s.s0, mo.resolution + 1e-15);
+    // The scene is left at the stretch's end.
+    EXPECT_TRUE(scene.pose(f.cube).isApprox(to));
+    // Beside the plate, the same fall touches nothing: no pair, proved on a handful of checks.
+    const Pose beside_a[] = {where * translation(30, 9, 5)}, beside_b[] = {where * translation(30, 9, -5)};
+    const MotionResult clear = check_motion(scene, f.m, moving, beside_a, beside_b, {}, mo);
+    EXPECT_TRUE(clear.pairs.empty());
+    EXPECT_TRUE(clear.complete);
+    EXPECT_LT(clear.checks, 64u);
+  }
 }
 
 // A cube whose part frame's origin lies 60 mm above it turns by 60 degrees about that origin: its
