@@ -5,6 +5,12 @@
 #include "cadclash/geometry.h"
 
 #include <BRepAlgoAPI_Common.hxx>
+#include <BRepBndLib.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <Bnd_Box.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <TopoDS_Wire.hxx>
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
@@ -22,6 +28,7 @@
 #include <cassert>
 #include <mutex>
 #include <shared_mutex>
+#include <vector>
 
 namespace cadclash {
 namespace {
@@ -90,6 +97,38 @@ bool BrepSource::triangulate(std::uint32_t local_index, double deflection, Trian
   return ok;
 }
 
+namespace {
+
+// The face without the holes (inner wires) whose boxes miss `region`: its common part with the
+// region's box is the same, and the Boolean then meets only the wires near it (a board's top face
+// has hundreds of holes). The outer wire always stays.
+TopoDS_Face without_far_holes(const TopoDS_Face& face, const Aabb& region) {
+  const TopoDS_Wire outer = BRepTools::OuterWire(face);
+  Bnd_Box near;
+  near.Update(region.min().x(), region.min().y(), region.min().z(), region.max().x(), region.max().y(), region.max().z());
+  std::vector<TopoDS_Shape> keep;
+  bool dropped = false;
+  for (TopoDS_Iterator it(face, Standard_False, Standard_False); it.More(); it.Next()) {
+    if (it.Value().ShapeType() != TopAbs_WIRE) continue;
+    if (!it.Value().IsSame(outer)) {
+      Bnd_Box b;
+      BRepBndLib::Add(it.Value(), b);  // with the edges' tolerances: never smaller than the wire
+      if (b.IsOut(near)) {
+        dropped = true;
+        continue;
+      }
+    }
+    keep.push_back(it.Value());
+  }
+  if (!dropped) return face;
+  TopoDS_Face out = TopoDS::Face(face.EmptyCopied());
+  BRep_Builder builder;
+  for (const TopoDS_Shape& w : keep) builder.Add(out, w);
+  return out;
+}
+
+}  // namespace
+
 bool BrepSource::triangulate_region(std::uint32_t local_index, double deflection, const Aabb& region,
                                     TriangleMesh& out, double& achieved_deflection, Diagnostic& error) {
   assert(local_index < impl_->faces.size() && deflection > 0.0 && !region.isEmpty());
@@ -104,7 +143,8 @@ bool BrepSource::triangulate_region(std::uint32_t local_index, double deflection
     // not to touch its arguments; BRepMesh writes into the copy's pieces only.
     std::shared_lock<std::shared_mutex> lock(impl_->mutex);
     try {
-      const TopoDS_Shape face = BRepBuilderAPI_Copy(impl_->faces[local_index], Standard_False, Standard_False).Shape();
+      const TopoDS_Shape face = without_far_holes(
+          TopoDS::Face(BRepBuilderAPI_Copy(impl_->faces[local_index], Standard_False, Standard_False).Shape()), region);
       const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(region.min().x(), region.min().y(), region.min().z()),
                                                    gp_Pnt(region.max().x(), region.max().y(), region.max().z()))
                                    .Shape();
