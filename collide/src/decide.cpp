@@ -152,6 +152,46 @@ std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh
   return gap;
 }
 
+std::optional<double> hole_gap(const AnalyticSurface& plane, std::span<const SurfaceSource::CircularHole> holes,
+                               const TriangleMesh& mesh, const Pose& to_f, const Aabb& region, double reach) {
+  if (plane.shape != SurfaceShape::Plane || holes.empty() || mesh.triangles.empty()) return std::nullopt;
+  const Vec3 n = plane.axis.normalized();
+  // The holes whose cylinder (grown by reach) meets the mesh's box: a pin's triangles are inside one.
+  Aabb box;
+  for (const Vec3& v : mesh.vertices) box.extend(to_f * v);
+  std::vector<const SurfaceSource::CircularHole*> near;
+  for (const auto& h : holes) {
+    const Vec3 w = box.center() - h.centre;
+    if ((w - n.dot(w) * n).norm() <= h.radius + 0.5 * box.diagonal().norm() + reach) near.push_back(&h);
+  }
+  if (near.empty()) return std::nullopt;
+  double gap = reach;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 v[3] = {to_f * mesh.vertices[t[0]], to_f * mesh.vertices[t[1]], to_f * mesh.vertices[t[2]]};
+    Aabb tri;
+    for (const Vec3& p : v) tri.extend(p);
+    if (box_distance(tri, region) > reach) continue;  // every point of it is farther than reach
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Vec3& p : v) {
+      const double h = n.dot(p - plane.origin);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+    double g = lo > 0.0 ? lo : hi < 0.0 ? -hi : 0.0;  // off the plane
+    for (const auto* h : near) {  // inside a hole: the face is at least its radius from the axis
+      double rmax = 0.0;
+      for (const Vec3& p : v) {
+        const Vec3 w = p - h->centre;
+        rmax = std::max(rmax, (w - n.dot(w) * n).norm());
+      }
+      g = std::max(g, h->radius - rmax);
+    }
+    gap = std::min(gap, g);
+    if (gap <= 0.0) break;
+  }
+  return gap;
+}
+
 namespace {
 
 // Bounds of the distance to a cylinder's axis (or a sphere's centre) over the points of another

@@ -77,6 +77,16 @@ bool certainly_penetrating(const PairOutcome& o, double threshold, double band);
 std::optional<double> analytic_gap(const AnalyticSurface& an, const TriangleMesh& mesh, const Pose& to_f,
                                    const Aabb& region, double reach);
 
+// Lower bound on the distance between a planar face with round holes (`plane`, its `holes`
+// (SurfaceSource::circular_holes), both in frame F: every point of the face lies on the plane and at
+// least a hole's radius from its axis) and the triangles of `mesh` mapped into F by `to_f`, over the
+// triangles whose boxes come within `reach` of `region` (a box in F); `reach` when none does, nullopt
+// when no hole's cylinder meets the mesh's box. A triangle is at least as far as its height off the
+// plane, and as far inside a hole as its farthest vertex from that hole's axis (the distance to the
+// axis is convex): pins through a board's drilled holes. Subtract as for analytic_gap.
+std::optional<double> hole_gap(const AnalyticSurface& plane, std::span<const SurfaceSource::CircularHole> holes,
+                               const TriangleMesh& mesh, const Pose& to_f, const Aabb& region, double reach);
+
 // Lower bound on the distance between the points of surfaces `a` and `b` (both in one frame) that lie
 // in `region` (a box enclosing every place where the faces can come within the threshold), from
 // their parameters alone: plane, cylinder and sphere against each other. Tilts are not assumed away:

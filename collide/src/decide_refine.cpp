@@ -16,6 +16,10 @@ bool bounds_by_shape(const Surface& s) {
 }
 
 std::vector<SurfaceId> faces_to_refine(const Model& m, const DecideTask& t) {
+  // A board's face at a hole the other face reaches through bounds the gap by the other's triangles
+  // alone (hole_bound): finer triangles of the board cannot help there.
+  const bool ha = at_hole(m, t, true), hb = at_hole(m, t, false);
+  if (ha != hb) return {ha ? t.sb : t.sa};
   const bool a = bounds_by_shape(m.surfaces[t.sa]), b = bounds_by_shape(m.surfaces[t.sb]);
   if (a && !b) return {t.sb};
   if (b && !a) return {t.sa};
@@ -44,7 +48,7 @@ namespace {
 
 // The interval of two faces' triangles (finer ones), tightened by the plane, cylinder or sphere of
 // either side: a part standing off a flat face by more than the other face's band is proved apart.
-Interval finer_interval(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+Interval finer_interval(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
                         const CollideOptions& o, CollideCounters& c, PairOutcome& out, double& band,
                         double outside = std::numeric_limits<double>::infinity()) {
   band = fa.surface.deflection + fb.surface.deflection + t.roundoff;
@@ -52,7 +56,8 @@ Interval finer_interval(std::span<const double> slack, const DecideTask& t, Face
   out = pair_outcome(fa.surface, fa.bvh, fb.surface, fb.bvh, t.t_ab(), t.t_ba(), reach, o.clearance, c);
   Interval d = mesh_interval(out, band, reach);
   if (!out.intersecting)
-    d.lo = std::max(d.lo, analytic_bound(fa.surface, fb.surface, slack[t.sa], slack[t.sb], t, p.threshold));
+    d.lo = std::max({d.lo, analytic_bound(fa.surface, fb.surface, slack[t.sa], slack[t.sb], t, p.threshold),
+                     hole_bound(m, t, fa.surface, fb.surface, slack, p.threshold)});
   // The triangles of a region stand for the faces' points there; the points outside are farther.
   d.lo = std::min(d.lo, outside);
   d = {std::max(p.d.lo, d.lo), std::min(p.d.hi, d.hi)};
@@ -63,11 +68,11 @@ Interval finer_interval(std::span<const double> slack, const DecideTask& t, Face
 }  // namespace
 
 // Step 4: the same interval on finer triangles (of the faces faces_to_refine picked).
-void refined_step(std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
+void refined_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView fa, FaceView fb, Pending& p,
                   const CollideOptions& o, CollideCounters& c, double outside) {
   PairOutcome out;
   double band = 0.0;
-  p.d = finer_interval(slack, t, fa, fb, p, o, c, out, band, outside);
+  p.d = finer_interval(m, slack, t, fa, fb, p, o, c, out, band, outside);
   p.band = band;
   settle(p, verdict(p.d, p.threshold), DecidedBy::Refined, &out, o.clearance);
   // A contact proved on finer triangles is penetrating only when they prove it.
@@ -84,7 +89,7 @@ void corroborate(const Model& m, std::span<const double> slack, const DecideTask
                  Pending& p, const CollideOptions& o, CollideCounters& c) {
   // The surfaces' parameters first (exact mode has not asked them yet): a lower bound for free.
   if (t.outcome != nullptr) analytic(m, slack, t, p, o);
-  if (!p.settled && !p.fine) refined_step(slack, t, fa, fb, p, o, c);
+  if (!p.settled && !p.fine) refined_step(m, slack, t, fa, fb, p, o, c);
   // Settled apart here: the exact value is the measured distance, the finer triangles' lower bound
   // its corroboration; it is reported as decided by the exact faces.
   if (p.settled && p.exact) p.by = DecidedBy::Exact;
@@ -110,7 +115,7 @@ void corroborate(const Model& m, std::span<const double> slack, const DecideTask
   const FaceView da = deeper(t.sa, fa, ka), db = deeper(t.sb, fb, kb);
   PairOutcome out;
   double band = 0.0;
-  p.d = finer_interval(slack, t, da, db, p, o, c, out, band);
+  p.d = finer_interval(m, slack, t, da, db, p, o, c, out, band);
   settle(p, verdict(p.d, p.threshold), DecidedBy::Exact, t.outcome, o.clearance);
   if (!p.settled) witness_step(m, slack, t, da, db, &out, band, p, o, c);
 }

@@ -110,10 +110,57 @@ double hull_bound(const Model& m, std::span<const double> slack, const DecideTas
 
 }  // namespace
 
+namespace {
+
+// The holes of face `s` when it is a plane with round holes, else null.
+std::shared_ptr<const std::vector<SurfaceSource::CircularHole>> plane_holes(const Model& m, SurfaceId s) {
+  const Surface& f = m.surfaces[s];
+  if (f.analytic.shape != SurfaceShape::Plane) return nullptr;
+  const Part& part = m.parts[f.part];
+  if (!part.source) return nullptr;
+  auto holes = part.source->circular_holes(s - part.first_surface);
+  return holes && !holes->empty() ? holes : nullptr;
+}
+
+}  // namespace
+
+double hole_bound(const Model& m, const DecideTask& t, const Surface& a, const Surface& b, std::span<const double> slack,
+                  double threshold) {
+  const double r = t.roundoff;
+  double lb = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    const SurfaceId sp = side == 0 ? t.sa : t.sb;
+    const Surface& plane_face = side == 0 ? a : b;
+    const Surface& q = side == 0 ? b : a;
+    if (!q.has_triangles) continue;
+    const auto holes = plane_holes(m, sp);
+    if (!holes) continue;
+    // Searched up to twice what proving "apart" needs, as in analytic_bound.
+    const double reach = 2.0 * (threshold + q.deflection + r + slack[sp]);
+    const Pose& to_plane = side == 0 ? t.t_ab() : t.t_ba();
+    if (auto g = hole_gap(plane_face.analytic, *holes, q.mesh, to_plane, own_box(plane_face), reach))
+      lb = std::max(lb, std::min(*g, reach) - q.deflection - r - slack[sp]);
+  }
+  return lb;
+}
+
+bool at_hole(const Model& m, const DecideTask& t, bool of_a) {
+  const auto holes = plane_holes(m, of_a ? t.sa : t.sb);
+  if (!holes) return false;
+  const Surface& plane_face = m.surfaces[of_a ? t.sa : t.sb];
+  const Aabb other = transform_box(own_box(m.surfaces[of_a ? t.sb : t.sa]), of_a ? t.t_ab() : t.t_ba());
+  const Vec3 n = plane_face.analytic.axis.normalized();
+  return std::any_of(holes->begin(), holes->end(), [&](const SurfaceSource::CircularHole& h) {
+    const Vec3 w = other.center() - h.centre;
+    return (w - n.dot(w) * n).norm() < h.radius + 0.5 * other.diagonal().norm();
+  });
+}
+
 // Step 2: a plane, cylinder or sphere that the other face's triangles provably keep off.
 void analytic(const Model& m, std::span<const double> slack, const DecideTask& t, Pending& p, const CollideOptions& o) {
   double lb = analytic_bound(m.surfaces[t.sa], m.surfaces[t.sb], slack[t.sa], slack[t.sb], t, p.threshold);
   if (!(lb > p.threshold)) lb = std::max(lb, hull_bound(m, slack, t));
+  if (!(lb > p.threshold)) lb = std::max(lb, hole_bound(m, t, m.surfaces[t.sa], m.surfaces[t.sb], slack, p.threshold));
   if (!(lb > p.threshold)) return;
   p.d.lo = std::max(p.d.lo, lb);
   settle(p, Verdict::Apart, DecidedBy::Analytic, t.outcome, o.clearance);

@@ -134,6 +134,16 @@ void edge_support_step(const Model& m, std::span<const double> slack, const Deci
 double analytic_bound(const Surface& a, const Surface& b, double slack_a, double slack_b, const DecideTask& t,
                       double threshold);
 
+// A lower bound on d* from a planar face with round holes (SurfaceSource::circular_holes) against the
+// other face's triangles (hole_gap): a pin through a board's drilled hole is kept off the board's face
+// by its distance from the hole's axis (0 when neither face is such a plane or it does not help). `a`,
+// `b` are task t's faces or finer copies of them.
+double hole_bound(const Model& m, const DecideTask& t, const Surface& a, const Surface& b, std::span<const double> slack,
+                  double threshold);
+// Whether face a (of_a) or b of task t is a planar face with round holes one of which the other
+// face's box, in its frame, reaches into.
+bool at_hole(const Model& m, const DecideTask& t, bool of_a);
+
 // Step 4 and 6 helpers. A plane, cylinder or sphere bounds the distance to the other face's
 // triangles by that face's band alone (analytic_gap), so only the other face is refined then.
 bool bounds_by_shape(const Surface& s);
@@ -153,7 +163,7 @@ Aabb reach_region(const DecideTask& t, const Surface& a, const Surface& b, bool 
 // `outside` is a lower bound on the distance of the face's points outside the region to the other
 // face, and caps the interval's bottom), tightened by either face's plane, cylinder or sphere
 // against the other's triangles.
-void refined_step(std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
+void refined_step(const Model& m, std::span<const double> slack, const DecideTask& t, FaceView a, FaceView b, Pending& p,
                   const CollideOptions& o, CollideCounters& c,
                   double outside = std::numeric_limits<double>::infinity());
 

@@ -302,7 +302,7 @@ void refinement_step(Run& run) {
       return part ? FaceView{part->surface, part->bvh} : run.finer(s);
     };
     timed(run.seconds[k].refine, [&] {
-      refined_step(run.slack, tasks[k], view(tasks[k].sa, r.a), view(tasks[k].sb, r.b), run.pending[k], run.o,
+      refined_step(model, run.slack, tasks[k], view(tasks[k].sa, r.a), view(tasks[k].sb, r.b), run.pending[k], run.o,
                    run.task_counters[k], r.outside);
     });
   });

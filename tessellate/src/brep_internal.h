@@ -59,6 +59,13 @@ struct BrepSource::Impl {
   // Per face, made by point_distance on first use (under locator_mutex); read-only afterwards.
   mutable std::vector<std::unique_ptr<const detail::FaceLocator>> locators;
   mutable std::mutex locator_mutex;
+  // Per face, made by circular_holes on first use (under holes_mutex); read-only afterwards.
+  struct HolesSlot {
+    std::once_flag made;
+    std::shared_ptr<const std::vector<SurfaceSource::CircularHole>> holes;
+  };
+  mutable std::unique_ptr<HolesSlot[]> holes;  // faces.size() slots once asked
+  mutable std::mutex holes_mutex;
   const detail::FaceLocator& locator(std::uint32_t local_index) const;
   // Names this source in the witness queries' per-thread caches (brep_face_cache.h), which let go of
   // its faces once `alive` has expired.
@@ -135,6 +142,11 @@ std::optional<double> face_boundary_witness(const FaceLocator& where, const Aabb
 // surface lies in their convex hull when the weights are positive), rounding included; nullopt for
 // other surfaces. Reads the face only. May throw Standard_Failure.
 std::optional<std::array<double, 2>> face_height_range(const TopoDS_Face& face, const Vec3& o, const Vec3& n);
+
+// The round holes of a planar face (SurfaceSource::circular_holes; brep_face_holes.cpp): inner wires
+// running once around one circle whose centre the face's classifier (`where`) puts outside the face, radius
+// reduced by the tilt and the edges' tolerances. Empty for other faces. May throw Standard_Failure.
+std::vector<SurfaceSource::CircularHole> face_circular_holes(const TopoDS_Face& face, const FaceLocator& where);
 
 // The face's surface as rational Bézier patches (part-local, the face's location applied): B-spline and
 // Bézier surfaces (trimmed ones unwrapped) whole, planes, cylinders, cones, spheres and tori over the

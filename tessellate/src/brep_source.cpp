@@ -241,6 +241,30 @@ std::optional<SurfaceSource::BezierPatches> BrepSource::bezier_patches(std::uint
   }
 }
 
+std::shared_ptr<const std::vector<SurfaceSource::CircularHole>> BrepSource::circular_holes(
+    std::uint32_t local_index) const {
+  const Impl& a = *impl_;
+  assert(local_index < a.faces.size());
+  Impl::HolesSlot* slot = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(a.holes_mutex);
+    if (!a.holes) a.holes = std::make_unique<Impl::HolesSlot[]>(a.faces.size());
+    slot = &a.holes[local_index];
+  }
+  // Once per face; a second thread asking meanwhile waits for it (a board's face has hundreds).
+  std::call_once(slot->made, [&] {
+    auto made = std::make_shared<std::vector<CircularHole>>();
+    std::shared_lock<std::shared_mutex> lock(a.mutex);
+    try {
+      *made = detail::face_circular_holes(a.faces[local_index], a.locator(local_index));
+    } catch (const Standard_Failure&) {
+      made->clear();  // no hole is known: the certificate is not offered
+    }
+    slot->holes = std::move(made);
+  });
+  return slot->holes;
+}
+
 std::optional<SurfaceSource::SurfacePoint> BrepSource::edge_support(std::uint32_t local_index, const Vec3& direction,
                                                                     const Vec3& near) const {
   const Impl& a = *impl_;

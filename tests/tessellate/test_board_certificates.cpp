@@ -141,47 +141,14 @@ Chord deepest_chord(const Model& m, double z, const Vec3& centre, double r) {
   return out;
 }
 
-// A square pin through a round hole drilled in a board, a corner 0.003 mm farther from the rim than
-// the deepest chord of the rim in the board's triangles: the board's top face is a plane whose
-// outline its triangles cut by that chord, and the pin's sides cross the board's plane inside the
-// hole, so neither the plane nor the hulls (the board's patch spans the hole) can tell. Finer
-// triangles of the board's top face can: apart, by refinement, without OCCT's distance. Pushed to
-// the rim, the pin's corner reaches past it: contact.
-TEST(RefinedAnalytic, APinNearTheRimOfItsHoleIsProvedApartByRefiningTheBoard) {
-  const double r = 1.0;
-  const Vec3 centre(10, 10, 2);
-  const TopoDS_Shape board =
-      BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(20, 20, 2).Shape(),
-                      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(10, 10, -1), gp_Dir(0, 0, 1)), r, 4).Shape())
-          .Shape();
-  const Chord chord = deepest_chord(build({board}, 0.1), 2.0, centre, r);
-  ASSERT_GT(chord.sagitta, 0.004);
-  const double corner = r - chord.sagitta - 0.003, half = corner / std::sqrt(2.0);
-  const TopoDS_Shape pin = BRepPrimAPI_MakeBox(gp_Pnt(-half, -half, -2), 2 * half, 2 * half, 6).Shape();
-  Model m = build({board, pin}, 0.1);
-  place(m, 0, "/board", Pose::Identity());
-  // Turned so that a corner (at 45 degrees in the pin's frame) faces the middle of that chord.
-  auto pin_at = [&](double out) {
-    const Vec3 dir(std::cos(chord.angle), std::sin(chord.angle), 0.0);
-    return moved(Vec3(10, 10, 0) + out * dir, chord.angle - std::numbers::pi / 4);
-  };
-  place(m, 1, "/pin", pin_at(0.0));
-  const Outcome apart = check_pair(m, 1e-4);
-  EXPECT_FALSE(apart.contact);
-  EXPECT_GE(apart.report.counters.refined_surfaces, 1u);
-  EXPECT_GE(apart.report.counters.decided_refined, 1u);
-  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
-  EXPECT_EQ(apart.report.counters.undecided, 0u);
-  Model near = m;
-  near.instances[1].pose = pin_at(chord.sagitta + 0.004);
-  EXPECT_TRUE(check_pair(near, 1e-4).contact);
-}
-
-// A source that counts what refinement asks of the one it wraps (whole faces, parts of faces).
+// A source that counts what refinement asks of the one it wraps (whole faces, parts of faces). It
+// tells the decision of the face's round holes only when `holes` is set: without them, a pin near
+// the rim of its hole is for refinement to decide.
 class CountingSource final : public SurfaceSource {
  public:
   explicit CountingSource(std::shared_ptr<SurfaceSource> inner) : inner_(std::move(inner)) {}
   std::atomic<int> whole{0}, regions{0};
+  bool holes = false;
 
   bool triangulate(std::uint32_t i, double d, TriangleMesh& out, double& a, Diagnostic& e) override {
     ++whole;
@@ -198,6 +165,9 @@ class CountingSource final : public SurfaceSource {
     return inner_->height_range(i, o, n);
   }
   std::optional<BezierPatches> bezier_patches(std::uint32_t i) const override { return inner_->bezier_patches(i); }
+  std::shared_ptr<const std::vector<CircularHole>> circular_holes(std::uint32_t i) const override {
+    return holes ? inner_->circular_holes(i) : nullptr;
+  }
   std::optional<SurfacePoint> edge_support(std::uint32_t i, const Vec3& d, const Vec3& near) const override {
     return inner_->edge_support(i, d, near);
   }
@@ -221,9 +191,47 @@ class CountingSource final : public SurfaceSource {
   std::shared_ptr<SurfaceSource> inner_;
 };
 
+// A square pin through a round hole drilled in a board, a corner 0.003 mm farther from the rim than
+// the deepest chord of the rim in the board's triangles: the board's top face is a plane whose
+// outline its triangles cut by that chord, and the pin's sides cross the board's plane inside the
+// hole, so neither the plane nor the hulls (the board's patch spans the hole) can tell. Finer
+// triangles of the board's top face can: apart, by refinement, without OCCT's distance (the
+// board's source tells nothing of its holes here: HoleBound below decides this pin without
+// refinement). Pushed to the rim, the pin's corner reaches past it: contact.
+TEST(RefinedAnalytic, APinNearTheRimOfItsHoleIsProvedApartByRefiningTheBoard) {
+  const double r = 1.0;
+  const Vec3 centre(10, 10, 2);
+  const TopoDS_Shape board =
+      BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(20, 20, 2).Shape(),
+                      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(10, 10, -1), gp_Dir(0, 0, 1)), r, 4).Shape())
+          .Shape();
+  const Chord chord = deepest_chord(build({board}, 0.1), 2.0, centre, r);
+  ASSERT_GT(chord.sagitta, 0.004);
+  const double corner = r - chord.sagitta - 0.003, half = corner / std::sqrt(2.0);
+  const TopoDS_Shape pin = BRepPrimAPI_MakeBox(gp_Pnt(-half, -half, -2), 2 * half, 2 * half, 6).Shape();
+  Model m = build({board, pin}, 0.1);
+  m.parts[0].source = std::make_shared<CountingSource>(m.parts[0].source);
+  place(m, 0, "/board", Pose::Identity());
+  // Turned so that a corner (at 45 degrees in the pin's frame) faces the middle of that chord.
+  auto pin_at = [&](double out) {
+    const Vec3 dir(std::cos(chord.angle), std::sin(chord.angle), 0.0);
+    return moved(Vec3(10, 10, 0) + out * dir, chord.angle - std::numbers::pi / 4);
+  };
+  place(m, 1, "/pin", pin_at(0.0));
+  const Outcome apart = check_pair(m, 1e-4);
+  EXPECT_FALSE(apart.contact);
+  EXPECT_GE(apart.report.counters.refined_surfaces, 1u);
+  EXPECT_GE(apart.report.counters.decided_refined, 1u);
+  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
+  EXPECT_EQ(apart.report.counters.undecided, 0u);
+  Model near = m;
+  near.instances[1].pose = pin_at(chord.sagitta + 0.004);
+  EXPECT_TRUE(check_pair(near, 1e-4).contact);
+}
+
 // A board of 144 drilled holes (its top face thousands of triangles) and a square pin in one of
-// them, a corner 0.003 mm farther from the rim than the deepest chord there: as above, only finer
-// triangles of the board's top face prove the pin apart, and only near the pin are they made
+// them, a corner 0.003 mm farther from the rim than the deepest chord there: as above (the holes
+// not told), only finer triangles of the board's top face prove the pin apart, and only near the pin are they made
 // (SurfaceSource::triangulate_region; the whole face is never meshed again).
 TEST(RegionalRefinement, APinInABoardOfManyHolesRefinesTheBoardOnlyNearIt) {
   const double r = 1.0;
@@ -302,6 +310,132 @@ TEST(RegionalRefinement, TriangulateRegionCoversThePartOfTheFaceInTheBox) {
   TriangleMesh none;
   ASSERT_TRUE(src->triangulate_region(side, 0.01, Aabb(Vec3(20, 20, 20), Vec3(21, 21, 21)), none, achieved, error));
   EXPECT_TRUE(none.triangles.empty());
+}
+
+// A board of 12 x 12 holes drilled through a 100 x 100 x 2 plate, each of radius r.
+TopoDS_Shape drilled_board(double r) {
+  TopoDS_Compound drills;
+  BRep_Builder builder;
+  builder.MakeCompound(drills);
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      builder.Add(drills, BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(6 + 8 * i, 6 + 8 * j, -1), gp_Dir(0, 0, 1)), r, 4).Shape());
+  return BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(100, 100, 2).Shape(), drills).Shape();
+}
+
+// The planar face of part 0 whose box lies at height z.
+std::uint32_t plane_at(const Model& m, double z) {
+  for (std::uint32_t i = 0; i < m.parts[0].surface_count; ++i)
+    if (m.surfaces[i].analytic.shape == SurfaceShape::Plane && std::abs(m.surfaces[i].aabb.min().z() - z) < 1e-6 &&
+        std::abs(m.surfaces[i].aabb.max().z() - z) < 1e-6)
+      return i;
+  return kInvalidId;
+}
+
+// circular_holes lists a drilled plate's holes on its top face (centres on the plane at the drills'
+// axes, radii the drill's less at most a micrometre), and none for faces whose circles are not holes
+// or not circles: a disk (its circle the outer wire), a plate with a square hole, a plate drilled
+// at a slant (its rim an ellipse).
+TEST(HoleBound, CircularHolesListsTheDrilledHolesOfAPlate) {
+  const Model m = build({drilled_board(1.0)}, 0.1);
+  const std::uint32_t top = plane_at(m, 2.0);
+  ASSERT_NE(top, kInvalidId);
+  const auto holes = m.parts[0].source->circular_holes(top);
+  ASSERT_NE(holes, nullptr);
+  ASSERT_EQ(holes->size(), 144u);
+  std::vector<std::pair<long, long>> at;
+  for (const auto& h : *holes) {
+    EXPECT_NEAR(h.centre.z(), 2.0, 1e-9);
+    EXPECT_LE(h.radius, 1.0);
+    EXPECT_GT(h.radius, 1.0 - 1e-6);
+    at.emplace_back(std::lround(h.centre.x()), std::lround(h.centre.y()));
+    EXPECT_NEAR(h.centre.x(), static_cast<double>(at.back().first), 1e-9);
+    EXPECT_NEAR(h.centre.y(), static_cast<double>(at.back().second), 1e-9);
+  }
+  std::sort(at.begin(), at.end());
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) EXPECT_EQ(at[static_cast<std::size_t>(12 * i + j)], std::make_pair(6L + 8 * i, 6L + 8 * j));
+
+  const auto none = [](const TopoDS_Shape& shape, double z) {
+    const Model part = build({shape}, 0.1);
+    const std::uint32_t face = plane_at(part, z);
+    EXPECT_NE(face, kInvalidId);
+    if (face == kInvalidId) return false;
+    const auto h = part.parts[0].source->circular_holes(face);
+    return h != nullptr && h->empty();
+  };
+  EXPECT_TRUE(none(BRepPrimAPI_MakeCylinder(5, 10).Shape(), 10.0));
+  EXPECT_TRUE(none(BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(20, 20, 2).Shape(),
+                                   BRepPrimAPI_MakeBox(gp_Pnt(8, 8, -1), 4, 4, 4).Shape())
+                       .Shape(),
+                   2.0));
+  EXPECT_TRUE(none(BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(20, 20, 2).Shape(),
+                                   BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(10, 10, -1), gp_Dir(0.3, 0, 1)), 1, 6).Shape())
+                       .Shape(),
+                   2.0));
+}
+
+// A pin in one of a board's 144 holes, its farthest reach from the hole's axis `reach` (< r):
+// part 1 placed at the hole (46, 54), shifted from the axis by `shift` along x.
+struct PinInHole {
+  Model m;
+  std::shared_ptr<CountingSource> board;
+};
+PinInHole pin_in_hole(const TopoDS_Shape& pin, double shift) {
+  PinInHole out{build({drilled_board(1.0), pin}, 0.1), nullptr};
+  out.board = std::make_shared<CountingSource>(out.m.parts[0].source);
+  out.board->holes = true;
+  out.m.parts[0].source = out.board;
+  place(out.m, 0, "/board", Pose::Identity());
+  place(out.m, 1, "/pin", moved(Vec3(46 + shift, 54, 0)));
+  return out;
+}
+
+// A square pin off the axis of its hole, its far corners 0.1 mm from the rim, the near ones deep
+// inside: the board's round hole keeps its sides off the top and bottom faces by their farthest
+// vertex from the axis, so at tolerance 0.095 it is apart by the surfaces' parameters alone
+// (decided analytic): nothing meshed again, no OCCT distance. At 0.1005, contact (the exact gap is
+// 0.1; the triangles cannot show it, a witness on the exact faces does, once the bound has not
+// claimed the pair apart).
+TEST(HoleBound, ASquarePinNearTheRimIsApartByTheHolesAxisWithoutRefinement) {
+  const double half = 0.3;
+  const double shift = 0.9 - half * std::sqrt(2.0);  // the far corners at 0.9 from the axis
+  const TopoDS_Shape pin = BRepPrimAPI_MakeBox(gp_Pnt(-half, -half, -2), 2 * half, 2 * half, 6).Shape();
+  // Turned so that a corner points along +x.
+  PinInHole s = pin_in_hole(pin, 0.0);
+  s.m.instances[1].pose = moved(Vec3(46 + shift, 54, 0), std::numbers::pi / 4);
+  const Outcome apart = check_pair(s.m, 0.095);
+  EXPECT_FALSE(apart.contact);
+  EXPECT_GE(apart.report.counters.decided_analytic, 1u);
+  EXPECT_EQ(apart.report.counters.refined_surfaces, 0u);
+  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
+  EXPECT_EQ(apart.report.counters.undecided, 0u);
+  EXPECT_EQ(s.board->regions.load() + s.board->whole.load(), 0);
+  // The pin's far corner edge touches the hole's wall and both the board's faces at their rims.
+  const Outcome near = check_pair(s.m, 0.1005);
+  const std::uint32_t top = plane_at(s.m, 2.0), bottom = plane_at(s.m, 0.0);
+  int faces = 0;
+  for (const SurfacePairResult& p : near.report.pairs)
+    faces += (p.surface_a == top || p.surface_a == bottom) && p.contact == ContactClass::Touching;
+  EXPECT_EQ(faces, 2 * 2) << "the two sides meeting at the far corner touch both faces at the rim";
+}
+
+// A round pin 0.1 mm from the rim, its triangles up to 0.0036 mm inside its cylinder: too coarse
+// for the hole's bound at tolerance 0.098, so the pin alone is meshed finer (never the board's
+// face: at a hole, finer board triangles cannot help), and the finer pin is proved apart. At
+// 0.102, contact.
+TEST(HoleBound, ARoundPinNearTheRimRefinesThePinOnly) {
+  PinInHole s = pin_in_hole(BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, -2), gp_Dir(0, 0, 1)), 0.5, 6).Shape(), 0.4);
+  for (std::uint32_t i = s.m.parts[1].first_surface; i < s.m.surfaces.size(); ++i)
+    ASSERT_GT(s.m.surfaces[i].deflection, 0.0025) << "the pin's triangles must be too coarse for the bound";
+  const Outcome apart = check_pair(s.m, 0.098);
+  EXPECT_FALSE(apart.contact);
+  EXPECT_GE(apart.report.counters.decided_refined, 1u);
+  EXPECT_EQ(apart.report.counters.refined_surfaces, 1u);
+  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
+  EXPECT_EQ(apart.report.counters.undecided, 0u);
+  EXPECT_EQ(s.board->regions.load() + s.board->whole.load(), 0);
+  EXPECT_TRUE(check_pair(s.m, 0.102).contact);
 }
 
 }  // namespace

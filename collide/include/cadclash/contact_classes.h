@@ -45,7 +45,10 @@ namespace cadclash {
 // both faces are planar and their planes prove it (depth: below).
 // Ambiguous pairs are refined, cheapest first, until decided:
 //   analytic  the other face's triangles lie provably off a plane, cylinder or sphere (Surface::analytic)
-//             by more than T + its deflection: a lower bound on d* (proves "apart"); or a vertex of
+//             by more than T + its deflection, or reach through a round hole of a planar face
+//             (SurfaceSource::circular_holes: a board's drilled holes) no farther from the hole's
+//             axis than its radius less T and that deflection (a pin near its rim): a lower bound on
+//             d* (proves "apart"); or a vertex of
 //             one face whose foot point on the other's plane, cylinder or sphere is provably inside
 //             that face, within T (proves contact);
 //   crossing  triangles crossing deeper than T where one face lies on a plane (a part sunk into or
@@ -82,7 +85,8 @@ namespace cadclash {
 //             the finer band), the faces re-tessellated at a tenth of their deflection by their
 //             SurfaceSource (cached in the Scene) and the interval taken again, with the plane,
 //             cylinder or sphere of either face against the other's finer triangles; a face of those
-//             shapes is not refined when the other face is not one (its surface bounds the gap). A
+//             shapes is not refined when the other face is not one (its surface bounds the gap), nor
+//             a planar face with round holes at a hole the other face reaches into (the hole does). A
 //             large face (2,000 triangles and more) of which the pair's reach is a small part (a
 //             quarter of its box's diagonal at most) is re-tessellated only there
 //             (SurfaceSource::triangulate_region: a board's top face near one pin), by the pair's

@@ -291,6 +291,21 @@ class SurfaceSource {
     return std::nullopt;
   }
 
+  // The round holes of planar face `local_index` (a board's drilled holes): for each, a point `centre`
+  // on the face's plane and a `radius` such that every point of the face lies at least `radius` from
+  // the line through `centre` along the plane's normal (part-local; the edges' tolerances, the
+  // circle's tilt and offset from the plane and all rounding already taken off). A part reaching
+  // through a hole is kept off the face by its distance from that line. Empty when the face is not
+  // planar or has no such hole. Computed once per face and kept; thread-safe like exact_distance.
+  struct CircularHole {
+    Vec3 centre = Vec3::Zero();
+    double radius = 0.0;
+  };
+  virtual std::shared_ptr<const std::vector<CircularHole>> circular_holes(std::uint32_t local_index) const {
+    (void)local_index;
+    return nullptr;
+  }
+
   // The point of face `local_index`'s edges farthest along `direction` (a unit vector, part-local)
   // near `near`: Newton on the edge curve nearest `near` for the extremum of direction·C(t), clamped
   // to the edge's ends; the point, its rounding (normal unused). A point of the face: where a face

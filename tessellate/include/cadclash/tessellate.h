@@ -180,6 +180,10 @@ class BrepSource final : public SurfaceSource {
   // weights and beyond 1024 patches.
   std::optional<BezierPatches> bezier_patches(std::uint32_t local_index) const override;
 
+  // Inner wires of a planar face running once around one circle, its centre outside the face by
+  // OCCT's face classifier (brep_face_holes.cpp); made on first use and kept.
+  std::shared_ptr<const std::vector<CircularHole>> circular_holes(std::uint32_t local_index) const override;
+
   // Newton (first and second derivatives of BRepAdaptor_Curve) on the edge nearest `near`.
   std::optional<SurfacePoint> edge_support(std::uint32_t local_index, const Vec3& direction,
                                            const Vec3& near) const override;
