@@ -4,7 +4,7 @@
 # 0.05 mm above a board drilled for their pins) and the seated / sunk boards of
 # scripts/uncertainty_bench.sh, each checked certified and --fast in one run, 2 threads: what each
 # reports, which certificate decided the pairs the triangles left open, and the query and end-to-end
-# times side by side (the median of BOARDS_BENCH_REPEATS runs each, default 3). The 174 MB board only
+# times side by side (the median of BOARDS_BENCH_REPEATS runs each, default 5). The 174 MB board only
 # with CADCLASH_BENCH_LARGE=1 (its import takes a minute).
 # Writes a Markdown table on stdout.
 #   bash scripts/boards_bench.sh [BUILD_DIR] [OUT_DIR] [UNCERTAINTY_DIR]
@@ -22,8 +22,9 @@ fi
 mkdir -p "$out"
 # name | file | options
 # The pins stand 0.1 mm from their holes' rims (make_board_assembly's clearance): at tolerance 0.095
-# with OCCT's tolerances alone every pin against the board's faces needs finer triangles of the
-# board's top and bottom faces near it (refinement by region).
+# with OCCT's tolerances alone every pin against the board's top and bottom faces is within the
+# triangles' band; the holes' radii decide them (the analytic step; before it, finer triangles of
+# the board near each pin).
 runs=("board-5mb|$corpus/board-5mb.step|" "board-5mb-rims|$corpus/board-5mb.step|--tolerance 0.095 --uncertainty occt"
       "board-40mb|$corpus/board-40mb.step|")
 if [ "${CADCLASH_BENCH_LARGE:-0}" = 1 ] && [ -f "$corpus/board-150mb.step" ]; then
@@ -33,7 +34,7 @@ if [ -f "$band/board-seated.step" ]; then
   runs+=("seated|$band/board-seated.step|" "seated-occt|$band/board-seated.step|--tolerance 0.04 --uncertainty occt")
 fi
 [ -f "$band/board-sunk.step" ] && runs+=("sunk|$band/board-sunk.step|")
-repeats=${BOARDS_BENCH_REPEATS:-3}
+repeats=${BOARDS_BENCH_REPEATS:-5}
 rm -f "$out/runs.txt.new"
 for r in "${runs[@]}"; do
   IFS='|' read -r name file options <<<"$r"
