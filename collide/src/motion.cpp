@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -71,10 +72,13 @@ double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, do
 namespace cadclash {
 namespace {
 
-using PairKey = std::pair<InstanceId, InstanceId>;
+// An instance pair (surfaces kInvalidId: any of its surface pairs, or containment) or one surface
+// pair of it: the search settles both levels at once.
+using PairKey = std::tuple<InstanceId, InstanceId, SurfaceId, SurfaceId>;
 
-// The instance pairs a report has in contact (penetrating, touching, containment), and whether it
-// is partial or undecided somewhere (then it proves nothing for its undecided pairs).
+// The pairs a report has in contact (penetrating, touching, containment), and whether it is partial
+// or undecided somewhere (then it proves nothing for its undecided pairs): each surface pair, and
+// its instance pair.
 struct Contacts {
   std::set<PairKey> contact;
   std::set<PairKey> open;  // in contact or undecided: not cleared
@@ -85,10 +89,12 @@ Contacts contacts_of(const Report& r) {
   Contacts c;
   c.complete = r.complete;
   for (const SurfacePairResult& p : r.pairs) {
-    const PairKey k{p.instance_a, p.instance_b};
     if (p.contact == ContactClass::Clearance) continue;
-    c.open.insert(k);
-    if (p.contact != ContactClass::Undecided) c.contact.insert(k);
+    for (const PairKey& k : {PairKey{p.instance_a, p.instance_b, kInvalidId, kInvalidId},
+                             PairKey{p.instance_a, p.instance_b, p.surface_a, p.surface_b}}) {
+      c.open.insert(k);
+      if (p.contact != ContactClass::Undecided) c.contact.insert(k);
+    }
   }
   return c;
 }
@@ -181,10 +187,16 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     stack.push_back({st.s0, mid, std::move(halve), false});
   }
   place(1.0);
+  std::map<std::pair<InstanceId, InstanceId>, PairMotion> by_pair;
   for (auto& [k, v] : spans) {
     std::sort(v.begin(), v.end(), [](const MotionSpan& x, const MotionSpan& y) { return x.s0 < y.s0; });
-    out.pairs.push_back({k.first, k.second, std::move(v)});
+    const auto [a, b, sa, sb] = k;
+    PairMotion& p = by_pair[{a, b}];
+    p.a = a, p.b = b;
+    if (sa == kInvalidId && sb == kInvalidId) p.spans = std::move(v);
+    else p.surfaces.push_back({sa, sb, std::move(v)});
   }
+  for (auto& [k, p] : by_pair) out.pairs.push_back(std::move(p));
   return out;
 }
 

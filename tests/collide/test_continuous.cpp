@@ -131,7 +131,11 @@ TEST(ContinuousMotion, TwoMovingPartsPassingThroughEachOtherAreFound) {
 }
 
 // A cube resting on the plate and sliding along it stays in contact: the stretch is listed with
-// contact proved at its ends, not halved down to the resolution (a handful of checks).
+// contact proved at its ends, not halved down to the resolution, for the instance pair and for each
+// surface pair in contact (the plate's top against the cube's bottom and its four sides). The
+// surface pairs 2 mm apart (the plate's top and the cube's top) are cleared once a stretch travels
+// less than that: a few levels of halving (tens of checks), where halving to the resolution would
+// take thousands.
 TEST(ContinuousMotion, ContactThatLastsIsNotHalvedAway) {
   PlateAndCube f;
   Scene scene(f.m);
@@ -143,7 +147,118 @@ TEST(ContinuousMotion, ContactThatLastsIsNotHalvedAway) {
   EXPECT_TRUE(r.pairs[0].spans[0].contact_at_ends);
   EXPECT_EQ(r.pairs[0].spans[0].s0, 0.0);
   EXPECT_EQ(r.pairs[0].spans[0].s1, 1.0);
-  EXPECT_LE(r.checks, 4u);
+  ASSERT_EQ(r.pairs[0].surfaces.size(), 5u);
+  for (const SurfaceMotion& sm : r.pairs[0].surfaces) {
+    EXPECT_EQ(sm.a, 5u);  // the plate's top
+    ASSERT_EQ(sm.spans.size(), 1u);
+    EXPECT_TRUE(sm.spans[0].contact_at_ends);
+    EXPECT_EQ(sm.spans[0].s1 - sm.spans[0].s0, 1.0);
+  }
+  EXPECT_LE(r.checks, 48u);
+}
+
+// The spans of surface pair (a, b) of the pair's timeline (empty when it is not listed).
+std::vector<MotionSpan> surface_spans(const PairMotion& p, SurfaceId a, SurfaceId b) {
+  for (const SurfaceMotion& s : p.surfaces)
+    if (s.a == a && s.b == b) return s.spans;
+  return {};
+}
+
+// Whether `spans` cover [lo, hi] and stay within [before, after].
+bool covers(const std::vector<MotionSpan>& spans, double lo, double hi, double before, double after) {
+  double covered = lo;
+  for (const MotionSpan& s : spans) {
+    if (s.s0 < before || s.s1 > after || s.s0 > s.s1) return false;
+    if (s.s0 <= covered) covered = std::max(covered, s.s1);
+  }
+  return !spans.empty() && covered >= hi;
+}
+
+// The cube falling through the plate, surface by surface (plate faces 0-5, cube faces 6-11, each
+// x-, x+, y-, y+, z-, z+): a side of the cube crosses the plate's top face while the cube spans
+// z = 1 (s in [0.4, 0.6]) and its bottom face while it spans z = 0 ([0.5, 0.7]); the cube's bottom
+// face meets the plate's top face only as it arrives (s = 0.4) and the plate's bottom face as it
+// passes z = 0 (s = 0.5). Each surface pair's spans cover its own contact and no more.
+TEST(ContinuousMotion, EachSurfacePairGetsItsOwnSpans) {
+  PlateAndCube f;
+  Scene scene(f.m);
+  MotionOptions mo;
+  mo.resolution = 1e-3;
+  const InstanceId moving[] = {f.cube};
+  const Pose a[] = {translation(9, 9, 5)}, b[] = {translation(9, 9, -5)};
+  const MotionResult r = check_motion(scene, f.m, moving, a, b, {}, mo);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const PairMotion& p = r.pairs[0];
+  const double e = 2 * mo.resolution;
+  EXPECT_TRUE(covers(surface_spans(p, 5, 6), 0.4, 0.6, 0.4 - e, 0.6 + e));   // top x cube's x- side
+  EXPECT_TRUE(covers(surface_spans(p, 5, 9), 0.4, 0.6, 0.4 - e, 0.6 + e));   // top x cube's y+ side
+  EXPECT_TRUE(covers(surface_spans(p, 4, 7), 0.5, 0.7, 0.5 - e, 0.7 + e));   // bottom x cube's x+ side
+  EXPECT_TRUE(covers(surface_spans(p, 5, 10), 0.4, 0.4, 0.4 - e, 0.4 + e));  // top x cube's bottom
+  EXPECT_TRUE(covers(surface_spans(p, 4, 10), 0.5, 0.5, 0.5 - e, 0.5 + e));  // bottom x cube's bottom
+  EXPECT_TRUE(covers(surface_spans(p, 4, 11), 0.7, 0.7, 0.7 - e, 0.7 + e));  // bottom x cube's top
+  EXPECT_TRUE(surface_spans(p, 0, 6).empty());  // the plate's far side x-: never near
+  // Every surface pair's spans lie within the instance pair's.
+  for (const SurfaceMotion& sm : p.surfaces)
+    for (const MotionSpan& s : sm.spans) {
+      bool inside = false;
+      for (const MotionSpan& q : p.spans) inside |= q.s0 <= s.s0 && s.s1 <= q.s1;
+      EXPECT_TRUE(inside) << sm.a << " x " << sm.b << " [" << s.s0 << ", " << s.s1 << "]";
+    }
+}
+
+// A whole path (replay_continuous): the cube goes down through the plate between steps 0 and 10
+// and up through it between 10 and 20; every step is clear, so a discrete replay sees nothing. The
+// timeline, in step numbers, covers [4, 7] and [13, 16] (a resolution of 1/1000 of a stretch: 0.01).
+// A row naming no instance is a warning; a step number that goes back is an error, and the path
+// stops there.
+TEST(ContinuousPath, APathWhoseStepsAreAllClearPassesThroughThePlateTwice) {
+  PlateAndCube f;
+  Scene scene(f.m);
+  std::vector<TrajectoryRow> rows = {{0, "/cube", translation(9, 9, 5), 1},
+                                     {0, "/nothing", translation(0, 0, 0), 2},
+                                     {10, "/cube", translation(9, 9, -5), 3},
+                                     {20, "/cube", translation(9, 9, 5), 4},
+                                     {15, "/cube", translation(9, 9, 5), 5}};
+  std::vector<Diagnostic> ds;
+  const PathResult r = replay_continuous(scene, f.m, rows, {}, {}, ds, "path.csv");
+  ASSERT_EQ(r.steps.size(), 3u);
+  for (const StepResult& s : r.steps) EXPECT_TRUE(s.report.pairs.empty()) << s.step;
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const double e = 2 * 0.01;
+  std::vector<MotionSpan> down, up;
+  for (const MotionSpan& s : r.pairs[0].spans) (s.s1 <= 10 ? down : up).push_back(s);
+  EXPECT_TRUE(covers(down, 4, 7, 4 - e, 7 + e));
+  EXPECT_TRUE(covers(up, 13, 16, 13 - e, 16 + e));
+  EXPECT_FALSE(r.complete);  // stopped at the step that goes back
+  ASSERT_EQ(ds.size(), 2u);
+  EXPECT_EQ(ds[0].severity, Severity::Warning);
+  EXPECT_EQ(ds[0].line, 2);
+  EXPECT_EQ(ds[1].severity, Severity::Error);
+  EXPECT_EQ(ds[1].line, 5);
+}
+
+// A cube resting on the plate slides along it over three steps: one span, proved in contact at both
+// ends, joined across the steps (for the instance pair and each surface pair in contact).
+TEST(ContinuousPath, ContactAcrossStepsIsOneSpan) {
+  PlateAndCube f;
+  Scene scene(f.m);
+  const std::vector<TrajectoryRow> rows = {
+      {0, "/cube", translation(2, 2, 1), 1}, {1, "/cube", translation(7, 2, 1), 2}, {2, "/cube", translation(12, 2, 1), 3}};
+  std::vector<Diagnostic> ds;
+  const PathResult r = replay_continuous(scene, f.m, rows, {}, {}, ds, "slide.csv");
+  EXPECT_TRUE(r.complete);
+  EXPECT_TRUE(ds.empty());
+  ASSERT_EQ(r.pairs.size(), 1u);
+  ASSERT_EQ(r.pairs[0].spans.size(), 1u);
+  EXPECT_TRUE(r.pairs[0].spans[0].contact_at_ends);
+  EXPECT_EQ(r.pairs[0].spans[0].s0, 0.0);
+  EXPECT_EQ(r.pairs[0].spans[0].s1, 2.0);
+  ASSERT_EQ(r.pairs[0].surfaces.size(), 5u);
+  for (const SurfaceMotion& sm : r.pairs[0].surfaces) {
+    ASSERT_EQ(sm.spans.size(), 1u);
+    EXPECT_EQ(sm.spans[0].s0, 0.0);
+    EXPECT_EQ(sm.spans[0].s1, 2.0);
+  }
 }
 
 }  // namespace

@@ -87,9 +87,16 @@ struct MotionSpan {
   // resolution and a contact may begin, end or hold there (or the search stopped: MotionResult).
   bool contact_at_ends = false;
 };
+struct SurfaceMotion {
+  SurfaceId a = kInvalidId, b = kInvalidId;  // a surface of instance a's part, one of b's
+  std::vector<MotionSpan> spans;             // ascending, disjoint
+};
 struct PairMotion {
   InstanceId a = kInvalidId, b = kInvalidId;  // a < b
-  std::vector<MotionSpan> spans;               // ascending, disjoint
+  // The instance pair's: where any of its surface pairs (or containment) may be in contact.
+  std::vector<MotionSpan> spans;              // ascending, disjoint
+  // Each surface pair's own (by (a, b)): where that pair may be in contact, the same guarantees.
+  std::vector<SurfaceMotion> surfaces;
 };
 struct MotionResult {
   std::vector<PairMotion> pairs;  // by (a, b); a pair not listed is out of contact over the whole stretch
@@ -119,5 +126,29 @@ struct StepResult {
 std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const TrajectoryRow> rows,
                                           const CollideOptions& options,
                                           std::vector<Diagnostic>& diagnostics, const std::string& file = {});
+
+// A whole path checked continuously: each step checked as replay_trajectory does, and the motion
+// between consecutive steps by check_motion (the instances a step's rows move, from where the
+// scene had them). Times are the path's: between steps k and k + 1 the motion's fraction s is at
+// time step_k + s (step_{k+1} - step_k); `motion.resolution` is a fraction of that stretch. The
+// first step places the instances (no motion before it).
+struct PathResult {
+  std::vector<StepResult> steps;  // the check at each step, as replay_trajectory
+  // Every instance pair that may be in contact at some time between the first and last step checked,
+  // with its spans and its surface pairs' in path time; consecutive spans proved in contact at both
+  // ends are joined (also across steps). A pair not listed is out of contact over the whole path.
+  std::vector<PairMotion> pairs;
+  std::size_t checks = 0;  // static checks run for the motion (the steps' own not counted)
+  bool complete = true;    // false: a stretch ran out of max_checks, or the time budget stopped the path
+};
+// Budgets as replay_trajectory: options.time_budget_seconds covers the whole path (each stretch and
+// step gets what the earlier ones left); when it runs out, the later steps and the motion to them are
+// not checked and a warning says from which step. Rows naming unknown instances: warnings, skipped.
+// Step numbers must ascend: a step not after the one before is an error naming its line, and the
+// path is checked up to there.
+// Precondition: motion.resolution > 0.
+PathResult replay_continuous(Scene& scene, const Model& model, std::span<const TrajectoryRow> rows,
+                             const CollideOptions& options, const MotionOptions& motion,
+                             std::vector<Diagnostic>& diagnostics, const std::string& file = {});
 
 }  // namespace cadclash

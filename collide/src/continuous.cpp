@@ -1,0 +1,119 @@
+// A whole path checked continuously (trajectory.h, replay_continuous): the steps as a replay checks
+// them, the motion between them by check_motion, and the spans joined into one timeline per pair.
+#include "cadclash/trajectory.h"
+
+#include "cadclash/internal/progress_meter.h"
+
+#include <cassert>
+#include <chrono>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cadclash {
+namespace {
+
+// Appends `s` (path time, after every span already in `into`) to `into`, joining it to the last one
+// when both are proved in contact at their ends and meet.
+void append_span(std::vector<MotionSpan>& into, const MotionSpan& s) {
+  if (!into.empty() && into.back().contact_at_ends && s.contact_at_ends && into.back().s1 == s.s0) {
+    into.back().s1 = s.s1;
+    return;
+  }
+  into.push_back(s);
+}
+
+MotionSpan to_path_time(const MotionSpan& s, double t0, double t1) {
+  // Exact at the ends: s = 0 and s = 1 give t0 and t1.
+  auto at = [&](double f) { return f == 1.0 ? t1 : t0 + f * (t1 - t0); };
+  return {at(s.s0), at(s.s1), s.contact_at_ends};
+}
+
+}  // namespace
+
+PathResult replay_continuous(Scene& scene, const Model& model, std::span<const TrajectoryRow> rows,
+                             const CollideOptions& options, const MotionOptions& motion,
+                             std::vector<Diagnostic>& diagnostics, const std::string& file) {
+  assert(motion.resolution > 0.0);
+  PathResult out;
+  const auto start = std::chrono::steady_clock::now();
+  std::size_t steps = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) steps += k == 0 || rows[k].step != rows[k - 1].step;
+  detail::ProgressMeter meter(&options.progress, ProgressStage::TrajectoryStep, steps,
+                              rows.empty() ? std::string() : std::to_string(rows.front().step));
+  // Per instance pair, its timeline so far, and per surface pair of it.
+  std::map<std::pair<InstanceId, InstanceId>, PairMotion> timeline;
+  std::map<std::pair<InstanceId, InstanceId>, std::map<std::pair<SurfaceId, SurfaceId>, std::vector<MotionSpan>>> surfaces;
+  std::size_t k = 0;
+  while (k < rows.size()) {
+    const std::int64_t step = rows[k].step;
+    CollideOptions step_options = options;
+    step_options.progress = nullptr;  // the path reports its steps, not the checks inside them
+    if (options.time_budget_seconds > 0.0) {
+      const double left = options.time_budget_seconds -
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const bool out_of_time = left <= 0.0 || (!out.steps.empty() && !out.steps.back().report.complete &&
+                                               out.steps.back().report.stopped_by.find("time") != std::string::npos);
+      if (out_of_time) {
+        diagnostics.push_back(steps_not_checked(rows, k, file));
+        out.complete = false;
+        break;
+      }
+      step_options.time_budget_seconds = left;
+    }
+    if (!out.steps.empty() && step <= out.steps.back().step) {
+      diagnostics.push_back({Severity::Error, file, rows[k].line, -1,
+                             "step " + std::to_string(step) + " does not follow step " +
+                                 std::to_string(out.steps.back().step) +
+                                 ": the motion between steps needs ascending step numbers; not checked from here on"});
+      out.complete = false;
+      break;
+    }
+    // The step's rows, the last one for an instance named twice.
+    std::map<InstanceId, Pose> to;
+    std::size_t next = k;
+    for (; next < rows.size() && rows[next].step == step; ++next) {
+      const InstanceId id = scene.find_instance(rows[next].path);
+      if (id == kInvalidId) {
+        diagnostics.push_back({Severity::Warning, file, rows[next].line, -1,
+                               "no instance with path '" + rows[next].path + "'; row skipped"});
+        continue;
+      }
+      to[id] = rows[next].pose;
+    }
+    if (out.steps.empty()) {
+      for (const auto& [id, pose] : to) scene.set_pose(id, pose);
+    } else {
+      std::vector<InstanceId> moving;
+      std::vector<Pose> a, b;
+      for (const auto& [id, pose] : to) {
+        moving.push_back(id);
+        a.push_back(scene.pose(id));
+        b.push_back(pose);
+      }
+      const MotionResult m = check_motion(scene, model, moving, a, b, step_options, motion);
+      out.checks += m.checks;
+      out.complete = out.complete && m.complete;
+      const auto t0 = static_cast<double>(out.steps.back().step), t1 = static_cast<double>(step);
+      for (const PairMotion& p : m.pairs) {
+        PairMotion& into = timeline[{p.a, p.b}];
+        into.a = p.a, into.b = p.b;
+        for (const MotionSpan& s : p.spans) append_span(into.spans, to_path_time(s, t0, t1));
+        for (const SurfaceMotion& sp : p.surfaces)
+          for (const MotionSpan& s : sp.spans) append_span(surfaces[{p.a, p.b}][{sp.a, sp.b}], to_path_time(s, t0, t1));
+      }
+    }
+    k = next;
+    out.steps.push_back({step, scene.check(step_options)});
+    if (meter.active()) meter.add(1, std::to_string(step));
+  }
+  meter.finish();
+  for (auto& [key, p] : timeline) {
+    for (auto& [sk, spans] : surfaces[key]) p.surfaces.push_back({sk.first, sk.second, std::move(spans)});
+    out.pairs.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace cadclash
