@@ -27,6 +27,9 @@ struct CheckOptions {
   double time_budget = 0.0;       // seconds; 0 = none
   double memory_budget_mb = 0.0;  // MiB; 0 = none
   std::string path_csv;
+  bool continuous = false;          // --continuous: the motion between the steps too
+  double time_resolution = 1e-3;    // fraction of the stretch between two steps
+  std::size_t motion_checks = 4096;  // static checks at most per stretch
   bool all_triangles = false;
   std::string json;
   std::string html;

@@ -133,6 +133,7 @@ struct CheckOutcome {
   std::vector<Diagnostic> diagnostics;  // the queries' own
   Report shown;                         // what --html shows: the query, or a trajectory's last step
   bool unreadable = false;              // an input file could not be read again for --volume
+  bool bad_path = false;                // the path has an error (--continuous: steps not ascending)
 };
 
 // How the queries run: in this process, or split over the ranks of an MPI job (cmd_check_mpi.h).
@@ -146,6 +147,10 @@ struct Runner {
   // their exact faces.
   std::function<bool()> before_html;
   std::function<bool(const ClashReview&)> before_volume;
+  // The path checked continuously (--continuous); empty where it cannot run (under mpirun).
+  std::function<PathResult(std::span<const TrajectoryRow>, const CollideOptions&, const MotionOptions&,
+                           std::vector<Diagnostic>&, const std::string&)>
+      path;
 };
 
 // One query of the prepared scene (run --repeat times, the last kept): the table and summary on
@@ -181,13 +186,54 @@ CheckOutcome check_once(const CheckOptions& o, const Model& m, const Runner& run
   return out;
 }
 
-// The trajectory replayed on the prepared scene: one line per step on stdout, each step into `report`.
+// A contact span of the path's timeline as a person reads it.
+std::string span_text(const MotionSpan& s) {
+  std::ostringstream t;
+  t.precision(6);
+  t << '[' << s.s0 << ", " << s.s1 << ']';
+  return s.contact_at_ends ? "in contact at both ends of " + t.str() : "may touch within " + t.str();
+}
+
+// The path's timeline (--continuous) on stdout: each instance pair that may touch between the steps.
+void print_timeline(const CheckOptions& o, const Model& m, const PathResult& p) {
+  std::cout << "\nbetween the steps (continuous, spans " << o.time_resolution << " of a stretch wide where a contact "
+            << "begins or ends; " << p.checks << " checks): ";
+  if (p.pairs.empty()) {
+    std::cout << "no instance pair comes into contact\n";
+  } else {
+    std::cout << p.pairs.size() << " instance pair" << (p.pairs.size() == 1 ? "" : "s") << " may touch\n";
+    for (const PairMotion& pm : p.pairs) {
+      std::cout << "  " << m.instances[pm.a].path << " x " << m.instances[pm.b].path << " (" << pm.surfaces.size()
+                << " surface pair" << (pm.surfaces.size() == 1 ? "" : "s") << "):";
+      for (const MotionSpan& s : pm.spans) std::cout << ' ' << span_text(s) << ';';
+      std::cout << '\n';
+    }
+  }
+  if (!p.complete) std::cout << "PARTIAL TIMELINE: a stretch ran out of its --motion-checks, or the path was cut short; "
+                                "its open spans are listed whole\n";
+}
+
+// The trajectory replayed on the prepared scene: one line per step on stdout, each step into `report`;
+// with --continuous the motion between the steps too.
 CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runner& run,
                               const std::vector<TrajectoryRow>& rows, const CollideOptions& copt, CheckReport& report) {
   CheckOutcome out;
   std::vector<Diagnostic> ds;
-  std::vector<StepResult> steps = run.replay(rows, copt, ds, o.path_csv);
+  std::optional<PathResult> path;
+  std::vector<StepResult> steps;
+  if (o.continuous) {
+    MotionOptions mo;
+    mo.resolution = o.time_resolution;
+    mo.max_checks = o.motion_checks;
+    path = run.path(rows, copt, mo, ds, o.path_csv);
+    steps = std::move(path->steps);
+    report.timeline = timeline_report(m, *path, o.time_resolution);
+    out.collision = !path->pairs.empty();
+  } else {
+    steps = run.replay(rows, copt, ds, o.path_csv);
+  }
   print_diagnostics(ds);
+  out.bad_path = has_error(ds);
   report.trajectory = o.path_csv;
   for (const StepResult& s : steps) {
     ClassCounts n;
@@ -216,6 +262,7 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
   }
   report.stopped_by = out.stopped_by;
   for (const Diagnostic& d : ds) report.diagnostics.push_back(format_diagnostic(d));
+  if (path) print_timeline(o, m, *path);
   if (!steps.empty()) out.shown = std::move(steps.back().report);
   return out;
 }
@@ -235,7 +282,8 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
   const bool input_error = has_error(imported.diagnostics) || has_error(run.diagnostics);
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
   for (const Diagnostic& d : run.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
-  report.complete = imported.complete && !has_error(run.diagnostics) && run.stopped_by.empty();
+  report.complete = imported.complete && !has_error(run.diagnostics) && run.stopped_by.empty() && !run.bad_path &&
+                    (!report.timeline || report.timeline->complete);
   if (!run.stopped_by.empty() && run.stopped_by != kOutOfRange)
     std::cerr << "cadclash check: warning: partial report: the " << run.stopped_by << " ran out before every pair was examined\n";
 
@@ -257,7 +305,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
   if (primary && !o.html.empty() && runner.before_html && !runner.before_html()) return kExitInputError;
   if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
     return kExitInputError;
-  if (input_error || run.unreadable) return kExitInputError;
+  if (input_error || run.unreadable || run.bad_path) return kExitInputError;
   if (o.fail_on_collision && run.collision) return kExitCollision;  // a definite finding, partial report or not
   return run.stopped_by.empty() ? kExitOk : kExitBudget;
 }
@@ -297,7 +345,12 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
                   return replay_trajectory(scene, r, with_progress(c, line), ds, file);
                 },
                 {},
-                {}};
+                {},
+                [&](std::span<const TrajectoryRow> r, const CollideOptions& c, const MotionOptions& mo,
+                    std::vector<Diagnostic>& ds, const std::string& file) {
+                  ProgressLine line(progress, std::cerr);
+                  return replay_continuous(scene, m, r, with_progress(c, line), mo, ds, file);
+                }};
   bool primary = true;
 #if CADCLASH_HAS_MPI
   if (mpi != nullptr) {
@@ -331,6 +384,14 @@ namespace {
 int run_check(const CheckOptions& o, const Launch& launch) {
   if (!o.html.empty() && !html_report_available()) {
     std::cerr << "cadclash check: --html needs a build with the viewer (CMake option CADCLASH_HTML_VIEWER=ON)\n";
+    return kExitUsage;
+  }
+  if (o.continuous && o.path_csv.empty()) {
+    std::cerr << "cadclash check: --continuous checks the motion between the steps of a --path; give one\n";
+    return kExitUsage;
+  }
+  if (launch.by_mpirun && o.continuous) {
+    std::cerr << "cadclash check: --continuous does not run under mpirun yet (run the path in one process)\n";
     return kExitUsage;
   }
   if (launch.by_mpirun && o.memory_budget_mb > 0.0) {
@@ -402,6 +463,18 @@ void register_check(CLI::App& app) {
   cmd->add_option("--clearance", o->clearance, "Also report pairs closer than this, mm")->check(CLI::NonNegativeNumber);
   add_threads_option(*cmd, o->threads, "files read at once, meshing and the query");
   cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz");
+  cmd->add_flag("--continuous", o->continuous,
+                "With --path: check the motion between the steps too (each instance moves along the screw-like "
+                "motion between its poses); a contact that begins and ends between two steps is found, and the "
+                "report gets a timeline per pair (docs/cli.md)");
+  cmd->add_option("--time-resolution", o->time_resolution,
+                  "With --continuous: how narrow the spans where a contact begins or ends are, as a fraction of "
+                  "the stretch between two steps")
+      ->check(CLI::Range(1e-9, 1.0));
+  cmd->add_option("--motion-checks", o->motion_checks,
+                  "With --continuous: static checks at most per stretch between two steps; past it the open spans "
+                  "are listed whole and the timeline is marked partial")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--time-budget", o->time_budget,
                   "Stop after this many seconds (whole trajectory with --path) and report what was found, marked partial; exit 4")
       ->check(CLI::NonNegativeNumber);

@@ -327,6 +327,49 @@ nlohmann::json review_json(const ClashReview& r) {
           {"approvals", std::move(approvals)}};
 }
 
+ReportTimeline timeline_report(const Model& model, const PathResult& r, double resolution) {
+  ReportTimeline t;
+  t.resolution = resolution;
+  t.checks = r.checks;
+  t.complete = r.complete;
+  auto spans_of = [](const std::vector<MotionSpan>& v) {
+    std::vector<ReportSpan> out;
+    for (const MotionSpan& s : v) out.push_back({s.s0, s.s1, s.contact_at_ends});
+    return out;
+  };
+  for (const PairMotion& p : r.pairs) {
+    ReportPairTimeline rp{model.instances[p.a].path, model.instances[p.b].path, spans_of(p.spans), {}};
+    for (const SurfaceMotion& s : p.surfaces)
+      rp.surfaces.push_back({side(model, p.a, s.a), side(model, p.b, s.b), spans_of(s.spans)});
+    t.pairs.push_back(std::move(rp));
+  }
+  return t;
+}
+
+namespace {
+
+nlohmann::json spans_json(const std::vector<ReportSpan>& v) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ReportSpan& s : v) out.push_back({{"t0", s.t0}, {"t1", s.t1}, {"contact_at_ends", s.contact_at_ends}});
+  return out;
+}
+
+nlohmann::json timeline_json(const ReportTimeline& t) {
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const ReportPairTimeline& p : t.pairs) {
+    nlohmann::json surfaces = nlohmann::json::array();
+    for (const ReportSurfaceTimeline& s : p.surfaces) {
+      nlohmann::json a = side_json(s.a), b = side_json(s.b);
+      for (nlohmann::json* j : {&a, &b}) j->erase("uncertainty");  // not the decision's: not known here
+      surfaces.push_back({{"a", std::move(a)}, {"b", std::move(b)}, {"spans", spans_json(s.spans)}});
+    }
+    pairs.push_back({{"a", p.a}, {"b", p.b}, {"spans", spans_json(p.spans)}, {"surfaces", std::move(surfaces)}});
+  }
+  return {{"resolution", t.resolution}, {"checks", t.checks}, {"complete", t.complete}, {"pairs", std::move(pairs)}};
+}
+
+}  // namespace
+
 nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions& o) {
   nlohmann::json j;
   j["schema"] = kCheckReportSchema;
@@ -346,6 +389,7 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
     j["steps"] = std::move(steps);
     j["steps_not_checked"] = r.steps_not_checked;
     j["stopped_by"] = string_or_null(r.stopped_by);
+    if (r.timeline) j["timeline"] = timeline_json(*r.timeline);
   }
   if (r.review) {
     j["clashes"] = clashes_json(*r.review);

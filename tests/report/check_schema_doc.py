@@ -40,6 +40,10 @@ SECTIONS = {
     "Approval": "approval",
     "`import_timings`": "import_timings",
     "`import_timings.files[]`": "import_file",
+    "`timeline` (with `--continuous`)": "timeline",
+    "TimelinePair": "timeline_pair",
+    "TimelineSurfacePair": "timeline_surface",
+    "Span": "span",
 }
 # Documented keys no run here writes, with the reason. Keep empty when possible.
 NOT_WRITTEN = {}
@@ -58,7 +62,7 @@ def documented(doc: str) -> dict:
         if rows:
             keys = set()
             for row in rows:
-                keys.update(re.findall(r"`([a-z_]+)`", row.split("|")[1]))
+                keys.update(re.findall(r"`([a-z_][a-z_0-9]*)`", row.split("|")[1]))
         else:
             paragraph = body.strip().split("\n\n")[0]
             keys = set(re.findall(r"`([a-z_]+)`", paragraph))
@@ -114,6 +118,18 @@ def collect(report: dict, seen: dict) -> None:
         for f in report["import_timings"]["files"]:
             add("import_file", f)
             seen.setdefault("values", set()).add(f["cache"])
+    if "timeline" in report:
+        add("timeline", report["timeline"])
+        for p in report["timeline"]["pairs"]:
+            add("timeline_pair", p)
+            for sp in p["spans"]:
+                add("span", sp)
+            for s in p["surfaces"]:
+                add("timeline_surface", s)
+                add("side", s["a"])
+                add("side", s["b"])
+                for sp in s["spans"]:
+                    add("span", sp)
     query(report)
     for s in report.get("steps", []):
         add("step", s)
@@ -133,6 +149,7 @@ def main() -> int:
         [as1, "--exact", "--cache", "CACHE"],
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
+        [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv", "--continuous"],
         [boxes[0], boxes[1], "--volume"],
     ]
     seen: dict = {}

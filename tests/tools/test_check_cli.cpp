@@ -243,6 +243,46 @@ TEST(CheckCli, TrajectoryReplay) {
   EXPECT_GT(j["steps"][2]["summary"]["penetrating"].get<int>(), 0);
 }
 
+// --continuous: the motion between the steps too. From step 0 to 1 the near box closes a 0.5 mm gap
+// to box_a, so it comes within the 0.01 tolerance at t = 0.98 (0.5 - 0.5 t <= 0.01): the timeline's
+// first span is at most 1/1000 of the stretch wide and brackets it; from there the pair stays in
+// contact to the last step (proved at both ends). The JSON is the same for 1 and 2 threads. Steps
+// that go back are an error naming the line; --continuous without --path a usage error.
+TEST(CheckCli, ContinuousTrajectoryHasATimeline) {
+  std::string first;
+  for (const char* threads : {"1", "2"}) {
+    const std::string json = tmp(std::string("continuous_") + threads + ".json");
+    const Proc r = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_ok.csv") +
+                       " --continuous --tolerance 0.01 --threads " + threads + " --no-timings --json " + json);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("between the steps"), std::string::npos) << r.out;
+    const std::string text = read(json);
+    if (first.empty()) first = text;
+    EXPECT_EQ(text, first) << "the report must not depend on the thread count";
+    const nlohmann::json j = nlohmann::json::parse(text);
+    ASSERT_EQ(j["steps"].size(), 3u);
+    const nlohmann::json& t = j["timeline"];
+    EXPECT_EQ(t["complete"], true);
+    ASSERT_EQ(t["pairs"].size(), 1u);
+    const nlohmann::json& spans = t["pairs"][0]["spans"];
+    ASSERT_GE(spans.size(), 2u);
+    const double t0 = spans[0]["t0"], t1 = spans[0]["t1"];
+    EXPECT_LE(t0, 0.98);
+    EXPECT_GE(t1, 0.98);
+    EXPECT_LE(t1 - t0, 1e-3 + 1e-12);
+    EXPECT_EQ(spans.back()["t1"], 2.0);
+    EXPECT_EQ(spans.back()["contact_at_ends"], true);
+    EXPECT_FALSE(t["pairs"][0]["surfaces"].empty());
+  }
+  const std::string back = tmp("path_back.csv");
+  std::ofstream(back) << "step,instance_path,tx,ty,tz,qw,qx,qy,qz\n0,/box_near.obj/box_near,0,0,0,1,0,0,0\n"
+                         "2,/box_near.obj/box_near,-0.5,0,0,1,0,0,0\n1,/box_near.obj/box_near,0,0,0,1,0,0,0\n";
+  const Proc bad = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + back + " --continuous");
+  EXPECT_EQ(bad.code, 1) << bad.out;
+  EXPECT_NE(bad.out.find("path_back.csv:4: error: step 1 does not follow step 2"), std::string::npos) << bad.out;
+  EXPECT_EQ(run("check " + data("box_a.obj") + " --continuous").code, 2);
+}
+
 TEST(CheckCli, BadTrajectoryNamesTheLines) {
   const Proc r = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_bad.csv"));
   EXPECT_EQ(r.code, 1);

@@ -321,6 +321,34 @@ struct ReportImport {
   std::vector<ReportFileImport> files;
 };
 
+// The whole path checked continuously (`check --path --continuous`; trajectory.h, replay_continuous):
+// per instance pair that may be in contact at some time, where, in step numbers. A span is proved in
+// contact at both ends (`contact_at_ends`; in between not proved either way) or at most the
+// resolution wide: a contact may begin, end or hold there. A pair not listed is proved out of
+// contact over the whole path.
+struct ReportSpan {
+  double t0 = 0.0, t1 = 0.0;
+  bool contact_at_ends = false;
+};
+struct ReportSurfaceTimeline {
+  ReportSide a, b;  // the surfaces (instance, part, surface, its STEP #id ...); uncertainty not set
+  std::vector<ReportSpan> spans;
+};
+struct ReportPairTimeline {
+  std::string a, b;  // instance paths
+  std::vector<ReportSpan> spans;
+  std::vector<ReportSurfaceTimeline> surfaces;
+};
+struct ReportTimeline {
+  double resolution = 0.0;   // the spans' width where a contact begins or ends, a fraction of a stretch
+  std::uint64_t checks = 0;  // static checks the motion took (the steps' own not counted)
+  bool complete = true;      // false: a stretch ran out of its checks, or the path was cut short
+  std::vector<ReportPairTimeline> pairs;
+};
+
+// `r` over `model` with every id resolved to names. Precondition: every id in `r` is valid for `model`.
+ReportTimeline timeline_report(const Model& model, const PathResult& r, double resolution);
+
 struct CheckReport {
   int version = kCheckReportVersion;
   std::vector<std::string> files;  // as given
@@ -338,6 +366,7 @@ struct CheckReport {
   // `clashes` and `review`); nullopt: not written (reports of the library's callers that do not ask).
   std::optional<ClashReview> review;
   std::optional<ReportImport> import;    // absent: not written (and not in reports written without timings)
+  std::optional<ReportTimeline> timeline;  // with --continuous: the path's timeline ("timeline")
 };
 
 // `r` over `model` with every id resolved to names: what the report says about one query.
