@@ -255,7 +255,10 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
   for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
   const std::size_t not_checked = distinct_steps - steps.size();
   report.steps_not_checked = not_checked;
-  if (not_checked > 0) {
+  if (not_checked > 0 && out.bad_path) {
+    std::cout << "\nPARTIAL REPORT: " << not_checked << " of " << distinct_steps
+              << " steps not checked (the path's error above)\n";
+  } else if (not_checked > 0) {
     std::cout << "\nPARTIAL REPORT: stopped by the time budget: " << not_checked << " of " << distinct_steps
               << " steps not checked\n";
     if (out.stopped_by.empty()) out.stopped_by = "time budget";
@@ -358,6 +361,14 @@ int check_imported(const CheckOptions& o, ImportResult& imported, const std::vec
     runner.check = [&](const CollideOptions& c) { return mpi->check(scene, m, c); };
     runner.replay = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, std::vector<Diagnostic>& ds,
                         const std::string& file) { return mpi->replay(scene, m, r, c, ds, file); };
+    // Every static check of the path split over the ranks; its pairs on every rank, so that every
+    // rank halves the same stretches.
+    runner.path = [&](std::span<const TrajectoryRow> r, const CollideOptions& c, const MotionOptions& mo,
+                      std::vector<Diagnostic>& ds, const std::string& file) {
+      MotionOptions everywhere = mo;
+      everywhere.check = [&](Scene& s, const CollideOptions& co) { return mpi->check_everywhere(s, m, co); };
+      return replay_continuous(scene, m, r, c, everywhere, ds, file);
+    };
     runner.before_html = [&] {
       mpi->mesh_every_part(m);
       return true;
@@ -390,8 +401,9 @@ int run_check(const CheckOptions& o, const Launch& launch) {
     std::cerr << "cadclash check: --continuous checks the motion between the steps of a --path; give one\n";
     return kExitUsage;
   }
-  if (launch.by_mpirun && o.continuous) {
-    std::cerr << "cadclash check: --continuous does not run under mpirun yet (run the path in one process)\n";
+  if (launch.by_mpirun && o.continuous && o.time_budget > 0.0) {
+    std::cerr << "cadclash check: --continuous with --time-budget does not run under mpirun yet (each rank's "
+                 "clock would decide where the path stops; run it in one process)\n";
     return kExitUsage;
   }
   if (launch.by_mpirun && o.memory_budget_mb > 0.0) {

@@ -105,7 +105,7 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
       }
     }
     k = next;
-    out.steps.push_back({step, scene.check(step_options)});
+    out.steps.push_back({step, motion.check ? motion.check(scene, step_options) : scene.check(step_options)});
     if (meter.active()) meter.add(1, std::to_string(step));
   }
   meter.finish();

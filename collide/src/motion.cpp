@@ -122,7 +122,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    return contacts_of(scene.check(o));
+    return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o));
   };
   std::map<double, Contacts> at;  // the static check at T, by s
   auto contacts_at = [&](double s) -> const Contacts& {

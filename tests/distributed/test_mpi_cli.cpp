@@ -169,6 +169,16 @@ TEST(MpiCli, As1TrajectorySameReport) {
   expect_identical("check '" + as1_path() + "' --lazy --deflection 2 --path '" + as1_trajectory_csv() + "'", false);
 }
 
+// --continuous: every static check of the path split over the ranks, its pairs on every rank (so
+// every rank halves the same stretches); the timeline the same bytes as in one process.
+TEST(MpiCli, ContinuousPathSameReport) {
+  const std::string boxes = std::string(CADCLASH_DATA_DIR) + "/collide/";
+  expect_identical("check '" + boxes + "box_a.obj' '" + boxes + "box_near.obj' --path '" + boxes +
+                       "path_ok.csv' --continuous --tolerance 0.01",
+                   false);
+  EXPECT_NE(slurp(scratch("np4.json")).find("\"timeline\""), std::string::npos);
+}
+
 // Part meshing: steps reach parts the rank has not meshed yet; the plan uses the deflections other
 // ranks' parts achieved (below the asked 2 mm).
 TEST(MpiCli, As1PartMeshingTrajectorySameReport) {

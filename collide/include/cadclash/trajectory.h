@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,6 +81,10 @@ double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, do
 struct MotionOptions {
   double resolution = 1e-3;      // width of the spans a contact may begin or end in, as a fraction of the stretch (> 0)
   std::size_t max_checks = 4096;  // static checks at most; past it the open spans are listed as they are
+  // How each static check runs; empty: Scene::check. A distributed run (cadclash check under mpirun)
+  // passes its own: it must return, on every process, reports with the same pairs (ids and classes)
+  // and the same `complete`, so that every process takes the same stretches.
+  std::function<Report(Scene&, const CollideOptions&)> check;
 };
 struct MotionSpan {
   double s0 = 0.0, s1 = 0.0;
