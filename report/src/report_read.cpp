@@ -365,6 +365,40 @@ ReportImport read_import(const Json& j, const std::string& p) {
   return out;
 }
 
+std::vector<ReportSpan> read_spans(const Json& j, const std::string& p) {
+  std::vector<ReportSpan> out;
+  const Json& a = array(j, p);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const std::string pk = p + "/" + std::to_string(k);
+    out.push_back({number(field(a[k], pk, "t0"), pk + "/t0"), number(field(a[k], pk, "t1"), pk + "/t1"),
+                   boolean(field(a[k], pk, "contact_at_ends"), pk + "/contact_at_ends")});
+  }
+  return out;
+}
+
+ReportTimeline read_timeline(const Json& j, const std::string& p) {
+  ReportTimeline t;
+  t.resolution = number(field(j, p, "resolution"), p + "/resolution");
+  t.checks = count(field(j, p, "checks"), p + "/checks");
+  t.complete = boolean(field(j, p, "complete"), p + "/complete");
+  const Json& pairs = array(field(j, p, "pairs"), p + "/pairs");
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const std::string pk = p + "/pairs/" + std::to_string(k);
+    ReportPairTimeline rp;
+    rp.a = text(field(pairs[k], pk, "a"), pk + "/a");
+    rp.b = text(field(pairs[k], pk, "b"), pk + "/b");
+    rp.spans = read_spans(field(pairs[k], pk, "spans"), pk + "/spans");
+    const Json& surfaces = array(field(pairs[k], pk, "surfaces"), pk + "/surfaces");
+    for (std::size_t i = 0; i < surfaces.size(); ++i) {
+      const std::string si = pk + "/surfaces/" + std::to_string(i);
+      rp.surfaces.push_back({read_side(field(surfaces[i], si, "a"), si + "/a"), read_side(field(surfaces[i], si, "b"), si + "/b"),
+                             read_spans(field(surfaces[i], si, "spans"), si + "/spans")});
+    }
+    t.pairs.push_back(std::move(rp));
+  }
+  return t;
+}
+
 CheckReport read_report(const Json& j) {
   CheckReport r;
   object(j, "");
@@ -385,6 +419,7 @@ CheckReport read_report(const Json& j) {
     }
     r.steps_not_checked = count(field(j, "", "steps_not_checked"), "/steps_not_checked");
     r.stopped_by = string_or_null(field(j, "", "stopped_by"), "/stopped_by");
+    if (j.contains("timeline")) r.timeline = read_timeline(object(j["timeline"], "/timeline"), "/timeline");  // --continuous
   } else {
     r.query = read_query(j, "");
   }

@@ -141,6 +141,41 @@ TEST(ReportRoundTrip, TrajectoryReport) {
   EXPECT_EQ(rewrite(text), text);
 }
 
+// A continuous path's report (--continuous): its timeline read back as written, spans and the
+// surfaces' sides included; a timeline span without its `t1` is an error naming the path.
+TEST(ReportRoundTrip, ContinuousPathTimeline) {
+  const std::string dir = std::string(CADCLASH_DATA_DIR) + "/collide/";
+  const std::vector<std::string> files = {dir + "box_a.obj", dir + "box_near.obj"};
+  ImportResult in = import_files(files);
+  ASSERT_EQ(in.model.instances.size(), 2u);
+  Scene scene(in.model);
+  const std::vector<TrajectoryRow> rows = {{0, in.model.instances[1].path, Pose::Identity(), 1},
+                                           {1, in.model.instances[1].path, Pose(Eigen::Translation3d(-0.5, 0, 0)), 2}};
+  CollideOptions o;
+  o.tolerance = 0.01;
+  std::vector<Diagnostic> ds;
+  const PathResult path = replay_continuous(scene, in.model, rows, o, {}, ds, "path.csv");
+  CheckReport r;
+  r.files = {"box_a.obj", "box_near.obj"};
+  r.settings = report_settings(o);
+  r.trajectory = "path.csv";
+  for (const StepResult& s : path.steps) r.steps.push_back({s.step, query_report(in.model, s.report)});
+  r.timeline = timeline_report(in.model, path, 1e-3);
+  ASSERT_EQ(r.timeline->pairs.size(), 1u);
+  ASSERT_FALSE(r.timeline->pairs[0].surfaces.empty());
+  const std::string text = check_report_text(r, {.timings = false});
+  EXPECT_NE(text.find("\"timeline\""), std::string::npos);
+  EXPECT_EQ(rewrite(text, {.timings = false}), text);
+  const ReportReadResult read = check_report_from_json(std::string_view(text));
+  ASSERT_TRUE(read.report.timeline);
+  EXPECT_EQ(read.report.timeline->pairs[0].surfaces[0].a.surface, r.timeline->pairs[0].surfaces[0].a.surface);
+  nlohmann::json bad = nlohmann::json::parse(text);
+  bad["timeline"]["pairs"][0]["spans"][0].erase("t1");
+  const ReportReadResult broken = check_report_from_parsed(bad);
+  ASSERT_TRUE(broken.error);
+  EXPECT_EQ(broken.error->path, "/timeline/pairs/0/spans/0/t1");
+}
+
 TEST(ReportRoundTrip, RealQueriesOnMeshesAndAs1) {
   const std::string dir = std::string(CADCLASH_DATA_DIR) + "/collide/";
   std::vector<std::vector<std::string>> inputs = {{dir + "box_a.obj", dir + "box_overlap.obj", dir + "box_near.obj"}};
