@@ -19,8 +19,8 @@ Contracts:
 - Queries (``Scene.check``, ``collide``, ``replay``, ``load``) release the GIL; results do not depend
   on the thread count.
 """
-from ._types import (Counters, Diagnostic, InputError, ModelMemory, PairResult, Provenance, Replay, Report,
-                     StepResult, Timings)
+from ._types import (Counters, Diagnostic, InputError, ModelMemory, PairResult, PairTimeline, Provenance, Replay,
+                     Report, StepResult, SurfaceTimeline, Timeline, TimelineSpan, Timings)
 from ._options import CollideOptions
 from ._model import Instance, Model, Part, Surface, load
 from ._scene import Scene, collide, replay
@@ -28,7 +28,8 @@ from ._scene import Scene, collide, replay
 __all__ = [
     "load", "Model", "Part", "Instance", "Surface", "Provenance",
     "Scene", "collide", "replay", "CollideOptions",
-    "Report", "PairResult", "Counters", "Timings", "ModelMemory", "StepResult", "Replay", "Diagnostic",
+    "Report", "PairResult", "Counters", "Timings", "ModelMemory", "StepResult", "Replay", "Timeline", "PairTimeline",
+    "SurfaceTimeline", "TimelineSpan", "Diagnostic",
     "InputError",
 ]
 __version__ = "0.1.0"

@@ -9,7 +9,8 @@ import numpy as np
 from . import _cadclash as _core
 from ._model import Instance, Model, _path_under
 from ._options import CollideOptions, _resolve, _to_core
-from ._types import Counters, InputError, ModelMemory, PairResult, Replay, Report, StepResult, Timings, _diagnostics
+from ._types import (Counters, InputError, ModelMemory, PairResult, Replay, Report, StepResult, Timeline, Timings,
+                     _diagnostics)
 
 __all__ = ["Scene", "collide", "replay"]
 
@@ -147,11 +148,19 @@ def collide(model: Model, a: InstanceKey, b: InstanceKey, options: Optional[Coll
     return _report(model, _core.collide(model, model._instance_id(a), model._instance_id(b), o), settings)
 
 
-def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[CollideOptions] = None,
+def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[CollideOptions] = None, *,
+           continuous: bool = False, time_resolution: float = 1e-3, motion_checks: int = 4096,
            **kwargs: Any) -> Replay:
     """Replays a trajectory CSV (``step,instance_path,tx,ty,tz,qw,qx,qy,qz``; absolute world poses;
     optional header; '#' comments) on ``scene``: rows with equal consecutive step numbers are
     applied together, then the scene is checked. The scene keeps the last poses afterwards.
+
+    ``continuous=True`` checks the motion between the steps too, as ``cadclash check --path
+    --continuous``: ``Replay.timeline`` lists every instance pair that may be in contact between
+    the first and last step, with spans in step numbers; ``time_resolution`` (a fraction of the
+    stretch between two steps) and ``motion_checks`` (static checks at most per stretch) as there.
+    Step numbers must then ascend (a step that goes back is an error in ``Replay.diagnostics`` and
+    the path stops there).
 
     Raises ``InputError`` naming the file and line when the file cannot be read or any row is bad
     (then nothing is run, like ``cadclash check --path``). Rows naming unknown instances are skipped
@@ -163,27 +172,30 @@ def replay(scene: Scene, trajectory: Union[str, os.PathLike], options: Optional[
             text = f.read()
     except OSError as e:
         raise InputError(f"{path}: error: cannot open trajectory ({e.strerror})", []) from e
-    parse_raw, steps_raw, run_raw, distinct_steps = scene._core.replay(text, path, o)
+    parse_raw, steps_raw, run_raw, distinct_steps, timeline = scene._core.replay(
+        text, path, o, continuous, float(time_resolution), int(motion_checks))
     parse = _diagnostics(parse_raw)
     if any(d.is_error for d in parse):
         raise InputError(f"{path}: the trajectory has errors; nothing checked", parse)
     steps = [StepResult(step, _report(scene.model, raw)) for step, raw in steps_raw]
     replay_diagnostics = _diagnostics(run_raw)
-    return Replay(steps, parse + replay_diagnostics,
-                  _replay_document(scene, o, path, steps, steps_raw, distinct_steps, replay_diagnostics))
+    document = _replay_document(scene, o, path, steps, steps_raw, distinct_steps, replay_diagnostics, timeline)
+    return Replay(steps, parse + replay_diagnostics, document, Timeline._from_raw(document._timeline()))
 
 
-def _replay_document(scene: Scene, o, path: str, steps, steps_raw, distinct_steps: int, replay_diagnostics):
+def _replay_document(scene: Scene, o, path: str, steps, steps_raw, distinct_steps: int, replay_diagnostics,
+                     timeline=None):
     """The `cadclash check --path` report of a replay, assembled as the CLI does."""
     model = scene.model
     not_checked = distinct_steps - len(steps)
     stopped_by = next((s.report.stopped_by for s in steps if not s.report.complete), "")
-    if not stopped_by and not_checked > 0:
+    path_error = any(d.is_error for d in replay_diagnostics)  # continuous: a step that goes back
+    if not stopped_by and not_checked > 0 and not path_error:
         stopped_by = "time budget"
     step_diagnostics = [d for s in steps for d in s.report.diagnostics]
     diagnostics = [str(d) for d in replay_diagnostics + model.diagnostics + step_diagnostics]
-    complete = model.complete and not any(d.is_error for d in step_diagnostics) and not stopped_by
+    complete = model.complete and not any(d.is_error for d in step_diagnostics) and not stopped_by and not path_error
     settings = _core.report_settings(o, model, *scene._given)
     return _core.ReportDocument.trajectory(list(model.files), settings, path,
                                            [(step, raw[9]) for step, raw in steps_raw], not_checked, stopped_by,
-                                           diagnostics, complete)
+                                           diagnostics, complete, timeline)

@@ -353,6 +353,64 @@ class StepResult:
 
 
 @dataclass(frozen=True)
+class TimelineSpan:
+    """Where a pair may be in contact along a path, in step numbers (``replay(..., continuous=True)``):
+    proved in contact at ``t0`` and at ``t1`` when ``contact_at_ends`` (between them not proved
+    either way), else at most the resolution of its stretch wide, where a contact may begin, end or
+    hold. A time in no span is proved free."""
+
+    t0: float
+    t1: float
+    contact_at_ends: bool
+
+
+@dataclass(frozen=True)
+class SurfaceTimeline:
+    """One surface pair's spans: each side (instance path, part, surface name, STEP #id or None)."""
+
+    a: Tuple[str, str, Optional[str], Optional[int]]
+    b: Tuple[str, str, Optional[str], Optional[int]]
+    spans: List[TimelineSpan]
+
+
+@dataclass(frozen=True)
+class PairTimeline:
+    """One instance pair (paths) that may be in contact somewhere along the path: its spans (any of its
+    surface pairs, or containment) and each surface pair's."""
+
+    a: str
+    b: str
+    spans: List[TimelineSpan]
+    surfaces: List[SurfaceTimeline]
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """The motion between the steps of a path (``cadclash check --path --continuous``): every instance
+    pair not listed is proved out of contact over the whole path. ``resolution``: the width of the
+    spans where a contact begins or ends, as a fraction of the stretch between two steps; ``checks``:
+    static checks it took; ``complete`` false when a stretch ran out of ``motion_checks``."""
+
+    resolution: float
+    checks: int
+    complete: bool
+    pairs: List[PairTimeline]
+
+    @classmethod
+    def _from_raw(cls, raw) -> Optional["Timeline"]:
+        if raw is None:
+            return None
+        resolution, checks, complete, pairs = raw
+
+        def spans(v):
+            return [TimelineSpan(t0, t1, c) for t0, t1, c in v]
+
+        return cls(resolution, checks, complete,
+                   [PairTimeline(a, b, spans(s), [SurfaceTimeline(tuple(sa), tuple(sb), spans(ss)) for sa, sb, ss in surfaces])
+                    for a, b, s, surfaces in pairs])
+
+
+@dataclass(frozen=True)
 class Replay:
     """Result of ``replay()``: one report per step, and warnings for rows naming unknown instances
     (those rows are skipped) plus any tessellation errors."""
@@ -361,6 +419,8 @@ class Replay:
     diagnostics: List[Diagnostic]
     # The `cadclash check --path` JSON report of this replay; None for a Replay made by hand.
     _document: Optional["_core.ReportDocument"] = field(default=None, repr=False, compare=False)
+    # With continuous=True: the motion between the steps; None otherwise.
+    timeline: Optional[Timeline] = None
 
     @classmethod
     def from_json(cls, text: str) -> "Replay":
@@ -374,7 +434,7 @@ class Replay:
         doc = _core.ReportDocument.from_json(text)
         _, raw_steps, _, _ = doc._steps()
         steps = [StepResult(step, _query_from_document(raw, [], not raw[3], None)) for step, raw in raw_steps]
-        return cls(steps, [Diagnostic._from_text(t) for t in doc.diagnostics], doc)
+        return cls(steps, [Diagnostic._from_text(t) for t in doc.diagnostics], doc, Timeline._from_raw(doc._timeline()))
 
     @property
     def steps_not_checked(self) -> int:

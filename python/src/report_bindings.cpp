@@ -90,6 +90,7 @@ void bind_report(pyb::module_& m) {
       pyb::arg("options"), pyb::arg("model"), pyb::arg("select_a"), pyb::arg("select_b"), pyb::arg("exclude_under"),
       "The report's settings for a query with these options on this model (as `cadclash check` writes them).");
 
+  pyb::class_<ReportTimeline>(m, "ReportTimeline", "A continuous path's timeline (cadclash::ReportTimeline), opaque.");
   pyb::class_<CheckReport>(m, "ReportDocument", "A `cadclash check --json` report (cadclash::CheckReport).")
       .def(pyb::init([](std::vector<std::string> files, ReportSettings settings, QueryReport query,
                         std::vector<std::string> diagnostics, bool complete) {
@@ -146,7 +147,8 @@ void bind_report(pyb::module_& m) {
           "trajectory",
           [](std::vector<std::string> files, ReportSettings settings, std::string trajectory,
              std::vector<std::pair<std::int64_t, QueryReport>> steps, std::uint64_t steps_not_checked,
-             std::string stopped_by, std::vector<std::string> diagnostics, bool complete) {
+             std::string stopped_by, std::vector<std::string> diagnostics, bool complete,
+             std::optional<ReportTimeline> timeline) {
             CheckReport r;
             r.files = std::move(files);
             r.settings = std::move(settings);
@@ -155,12 +157,15 @@ void bind_report(pyb::module_& m) {
             r.steps_not_checked = steps_not_checked;
             r.stopped_by = std::move(stopped_by);
             r.diagnostics = std::move(diagnostics);
-            r.complete = complete;
+            r.complete = complete && (!timeline || timeline->complete);
+            r.timeline = std::move(timeline);
             return r;
           },
           pyb::arg("files"), pyb::arg("settings"), pyb::arg("trajectory"), pyb::arg("steps"),
           pyb::arg("steps_not_checked"), pyb::arg("stopped_by"), pyb::arg("diagnostics"), pyb::arg("complete"),
-          "A `cadclash check --path` report: one (step, QueryRecord) per step checked.")
+          pyb::arg("timeline") = pyb::none(),
+          "A `cadclash check --path` report: one (step, QueryRecord) per step checked, and with --continuous "
+          "the path's timeline.")
       .def(
           "to_json",
           [](const CheckReport& r, bool with_timings) { return check_report_text(r, {.timings = with_timings}); },
@@ -180,6 +185,24 @@ void bind_report(pyb::module_& m) {
       .def("_query", [](const CheckReport& r) {
         if (!r.query) throw pyb::value_error("a trajectory report (--path) holds steps, not one query: read it with Replay.from_json");
         return query_tuple(*r.query);
+      })
+      // (resolution, checks, complete, [(a, b, spans, [(side a, side b, spans)])]) with each span
+      // (t0, t1, contact_at_ends) and each side as in query_tuple; None without a timeline.
+      .def("_timeline", [](const CheckReport& r) -> pyb::object {
+        if (!r.timeline) return pyb::none();
+        auto spans = [](const std::vector<ReportSpan>& v) {
+          pyb::list out;
+          for (const ReportSpan& s : v) out.append(pyb::make_tuple(s.t0, s.t1, s.contact_at_ends));
+          return out;
+        };
+        pyb::list pairs;
+        for (const ReportPairTimeline& p : r.timeline->pairs) {
+          pyb::list surfaces;
+          for (const ReportSurfaceTimeline& s : p.surfaces)
+            surfaces.append(pyb::make_tuple(side_tuple(s.a), side_tuple(s.b), spans(s.spans)));
+          pairs.append(pyb::make_tuple(p.a, p.b, spans(p.spans), surfaces));
+        }
+        return pyb::make_tuple(r.timeline->resolution, r.timeline->checks, r.timeline->complete, pairs);
       })
       .def("_steps", [](const CheckReport& r) {
         if (r.query) throw pyb::value_error("a report of one query holds no steps (no --path trajectory): read it with Report.from_json");

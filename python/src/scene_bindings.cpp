@@ -138,11 +138,16 @@ void bind_scene_core(pyb::module_& m) {
              }
              return report_to_tuple(r, std::move(record));
            })
-      .def("replay", [](SceneCore& c, const std::string& csv_text, const std::string& file, const CollideOptions& o) {
+      .def("replay", [](SceneCore& c, const std::string& csv_text, const std::string& file, const CollideOptions& o,
+                        bool continuous, double resolution, std::size_t max_checks) {
         validate(o);
+        if (continuous && !(resolution > 0.0 && resolution <= 1.0))
+          throw pyb::value_error("time_resolution must be in (0, 1]");
+        if (continuous && max_checks == 0) throw pyb::value_error("motion_checks must be positive");
         std::vector<Diagnostic> parse_diags, run_diags;
         std::vector<StepResult> steps;
         std::vector<QueryReport> records;
+        std::optional<ReportTimeline> timeline;
         std::size_t distinct_steps = 0;  // of the rows: steps_not_checked = distinct_steps - steps
         {
           ModelLock lock(*c.state);
@@ -150,14 +155,24 @@ void bind_scene_core(pyb::module_& m) {
           for (std::size_t k = 0; k < rows.size(); ++k) distinct_steps += (k == 0 || rows[k].step != rows[k - 1].step);
           if (!has_error(parse_diags)) {  // like `cadclash check --path`: a bad row means nothing is run
             Running running(c.running);
-            steps = replay_trajectory(*c.scene, rows, o, run_diags, file);
+            if (continuous) {
+              MotionOptions mo;
+              mo.resolution = resolution;
+              mo.max_checks = max_checks;
+              PathResult path = replay_continuous(*c.scene, c.state->model, rows, o, mo, run_diags, file);
+              timeline = timeline_report(c.state->model, path, resolution);
+              steps = std::move(path.steps);
+            } else {
+              steps = replay_trajectory(*c.scene, rows, o, run_diags, file);
+            }
             for (const StepResult& s : steps) records.push_back(query_report(c.state->model, s.report));
           }
         }
         pyb::list out;
         for (std::size_t k = 0; k < steps.size(); ++k)
           out.append(pyb::make_tuple(steps[k].step, report_to_tuple(steps[k].report, std::move(records[k]))));
-        return pyb::make_tuple(diagnostics_to_list(parse_diags), out, diagnostics_to_list(run_diags), distinct_steps);
+        pyb::object t = timeline ? pyb::cast(std::move(*timeline)) : pyb::object(pyb::none());
+        return pyb::make_tuple(diagnostics_to_list(parse_diags), out, diagnostics_to_list(run_diags), distinct_steps, t);
       });
 
   m.def("collide", [](ModelCore& model, std::int64_t a, std::int64_t b, const CollideOptions& o) {

@@ -169,6 +169,30 @@ def test_a_trajectory_report_reads_back_as_a_replay(boxes, data_dir, cli_text):
         cadclash.Replay.from_json(cadclash.Scene(cadclash.load([str(b) for b in boxes])).check().to_json())
 
 
+def test_continuous_replay_is_byte_identical_to_check_path_continuous(boxes, data_dir, cli_text):
+    """replay(continuous=True) writes what `cadclash check --path --continuous` writes, byte for byte,
+    and the report reads back with its timeline: the near box comes within 0.01 of box_a at t = 0.98
+    (a span at most 1/1000 of the stretch wide brackets it), then stays in contact to the last step."""
+    csv = str(data_dir / "collide" / "path_ok.csv")
+    scene = cadclash.Scene(cadclash.load([str(b) for b in boxes]))
+    replayed = cadclash.replay(scene, csv, tolerance=0.01, continuous=True)
+    text = cli_text(boxes, "--path", csv, "--tolerance", "0.01", "--continuous")
+    _same_text(replayed.to_json(), text)
+    t = replayed.timeline
+    assert t is not None and t.complete and t.resolution == 1e-3 and t.checks > 0
+    assert len(t.pairs) == 1 and t.pairs[0].surfaces
+    first, last = t.pairs[0].spans[0], t.pairs[0].spans[-1]
+    assert first.t0 <= 0.98 <= first.t1 and first.t1 - first.t0 <= 1e-3 + 1e-12 and not first.contact_at_ends
+    assert last.t1 == 2.0 and last.contact_at_ends
+    side = t.pairs[0].surfaces[0].a
+    assert side[0] == t.pairs[0].a and side[2]  # instance path, part, surface name
+    back = cadclash.Replay.from_json(text)
+    assert back.to_json() == text and back.timeline == t
+    assert cadclash.replay(scene, csv, tolerance=0.01).timeline is None
+    with pytest.raises(ValueError, match="time_resolution"):
+        cadclash.replay(scene, csv, continuous=True, time_resolution=0)
+
+
 def test_model_bytes_match_the_json_report(as1, as1_path, cli_text):
     import json
     report = cadclash.Scene(as1).check()
