@@ -201,11 +201,15 @@ void print_timeline(const CheckOptions& o, const Model& m, const PathResult& p) 
   if (p.pairs.empty()) {
     std::cout << "no instance pair comes into contact\n";
   } else {
-    std::cout << p.pairs.size() << " instance pair" << (p.pairs.size() == 1 ? "" : "s") << " may touch\n";
+    std::cout << p.pairs.size() << " instance pair" << (p.pairs.size() == 1 ? "" : "s")
+              << (o.clearance > 0.0 ? " may touch or come within the clearance\n" : " may touch\n");
     for (const PairMotion& pm : p.pairs) {
       std::cout << "  " << m.instances[pm.a].path << " x " << m.instances[pm.b].path << " (" << pm.surfaces.size()
                 << " surface pair" << (pm.surfaces.size() == 1 ? "" : "s") << "):";
       for (const MotionSpan& s : pm.spans) std::cout << ' ' << span_text(s) << ';';
+      if (pm.closest)
+        std::cout << " closest " << pm.closest->hi << " mm (at least " << pm.closest->lo << ") within ["
+                  << pm.closest->s0 << ", " << pm.closest->s1 << "]";
       std::cout << '\n';
     }
   }
@@ -228,7 +232,8 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
     path = run.path(rows, copt, mo, ds, o.path_csv);
     steps = std::move(path->steps);
     report.timeline = timeline_report(m, *path, o.time_resolution);
-    out.collision = !path->pairs.empty();
+    // A pair that may touch between the steps is a finding; one that only comes within the clearance not.
+    out.collision = std::any_of(path->pairs.begin(), path->pairs.end(), [](const PairMotion& p) { return !p.spans.empty(); });
   } else {
     steps = run.replay(rows, copt, ds, o.path_csv);
   }

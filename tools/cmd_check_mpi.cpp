@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <functional>
 #include <iomanip>
@@ -148,12 +149,14 @@ Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options
 
 Report MpiCheck::check_everywhere(Scene& scene, Model& model, const CollideOptions& options) {
   Report r = check(scene, model, options);
-  // Five numbers per pair (instances, surfaces, class) and `complete` last, broadcast from rank 0.
+  // Seven numbers per pair (instances, surfaces, class, distance bounds' bits) and `complete` last,
+  // broadcast from rank 0.
   std::vector<std::uint64_t> packed;
   if (rank_ == 0) {
     for (const SurfacePairResult& p : r.pairs)
       packed.insert(packed.end(), {p.instance_a, p.instance_b, p.surface_a, p.surface_b,
-                                   static_cast<std::uint64_t>(p.contact)});
+                                   static_cast<std::uint64_t>(p.contact), std::bit_cast<std::uint64_t>(p.distance_lo),
+                                   std::bit_cast<std::uint64_t>(p.distance_hi)});
     packed.push_back(r.complete ? 1 : 0);
   }
   unsigned long long n = packed.size();
@@ -162,13 +165,15 @@ Report MpiCheck::check_everywhere(Scene& scene, Model& model, const CollideOptio
   MPI_Bcast(packed.data(), static_cast<int>(n), MPI_UINT64_T, 0, MPI_COMM_WORLD);
   if (rank_ == 0) return r;
   Report thin;
-  for (std::size_t k = 0; k + 5 <= packed.size(); k += 5) {
+  for (std::size_t k = 0; k + 7 <= packed.size(); k += 7) {
     SurfacePairResult p;
     p.instance_a = static_cast<InstanceId>(packed[k]);
     p.instance_b = static_cast<InstanceId>(packed[k + 1]);
     p.surface_a = static_cast<SurfaceId>(packed[k + 2]);
     p.surface_b = static_cast<SurfaceId>(packed[k + 3]);
     p.contact = static_cast<ContactClass>(packed[k + 4]);
+    p.distance_lo = std::bit_cast<double>(packed[k + 5]);
+    p.distance_hi = std::bit_cast<double>(packed[k + 6]);
     thin.pairs.push_back(p);
   }
   thin.complete = !packed.empty() && packed.back() == 1;

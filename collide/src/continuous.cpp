@@ -6,6 +6,7 @@
 
 #include <cassert>
 #include <chrono>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -45,6 +46,8 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
   // Per instance pair, its timeline so far, and per surface pair of it.
   std::map<std::pair<InstanceId, InstanceId>, PairMotion> timeline;
   std::map<std::pair<InstanceId, InstanceId>, std::map<std::pair<SurfaceId, SurfaceId>, std::vector<MotionSpan>>> surfaces;
+  // Per instance pair, its closest approach over each stretch (path time).
+  std::map<std::pair<InstanceId, InstanceId>, std::vector<ClosestApproach>> closest;
   std::size_t k = 0;
   while (k < rows.size()) {
     const std::int64_t step = rows[k].step;
@@ -102,6 +105,10 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
         for (const MotionSpan& s : p.spans) append_span(into.spans, to_path_time(s, t0, t1));
         for (const SurfaceMotion& sp : p.surfaces)
           for (const MotionSpan& s : sp.spans) append_span(surfaces[{p.a, p.b}][{sp.a, sp.b}], to_path_time(s, t0, t1));
+        if (p.closest) {
+          const MotionSpan when = to_path_time({p.closest->s0, p.closest->s1, false}, t0, t1);
+          closest[{p.a, p.b}].push_back({p.closest->lo, p.closest->hi, when.s0, when.s1});
+        }
       }
     }
     k = next;
@@ -111,6 +118,15 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
   meter.finish();
   for (auto& [key, p] : timeline) {
     for (auto& [sk, spans] : surfaces[key]) p.surfaces.push_back({sk.first, sk.second, std::move(spans)});
+    // The path's minimum is the least of the stretches'; it lies where a stretch's can be below it.
+    if (const auto it = closest.find(key); it != closest.end()) {
+      ClosestApproach c{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+      for (const ClosestApproach& x : it->second) c.lo = std::min(c.lo, x.lo), c.hi = std::min(c.hi, x.hi);
+      for (const ClosestApproach& x : it->second)
+        if (x.lo <= c.hi) c.s0 = std::min(c.s0, x.s0), c.s1 = std::max(c.s1, x.s1);
+      p.closest = c;
+    }
     out.pairs.push_back(std::move(p));
   }
   return out;

@@ -1,6 +1,7 @@
 // Motion between two poses of a path (trajectory.h, "Motion between steps"): the interpolated pose
 // and a bound on how far a part's points travel over a stretch of it.
 #include "cadclash/trajectory.h"
+#include "closest.h"
 
 #include <algorithm>
 #include <cassert>
@@ -112,6 +113,18 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s)
       boxes[i].extend(model.surfaces[s].aabb.isEmpty() ? mesh_aabb(model.surfaces[s].mesh) : model.surfaces[s].aabb);
   }
+  // A pair moves apart or together over [s0, s1] by at most its two sides' travel: at most the two
+  // largest.
+  auto travel_over = [&](double s0, double s1) {
+    double first = 0.0, second = 0.0;
+    for (std::size_t i = 0; i < moving.size(); ++i) {
+      if (boxes[i].isEmpty()) continue;
+      const double t = travel_bound(from[i], to[i], boxes[i], s0, s1);
+      if (t > first) second = std::exchange(first, t);
+      else second = std::max(second, t);
+    }
+    return first + second;
+  };
   MotionResult out;
   auto place = [&](double s) {
     for (std::size_t i = 0; i < moving.size(); ++i) scene.set_pose(moving[i], interpolate_pose(from[i], to[i], s));
@@ -146,15 +159,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     const bool budget = out.checks + 3 <= motion.max_checks;
     std::set<PairKey> suspect;
     if (budget) {
-      // A pair moves apart or together by at most its two sides' travel: at most the two largest.
-      double first = 0.0, second = 0.0;
-      for (std::size_t i = 0; i < moving.size(); ++i) {
-        if (boxes[i].isEmpty()) continue;
-        const double t = travel_bound(from[i], to[i], boxes[i], st.s0, st.s1);
-        if (t > first) second = std::exchange(first, t);
-        else second = std::max(second, t);
-      }
-      const Contacts grown = check(st.s0, options.tolerance + first + second);
+      const Contacts grown = check(st.s0, options.tolerance + travel_over(st.s0, st.s1));
       if (grown.complete) {
         for (const PairKey& k : grown.open)
           if (concerns(k)) suspect.insert(k);
@@ -186,8 +191,28 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     stack.push_back({mid, st.s1, halve, false});
     stack.push_back({st.s0, mid, std::move(halve), false});
   }
-  place(1.0);
   std::map<std::pair<InstanceId, InstanceId>, PairMotion> by_pair;
+  if (options.clearance > 0.0) {
+    auto check_at = [&](double s, double grow) {
+      place(s);
+      CollideOptions o = options;
+      o.clearance = options.clearance + grow;
+      return motion.check ? motion.check(scene, o) : scene.check(o);
+    };
+    bool complete = true;
+    const std::size_t left = motion.max_checks > out.checks ? motion.max_checks - out.checks : 1;
+    std::size_t used = 0;
+    for (auto& [k, c] : detail::closest_approach(check_at, travel_over, options.clearance, motion.resolution, left,
+                                                 used, complete)) {
+      if (spans.count({k.first, k.second, kInvalidId, kInvalidId})) continue;  // may touch: its spans say where
+      PairMotion& p = by_pair[k];
+      p.a = k.first, p.b = k.second;
+      p.closest = c;
+    }
+    out.checks += used;
+    out.complete = out.complete && complete;
+  }
+  place(1.0);
   for (auto& [k, v] : spans) {
     std::sort(v.begin(), v.end(), [](const MotionSpan& x, const MotionSpan& y) { return x.s0 < y.s0; });
     const auto [a, b, sa, sb] = k;

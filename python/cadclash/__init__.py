@@ -19,7 +19,7 @@ Contracts:
 - Queries (``Scene.check``, ``collide``, ``replay``, ``load``) release the GIL; results do not depend
   on the thread count.
 """
-from ._types import (Counters, Diagnostic, InputError, ModelMemory, PairResult, PairTimeline, Provenance, Replay,
+from ._types import (ClosestApproach, Counters, Diagnostic, InputError, ModelMemory, PairResult, PairTimeline, Provenance, Replay,
                      Report, StepResult, SurfaceTimeline, Timeline, TimelineSpan, Timings)
 from ._options import CollideOptions
 from ._model import Instance, Model, Part, Surface, load
@@ -29,7 +29,7 @@ __all__ = [
     "load", "Model", "Part", "Instance", "Surface", "Provenance",
     "Scene", "collide", "replay", "CollideOptions",
     "Report", "PairResult", "Counters", "Timings", "ModelMemory", "StepResult", "Replay", "Timeline", "PairTimeline",
-    "SurfaceTimeline", "TimelineSpan", "Diagnostic",
+    "SurfaceTimeline", "TimelineSpan", "ClosestApproach", "Diagnostic",
     "InputError",
 ]
 __version__ = "0.1.0"

@@ -374,14 +374,27 @@ class SurfaceTimeline:
 
 
 @dataclass(frozen=True)
+class ClosestApproach:
+    """With a clearance: the pair's minimum distance over the path lies in [lo, hi] (mm) and is
+    reached within [t0, t1] (step numbers)."""
+
+    lo: float
+    hi: float
+    t0: float
+    t1: float
+
+
+@dataclass(frozen=True)
 class PairTimeline:
-    """One instance pair (paths) that may be in contact somewhere along the path: its spans (any of its
-    surface pairs, or containment) and each surface pair's."""
+    """One instance pair (paths) that may be in contact somewhere along the path, or (with a
+    clearance) comes within it: its spans (any of its surface pairs, or containment), each surface
+    pair's, and its closest approach (None without a clearance)."""
 
     a: str
     b: str
     spans: List[TimelineSpan]
     surfaces: List[SurfaceTimeline]
+    closest: Optional[ClosestApproach] = None
 
 
 @dataclass(frozen=True)
@@ -406,8 +419,9 @@ class Timeline:
             return [TimelineSpan(t0, t1, c) for t0, t1, c in v]
 
         return cls(resolution, checks, complete,
-                   [PairTimeline(a, b, spans(s), [SurfaceTimeline(tuple(sa), tuple(sb), spans(ss)) for sa, sb, ss in surfaces])
-                    for a, b, s, surfaces in pairs])
+                   [PairTimeline(a, b, spans(s), [SurfaceTimeline(tuple(sa), tuple(sb), spans(ss)) for sa, sb, ss in surfaces],
+                                 ClosestApproach(*closest) if closest is not None else None)
+                    for a, b, s, surfaces, closest in pairs])
 
 
 @dataclass(frozen=True)

@@ -186,7 +186,7 @@ void bind_report(pyb::module_& m) {
         if (!r.query) throw pyb::value_error("a trajectory report (--path) holds steps, not one query: read it with Replay.from_json");
         return query_tuple(*r.query);
       })
-      // (resolution, checks, complete, [(a, b, spans, [(side a, side b, spans)])]) with each span
+      // (resolution, checks, complete, [(a, b, spans, [(side a, side b, spans)], closest|None)]) with each span
       // (t0, t1, contact_at_ends) and each side as in query_tuple; None without a timeline.
       .def("_timeline", [](const CheckReport& r) -> pyb::object {
         if (!r.timeline) return pyb::none();
@@ -200,7 +200,9 @@ void bind_report(pyb::module_& m) {
           pyb::list surfaces;
           for (const ReportSurfaceTimeline& s : p.surfaces)
             surfaces.append(pyb::make_tuple(side_tuple(s.a), side_tuple(s.b), spans(s.spans)));
-          pairs.append(pyb::make_tuple(p.a, p.b, spans(p.spans), surfaces));
+          pyb::object closest = p.closest ? pyb::object(pyb::make_tuple(p.closest->lo, p.closest->hi, p.closest->t0, p.closest->t1))
+                                          : pyb::object(pyb::none());
+          pairs.append(pyb::make_tuple(p.a, p.b, spans(p.spans), surfaces, closest));
         }
         return pyb::make_tuple(r.timeline->resolution, r.timeline->checks, r.timeline->complete, pairs);
       })

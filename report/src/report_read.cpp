@@ -394,6 +394,12 @@ ReportTimeline read_timeline(const Json& j, const std::string& p) {
       rp.surfaces.push_back({read_side(field(surfaces[i], si, "a"), si + "/a"), read_side(field(surfaces[i], si, "b"), si + "/b"),
                              read_spans(field(surfaces[i], si, "spans"), si + "/spans")});
     }
+    if (pairs[k].contains("closest")) {  // with --clearance
+      const Json& c = object(pairs[k]["closest"], pk + "/closest");
+      const std::string pc = pk + "/closest";
+      rp.closest = ReportClosest{number(field(c, pc, "lo"), pc + "/lo"), number(field(c, pc, "hi"), pc + "/hi"),
+                                 number(field(c, pc, "t0"), pc + "/t0"), number(field(c, pc, "t1"), pc + "/t1")};
+    }
     t.pairs.push_back(std::move(rp));
   }
   return t;

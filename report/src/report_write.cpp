@@ -338,7 +338,8 @@ ReportTimeline timeline_report(const Model& model, const PathResult& r, double r
     return out;
   };
   for (const PairMotion& p : r.pairs) {
-    ReportPairTimeline rp{model.instances[p.a].path, model.instances[p.b].path, spans_of(p.spans), {}};
+    ReportPairTimeline rp{model.instances[p.a].path, model.instances[p.b].path, spans_of(p.spans), {}, {}};
+    if (p.closest) rp.closest = ReportClosest{p.closest->lo, p.closest->hi, p.closest->s0, p.closest->s1};
     for (const SurfaceMotion& s : p.surfaces)
       rp.surfaces.push_back({side(model, p.a, s.a), side(model, p.b, s.b), spans_of(s.spans)});
     t.pairs.push_back(std::move(rp));
@@ -363,7 +364,10 @@ nlohmann::json timeline_json(const ReportTimeline& t) {
       for (nlohmann::json* j : {&a, &b}) j->erase("uncertainty");  // not the decision's: not known here
       surfaces.push_back({{"a", std::move(a)}, {"b", std::move(b)}, {"spans", spans_json(s.spans)}});
     }
-    pairs.push_back({{"a", p.a}, {"b", p.b}, {"spans", spans_json(p.spans)}, {"surfaces", std::move(surfaces)}});
+    nlohmann::json jp{{"a", p.a}, {"b", p.b}, {"spans", spans_json(p.spans)}, {"surfaces", std::move(surfaces)}};
+    if (p.closest)
+      jp["closest"] = {{"lo", p.closest->lo}, {"hi", p.closest->hi}, {"t0", p.closest->t0}, {"t1", p.closest->t1}};
+    pairs.push_back(std::move(jp));
   }
   return {{"resolution", t.resolution}, {"checks", t.checks}, {"complete", t.complete}, {"pairs", std::move(pairs)}};
 }

@@ -261,5 +261,39 @@ TEST(ContinuousPath, ContactAcrossStepsIsOneSpan) {
   }
 }
 
+// With a clearance, how close a pair comes (ClosestApproach): a cube flies diagonally past another,
+// nearest at s = 0.49 (its corner region sqrt(0.5) mm from the other's: x gap 0.3 - a, y gap a + 0.7
+// with a = -10 + 20 s). The minimum lies in [lo, hi], the time bracket holds 0.49 and is narrow; a
+// cube far away within no clearance is not listed; without a clearance, no closest approach.
+TEST(ContinuousMotion, ClosestApproachOfAPartFlyingPast) {
+  Model m;
+  const PartId cube = add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2));
+  const InstanceId flying = add_instance(m, "/flying", cube), still = add_instance(m, "/still", cube),
+                   far = add_instance(m, "/far", cube);
+  Scene scene(m);
+  scene.set_pose(still, translation(2.3, -2.7, 0));
+  scene.set_pose(far, translation(50, 50, 0));
+  const InstanceId moving[] = {flying};
+  const Pose a[] = {translation(-10, -10, 0)}, b[] = {translation(10, 10, 0)};
+  CollideOptions o;
+  o.clearance = 2.0;
+  const MotionResult r = check_motion(scene, m, moving, a, b, o, {});
+  ASSERT_EQ(r.pairs.size(), 1u);
+  EXPECT_EQ(r.pairs[0].a, flying);
+  EXPECT_EQ(r.pairs[0].b, still);
+  EXPECT_TRUE(r.pairs[0].spans.empty());
+  ASSERT_TRUE(r.pairs[0].closest);
+  const ClosestApproach& c = *r.pairs[0].closest;
+  EXPECT_LE(c.lo, std::sqrt(0.5));
+  EXPECT_GE(c.hi, std::sqrt(0.5) - 1e-12);
+  EXPECT_LE(c.hi - c.lo, 0.03);  // the travel over a resolution-wide part: 28.3 mm / 1000
+  EXPECT_LE(c.s0, 0.49);
+  EXPECT_GE(c.s1, 0.49);
+  EXPECT_LE(c.s1 - c.s0, 0.05);
+  EXPECT_TRUE(r.complete);
+  const MotionResult none = check_motion(scene, m, moving, a, b, {}, {});
+  EXPECT_TRUE(none.pairs.empty());
+}
+
 }  // namespace
 }  // namespace cadclash

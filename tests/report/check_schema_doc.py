@@ -150,6 +150,7 @@ def main() -> int:
         [*boxes, "--all-triangles", "--clearance", "1"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv"],
         [boxes[0], boxes[2], "--path", data / "collide" / "path_ok.csv", "--continuous"],
+        [boxes[0], boxes[2], "--path", data / "collide" / "path_pass.csv", "--continuous", "--clearance", "0.6"],
         [boxes[0], boxes[1], "--volume"],
     ]
     seen: dict = {}

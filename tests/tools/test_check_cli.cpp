@@ -273,7 +273,23 @@ TEST(CheckCli, ContinuousTrajectoryHasATimeline) {
     EXPECT_EQ(spans.back()["t1"], 2.0);
     EXPECT_EQ(spans.back()["contact_at_ends"], true);
     EXPECT_FALSE(t["pairs"][0]["surfaces"].empty());
+    EXPECT_FALSE(t["pairs"][0].contains("closest"));  // no --clearance
   }
+  // With --clearance, a path that passes 0.3 mm from box_a at step 1 and never touches: the pair is
+  // listed with no spans and its closest approach, 0.3 within [lo, hi], reached near t = 1.
+  const std::string pass_json = tmp("continuous_pass.json");
+  const Proc pass = run("check " + data("box_a.obj") + " " + data("box_near.obj") + " --path " + data("path_pass.csv") +
+                        " --continuous --tolerance 0.01 --clearance 0.6 --no-timings --json " + pass_json);
+  ASSERT_EQ(pass.code, 0) << pass.out;
+  const nlohmann::json pp = nlohmann::json::parse(read(pass_json))["timeline"]["pairs"];
+  ASSERT_EQ(pp.size(), 1u);
+  EXPECT_TRUE(pp[0]["spans"].empty());
+  const nlohmann::json& c = pp[0]["closest"];
+  EXPECT_LE(c["lo"].get<double>(), 0.3);
+  EXPECT_GE(c["hi"].get<double>(), 0.3 - 1e-9);
+  EXPECT_LE(c["hi"].get<double>() - c["lo"].get<double>(), 0.01);
+  EXPECT_LE(c["t0"].get<double>(), 1.0);
+  EXPECT_GE(c["t1"].get<double>(), 1.0);
   const std::string back = tmp("path_back.csv");
   std::ofstream(back) << "step,instance_path,tx,ty,tz,qw,qx,qy,qz\n0,/box_near.obj/box_near,0,0,0,1,0,0,0\n"
                          "2,/box_near.obj/box_near,-0.5,0,0,1,0,0,0\n1,/box_near.obj/box_near,0,0,0,1,0,0,0\n";

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -78,12 +79,17 @@ double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, do
 // stretch where the pair is proved in contact at both ends is not halved further (in between it is
 // not proved either way). Contact that begins and ends between two steps, a part passing through a
 // thin plate, is found: such a stretch is never cleared.
+// With options.clearance > 0 the pairs that come within the clearance somewhere also get their
+// closest approach (PairMotion::closest): a branch and bound over the stretch, each part of it
+// bounded below by the check at its start (with the clearance grown by the travel) less the
+// travel, pruned where that cannot beat the smallest upper bound found, halved down to
+// `resolution` elsewhere.
 struct MotionOptions {
   double resolution = 1e-3;      // width of the spans a contact may begin or end in, as a fraction of the stretch (> 0)
   std::size_t max_checks = 4096;  // static checks at most; past it the open spans are listed as they are
   // How each static check runs; empty: Scene::check. A distributed run (cadclash check under mpirun)
-  // passes its own: it must return, on every process, reports with the same pairs (ids and classes)
-  // and the same `complete`, so that every process takes the same stretches.
+  // passes its own: it must return, on every process, reports with the same pairs (ids, classes and
+  // distance bounds) and the same `complete`, so that every process takes the same stretches.
   std::function<Report(Scene&, const CollideOptions&)> check;
 };
 struct MotionSpan {
@@ -96,12 +102,23 @@ struct SurfaceMotion {
   SurfaceId a = kInvalidId, b = kInvalidId;  // a surface of instance a's part, one of b's
   std::vector<MotionSpan> spans;             // ascending, disjoint
 };
+// How close a pair comes over a stretch (with options.clearance > 0): the minimum distance of its
+// exact faces lies in [lo, hi] and is reached within [s0, s1] (certified: hi is a static check's
+// upper bound at a point of the stretch, lo a lower bound over all of it; s0 and s1 bound every
+// place where the distance can be below hi). lo is 0 when the pair may touch.
+struct ClosestApproach {
+  double lo = 0.0, hi = 0.0;
+  double s0 = 0.0, s1 = 0.0;
+};
 struct PairMotion {
   InstanceId a = kInvalidId, b = kInvalidId;  // a < b
   // The instance pair's: where any of its surface pairs (or containment) may be in contact.
   std::vector<MotionSpan> spans;              // ascending, disjoint
   // Each surface pair's own (by (a, b)): where that pair may be in contact, the same guarantees.
   std::vector<SurfaceMotion> surfaces;
+  // With options.clearance > 0: how close the pair comes, when it comes within the clearance
+  // somewhere and may touch nowhere (it is then listed with no spans; a pair with spans has none).
+  std::optional<ClosestApproach> closest;
 };
 struct MotionResult {
   std::vector<PairMotion> pairs;  // by (a, b); a pair not listed is out of contact over the whole stretch

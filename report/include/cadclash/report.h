@@ -334,10 +334,16 @@ struct ReportSurfaceTimeline {
   ReportSide a, b;  // the surfaces (instance, part, surface, its STEP #id ...); uncertainty not set
   std::vector<ReportSpan> spans;
 };
+// With --clearance: the minimum distance over the path lies in [lo, hi] and is reached within
+// [t0, t1] (step numbers).
+struct ReportClosest {
+  double lo = 0.0, hi = 0.0, t0 = 0.0, t1 = 0.0;
+};
 struct ReportPairTimeline {
   std::string a, b;  // instance paths
   std::vector<ReportSpan> spans;
   std::vector<ReportSurfaceTimeline> surfaces;
+  std::optional<ReportClosest> closest;  // with --clearance, when the pair comes within it
 };
 struct ReportTimeline {
   double resolution = 0.0;   // the spans' width where a contact begins or ends, a fraction of a stretch
