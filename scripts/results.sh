@@ -115,6 +115,9 @@ echo "results: the model-uncertainty band on real-part boards (scripts/uncertain
 bash "$root/scripts/uncertainty_bench.sh" "$build" "$out/uncertainty" >"$out/uncertainty.md"
 echo "results: certified against --fast on real-part boards (scripts/boards_bench.sh)"
 bash "$root/scripts/boards_bench.sh" "$build" "$out/boards" "$out/uncertainty" >"$out/boards.md"
+echo "results: continuous motion along paths (scripts/continuous_bench.sh)"
+bash "$root/scripts/continuous_bench.sh" "$build" >"$out/continuous.md" ||
+  echo "_continuous_bench: the reference found a contact outside cadclash's spans (see above)._" >>"$out/continuous.md"
 elapsed=$(( $(date +%s) - start ))
 
 # Plots next to the page; links in the embedded tables point there.
@@ -152,6 +155,7 @@ while IFS= read -r line || [ -n "$line" ]; do
     @SCALE@) cat "$out/scale.md" ;;
     @UNCERTAINTY_BAND@) cat "$out/uncertainty.md" ;;
     @BOARDS@) cat "$out/boards.md" ;;
+    @CONTINUOUS@) cat "$out/continuous.md" ;;
     @IMPORT_PEER@)
       # Measured by scripts/import_peer_bench.sh (~20 min), not here: its last table, as it is.
       bench=$root/out/import_peer_bench
