@@ -3,6 +3,7 @@
 #include "cadclash/trajectory.h"
 
 #include "cadclash/internal/progress_meter.h"
+#include "replay_budget.h"
 
 #include <cassert>
 #include <chrono>
@@ -53,18 +54,13 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
     const std::int64_t step = rows[k].step;
     CollideOptions step_options = options;
     step_options.progress = nullptr;  // the path reports its steps, not the checks inside them
-    if (options.time_budget_seconds > 0.0) {
-      const double left = options.time_budget_seconds -
-                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const bool out_of_time = left <= 0.0 || (!out.steps.empty() && !out.steps.back().report.complete &&
-                                               out.steps.back().report.stopped_by.find("time") != std::string::npos);
-      if (out_of_time) {
-        diagnostics.push_back(steps_not_checked(rows, k, file));
-        out.complete = false;
-        break;
-      }
-      step_options.time_budget_seconds = left;
+    const std::optional<double> left = detail::replay_time_left(options, start, out.steps);
+    if (!left) {
+      diagnostics.push_back(steps_not_checked(rows, k, file));
+      out.complete = false;
+      break;
     }
+    step_options.time_budget_seconds = *left;
     if (!out.steps.empty() && step <= out.steps.back().step) {
       diagnostics.push_back({Severity::Error, file, rows[k].line, -1,
                              "step " + std::to_string(step) + " does not follow step " +

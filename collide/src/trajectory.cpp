@@ -2,6 +2,7 @@
 #include "cadclash/collide.h"
 
 #include "cadclash/internal/progress_meter.h"
+#include "replay_budget.h"
 
 #include <cassert>
 #include <chrono>
@@ -140,17 +141,12 @@ std::vector<StepResult> replay_trajectory(Scene& scene, std::span<const Trajecto
     const std::int64_t step = rows[k].step;
     CollideOptions step_options = options;
     step_options.progress = nullptr;  // the replay reports its steps, not the checks inside them
-    if (options.time_budget_seconds > 0.0) {
-      const double left = options.time_budget_seconds -
-                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const bool out_of_time = left <= 0.0 || (!results.empty() && !results.back().report.complete &&
-                                               results.back().report.stopped_by.find("time") != std::string::npos);
-      if (out_of_time) {
-        diagnostics.push_back(steps_not_checked(rows, k, file));
-        break;
-      }
-      step_options.time_budget_seconds = left;
+    const std::optional<double> left = detail::replay_time_left(options, start, results);
+    if (!left) {
+      diagnostics.push_back(steps_not_checked(rows, k, file));
+      break;
     }
+    step_options.time_budget_seconds = *left;
     k = apply_trajectory_step(scene, rows, k, diagnostics, file);
     results.push_back({step, scene.check(step_options)});
     if (meter.active()) meter.add(1, std::to_string(step));

@@ -391,6 +391,16 @@ PinInHole pin_in_hole(const TopoDS_Shape& pin, double shift) {
   return out;
 }
 
+// Apart without OCCT's distance, nothing undecided, `refined` faces meshed finer and none of them
+// (nor any region) the board's.
+void expect_apart_board_untouched(const Outcome& apart, const PinInHole& s, std::size_t refined) {
+  EXPECT_FALSE(apart.contact);
+  EXPECT_EQ(apart.report.counters.refined_surfaces, refined);
+  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
+  EXPECT_EQ(apart.report.counters.undecided, 0u);
+  EXPECT_EQ(s.board->regions.load() + s.board->whole.load(), 0);
+}
+
 // A square pin off the axis of its hole, its far corners 0.1 mm from the rim, the near ones deep
 // inside: the board's round hole keeps its sides off the top and bottom faces by their farthest
 // vertex from the axis, so at tolerance 0.095 it is apart by the surfaces' parameters alone
@@ -405,12 +415,8 @@ TEST(HoleBound, ASquarePinNearTheRimIsApartByTheHolesAxisWithoutRefinement) {
   PinInHole s = pin_in_hole(pin, 0.0);
   s.m.instances[1].pose = moved(Vec3(46 + shift, 54, 0), std::numbers::pi / 4);
   const Outcome apart = check_pair(s.m, 0.095);
-  EXPECT_FALSE(apart.contact);
+  expect_apart_board_untouched(apart, s, 0);
   EXPECT_GE(apart.report.counters.decided_analytic, 1u);
-  EXPECT_EQ(apart.report.counters.refined_surfaces, 0u);
-  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
-  EXPECT_EQ(apart.report.counters.undecided, 0u);
-  EXPECT_EQ(s.board->regions.load() + s.board->whole.load(), 0);
   // The pin's far corner edge touches the hole's wall and both the board's faces at their rims.
   const Outcome near = check_pair(s.m, 0.1005);
   const std::uint32_t top = plane_at(s.m, 2.0), bottom = plane_at(s.m, 0.0);
@@ -429,12 +435,8 @@ TEST(HoleBound, ARoundPinNearTheRimRefinesThePinOnly) {
   for (std::uint32_t i = s.m.parts[1].first_surface; i < s.m.surfaces.size(); ++i)
     ASSERT_GT(s.m.surfaces[i].deflection, 0.0025) << "the pin's triangles must be too coarse for the bound";
   const Outcome apart = check_pair(s.m, 0.098);
-  EXPECT_FALSE(apart.contact);
+  expect_apart_board_untouched(apart, s, 1);
   EXPECT_GE(apart.report.counters.decided_refined, 1u);
-  EXPECT_EQ(apart.report.counters.refined_surfaces, 1u);
-  EXPECT_EQ(apart.report.counters.exact_queries, 0u);
-  EXPECT_EQ(apart.report.counters.undecided, 0u);
-  EXPECT_EQ(s.board->regions.load() + s.board->whole.load(), 0);
   EXPECT_TRUE(check_pair(s.m, 0.102).contact);
 }
 
