@@ -69,18 +69,8 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
       out.complete = false;
       break;
     }
-    // The step's rows, the last one for an instance named twice.
-    std::map<InstanceId, Pose> to;
     std::size_t next = k;
-    for (; next < rows.size() && rows[next].step == step; ++next) {
-      const InstanceId id = scene.find_instance(rows[next].path);
-      if (id == kInvalidId) {
-        diagnostics.push_back({Severity::Warning, file, rows[next].line, -1,
-                               "no instance with path '" + rows[next].path + "'; row skipped"});
-        continue;
-      }
-      to[id] = rows[next].pose;
-    }
+    const std::map<InstanceId, Pose> to = detail::step_poses(scene, rows, next, diagnostics, file);
     if (out.steps.empty()) {
       for (const auto& [id, pose] : to) scene.set_pose(id, pose);
     } else {

@@ -5,6 +5,8 @@
 #include "cadclash/trajectory.h"
 
 #include <chrono>
+#include <map>
+#include <span>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,5 +27,11 @@ inline std::optional<double> replay_time_left(const CollideOptions& options,
   if (left <= 0.0 || stopped) return std::nullopt;
   return left;
 }
+
+// The poses the step that starts at rows[k] gives (the last row for an instance named twice), and
+// the index of the first row after it; a row naming an unknown instance becomes a warning naming
+// `file` and its line and is skipped. Precondition: k < rows.size().
+std::map<InstanceId, Pose> step_poses(const Scene& scene, std::span<const TrajectoryRow> rows, std::size_t& k,
+                                      std::vector<Diagnostic>& diagnostics, const std::string& file);
 
 }  // namespace cadclash::detail

@@ -101,10 +101,13 @@ std::vector<TrajectoryRow> parse_trajectory(const std::string& text, const std::
   return rows;
 }
 
-std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> rows, std::size_t k,
-                                  std::vector<Diagnostic>& diagnostics, const std::string& file) {
+namespace detail {
+
+std::map<InstanceId, Pose> step_poses(const Scene& scene, std::span<const TrajectoryRow> rows, std::size_t& k,
+                                      std::vector<Diagnostic>& diagnostics, const std::string& file) {
   assert(k < rows.size());
   const std::int64_t step = rows[k].step;
+  std::map<InstanceId, Pose> poses;
   for (; k < rows.size() && rows[k].step == step; ++k) {
     const InstanceId id = scene.find_instance(rows[k].path);
     if (id == kInvalidId) {
@@ -112,8 +115,16 @@ std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> r
                              "no instance with path '" + rows[k].path + "'; row skipped"});
       continue;
     }
-    scene.set_pose(id, rows[k].pose);
+    poses[id] = rows[k].pose;
   }
+  return poses;
+}
+
+}  // namespace detail
+
+std::size_t apply_trajectory_step(Scene& scene, std::span<const TrajectoryRow> rows, std::size_t k,
+                                  std::vector<Diagnostic>& diagnostics, const std::string& file) {
+  for (const auto& [id, pose] : detail::step_poses(scene, rows, k, diagnostics, file)) scene.set_pose(id, pose);
   return k;
 }
 

@@ -424,6 +424,18 @@ TEST(HoleBound, ASquarePinNearTheRimIsApartByTheHolesAxisWithoutRefinement) {
   for (const SurfacePairResult& p : near.report.pairs)
     faces += (p.surface_a == top || p.surface_a == bottom) && p.contact == ContactClass::Touching;
   EXPECT_EQ(faces, 2 * 2) << "the two sides meeting at the far corner touch both faces at the rim";
+  // The same verdicts with the whole assembly turned and moved 10^6 mm away.
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1e6, -4e5, 3e5));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  for (Instance& i : s.m.instances) i.pose = far * i.pose;
+  const Outcome far_apart = check_pair(s.m, 0.095);
+  expect_apart_board_untouched(far_apart, s, 0);
+  EXPECT_GE(far_apart.report.counters.decided_analytic, 1u);
+  int far_faces = 0;
+  for (const SurfacePairResult& p : check_pair(s.m, 0.1005).report.pairs)
+    far_faces += (p.surface_a == top || p.surface_a == bottom) && p.contact == ContactClass::Touching;
+  EXPECT_EQ(far_faces, 2 * 2);
 }
 
 // A round pin 0.1 mm from the rim, its triangles up to 0.0036 mm inside its cylinder: too coarse
