@@ -112,6 +112,7 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(t.split_failed ? 1 : 0);
   w.u64(t.pieces);
   w.u64(t.pieces_cached);
+  write_component_placements(w, t.placements);
   if (!t.doc.IsNull()) {
     w.u64(1);
     const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
@@ -157,6 +158,11 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.split_failed = r.u64() == 1;
   t.pieces = r.u64();
   t.pieces_cached = r.u64();
+  t.unpacked = true;
+  if (!read_component_placements(r, t.placements)) {
+    why = "the placements are not whole";
+    return false;
+  }
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
@@ -233,7 +239,13 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   BrepPartTimings part_timings;
   const char* format = t.kind == SourceKind::IgesFace ? "IGES" : "STEP";
   if (!t.doc.IsNull()) {
-    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings);
+    std::vector<std::vector<std::string>> chains;
+    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings, &chains);
+    if (t.placements)
+      if (std::optional<Placements> p = file_placements(*t.placements, chains)) {
+        p->stored = t.unpacked;
+        result.files.back().placements = std::make_shared<const Placements>(std::move(*p));
+      }
     if (result.model.instances.empty()) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, std::string(format) + " file produced no shape"});
       result.complete = false;

@@ -5,6 +5,7 @@
 
 #include "cad_xcaf.h"
 #include "isolated_run.h"
+#include "step_placements.h"
 
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
@@ -39,6 +40,10 @@ struct Transfer {
   // Products: an XCAF document (closed by the destructor) and the entities of its faces.
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;
+  // STEP products: every occurrence's component and placement (step_placements.h); nullopt when
+  // one is placed otherwise, or not STEP.
+  std::optional<std::vector<ComponentPlacement>> placements;
+  bool unpacked = false;  // brought back from a child process (unpack_transfer): the document was stored and read
   // Or loose faces of one part: a compound, the entity #id of each face in TopExp::MapShapes order,
   // and the error that says how many were recovered (none for a .brep's shape, one part by design).
   TopoDS_Shape loose;

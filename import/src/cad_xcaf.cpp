@@ -81,6 +81,19 @@ std::vector<std::string> sibling_components(const std::vector<std::string>& name
   return out;
 }
 
+}  // namespace
+
+Pose pose_of_transformation(const gp_Trsf& trsf) {
+  Pose pose = Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) pose.matrix()(r, c) = trsf.Value(r + 1, c + 1) / trsf.ScaleFactor();
+    pose.matrix()(r, 3) = trsf.Value(r + 1, 4);
+  }
+  return pose;
+}
+
+namespace {
+
 struct Walker {
   Handle(XCAFDoc_ShapeTool) shapes;
   const std::string& file;
@@ -90,6 +103,8 @@ struct Walker {
   std::vector<Instance> instances;  // part = index into `leaves`
   std::vector<Diagnostic>& diagnostics;
   std::vector<std::string> products{};  // the product names from the root down to the label visited
+  std::vector<std::string> chain{};      // the component label entries from the root down to the label visited
+  std::vector<std::vector<std::string>> chains{};  // per instance, its chain
 
   void visit(const TDF_Label& label, const TopLoc_Location& location, const std::string& path, int depth) {
     products.push_back(label_name(label));
@@ -125,9 +140,14 @@ struct Walker {
       }
       const std::vector<std::string> parts = sibling_components(names);
       for (std::size_t i = 0; i < referred.size(); ++i) {
-        const TopLoc_Location child = location * XCAFDoc_ShapeTool::GetLocation(components(static_cast<Standard_Integer>(i) + 1));
+        const TDF_Label& component = components(static_cast<Standard_Integer>(i) + 1);
+        const TopLoc_Location child = location * XCAFDoc_ShapeTool::GetLocation(component);
+        TCollection_AsciiString entry;
+        TDF_Tool::Entry(component, entry);
+        chain.emplace_back(entry.ToCString());
         // An only child with a generic name adds nothing to its parent's path, which stays unique.
         visit(referred[i], child, referred.size() == 1 && generic_name(names[i]) ? path : path + "/" + parts[i], depth + 1);
+        chain.pop_back();
       }
       return;
     }
@@ -147,11 +167,7 @@ struct Walker {
     Instance instance;
     instance.path = path;
     instance.part = static_cast<PartId>(it->second);
-    Pose pose = Pose::Identity();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) pose.matrix()(r, c) = trsf.Value(r + 1, c + 1) / trsf.ScaleFactor();
-      pose.matrix()(r, 3) = trsf.Value(r + 1, 4);
-    }
+    const Pose pose = pose_of_transformation(trsf);
     for (int r = 0; r < 3; ++r) {
       if (in_supported_range(pose.translation()[r])) continue;
       char value[40];
@@ -164,6 +180,7 @@ struct Walker {
     }
     instance.pose = pose;
     instances.push_back(std::move(instance));
+    chains.push_back(chain);
   }
 };
 
@@ -256,7 +273,7 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
                        const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings) {
+                       BrepPartTimings* timings, std::vector<std::vector<std::string>>* chains) {
   Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, {}, result.diagnostics};
   TDF_LabelSequence roots;
   walker.shapes->GetFreeShapes(roots);
@@ -323,11 +340,13 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
   }
   std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
-  for (Instance& instance : walker.instances) {
+  for (std::size_t k = 0; k < walker.instances.size(); ++k) {
+    Instance& instance = walker.instances[k];
     const PartId id = id_of_leaf[instance.part];
     if (id == kInvalidId) continue;  // its part was dropped and reported above
     instance.part = id;
     result.model.instances.push_back(std::move(instance));
+    if (chains) chains->push_back(std::move(walker.chains[k]));
   }
 }
 

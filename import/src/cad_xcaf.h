@@ -9,6 +9,7 @@
 #include <Interface_InterfaceModel.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopoDS_Shape.hxx>
+#include <gp_Trsf.hxx>
 #include <Transfer_TransientProcess.hxx>
 
 #include <functional>
@@ -55,9 +56,15 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 // and placement, one part per distinct leaf shape (shared by all its instances), tessellated as the
 // options say. Face tags come from `faces` (by TShape) and the document's colours.
 // `timings`, when given, gets add_brep_parts' seconds added.
+// `chains`, when given, gets per instance added (in order) the entries of the component labels
+// from the root down to it.
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
                        const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings = nullptr);
+                       BrepPartTimings* timings = nullptr, std::vector<std::vector<std::string>>* chains = nullptr);
+
+// An instance's pose from its location's transformation, as add_xcaf_document makes it (the scale
+// divided out of the rotation part: the walk warns about a scale).
+Pose pose_of_transformation(const gp_Trsf& trsf);
 
 // The file's stem ("dir/part.brep" → "part").
 std::string cad_file_stem(const std::string& path);

@@ -1,6 +1,7 @@
 // The import cache: entry names from a SHA-256 of the file and the options, entries checked whole
 // before use, written through a temporary file and a rename.
 #include "import_cache.h"
+#include "step_placements.h"
 
 #include "cadclash/internal/byte_io.h"
 
@@ -13,6 +14,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -82,17 +84,29 @@ std::string build_identity() {
 // build reading them.
 // Doubles in hexadecimal, so no two settings share a key. `parallel_files` and the threads BRepMesh
 // uses do not change the result, so they are not in it.
-std::string cache_key(const std::string& path, const std::string& bytes, const ImportOptions& o) {
+std::string options_key(const std::string& path, const ImportOptions& o) {
   std::ostringstream k;
   k << std::hexfloat;
-  k << "cadclash import cache " << kCacheFormat << "\n" << build_identity() << "\nocct " << OCC_VERSION_COMPLETE << "\nfile sha256 "
-    << hex(sha256(bytes)) << "\npath " << path << "\ndeflection " << o.tessellation.linear_deflection << " relative "
+  k << "path " << path << "\ndeflection " << o.tessellation.linear_deflection << " relative "
     << o.tessellation.relative << " angular " << o.tessellation.angular_deflection << " verify "
     << o.tessellation.verify_deflection << " time limit " << o.tessellation.time_limit_seconds << "\nlazy " << o.lazy
     << " isolated " << o.isolate_cad_readers << " reader time limit " << o.reader_time_limit_seconds
     << " model tolerance " << o.model_tolerance << " uncertainty " << static_cast<int>(o.uncertainty) << " "
     << o.uncertainty_value << '\n';
   return k.str();
+}
+
+std::string cache_key(const std::string& path, const std::string& bytes, const ImportOptions& o) {
+  return "cadclash import cache " + std::to_string(kCacheFormat) + "\n" + build_identity() + "\nocct " + OCC_VERSION_COMPLETE +
+         "\nfile sha256 " + hex(sha256(bytes)) + "\n" + options_key(path, o);
+}
+
+// A path's placements entry (step_placements.h): which entry holds the model of the file last
+// read at `path`, what its text was without its placements' numbers, and how those numbers make
+// its instances' poses. One per path and options: the file at a path is what users edit.
+std::string placements_key(const std::string& path, const ImportOptions& o) {
+  return "cadclash import cache " + std::to_string(kCacheFormat) + "\n" + build_identity() + "\nocct " + OCC_VERSION_COMPLETE +
+         "\nplacements of the file at\n" + options_key(path, o);
 }
 
 std::string entry_name(const std::string& key) { return hex(sha256(key)) + ".entry"; }
@@ -274,6 +288,91 @@ CacheRecord::Entry record_entry(std::string key, ImportResult stored) {
   return e;
 }
 
+namespace {
+
+// The placements entry's payload: the skeleton of the file's text, the key of the entry holding its
+// model, and its Placements.
+std::string placements_payload(const std::string& skeleton, const std::string& file_key, const Placements& p,
+                               const std::vector<std::int64_t>& free) {
+  ByteWriter w;
+  w.str(skeleton);
+  w.str(file_key);
+  w.str(save_placements(p));
+  w.u64(free.size());
+  for (const std::int64_t id : free) w.i64(id);
+  return std::move(w.out);
+}
+
+// After `result` was read from `bytes` and stored under `file_key`: the path's placements entry,
+// when its instances are placed by numbers this can recompute (step_placements.h) and recomputing
+// them from this text gives every pose bit for bit. Nothing said when it is not stored: the next
+// edit of the file is then read as any other file is.
+void store_placements(const std::string& path, const std::string& bytes, const ImportOptions& options,
+                      const std::string& file_key, const ImportResult& result) {
+  if (result.files.empty() || !result.files.front().placements) return;
+  const Placements& p = *result.files.front().placements;
+  if (p.components.empty() || p.chains.size() != result.model.instances.size()) return;
+  for (const Diagnostic& d : result.diagnostics)  // a pose the walk warned about or dropped
+    if (d.message.find(" is placed ") != std::string::npos) return;
+  const std::vector<std::int64_t> ids = p.value_ids();
+  const std::vector<std::int64_t> free = free_placement_values(bytes, ids, p.axis_ids());
+  if (free.empty()) return;  // no number of this file can change without changing more than poses
+  const std::optional<PlacementText> text = placement_text(bytes, ids, free);
+  if (!text) return;
+  // Bit for bit: a pose the reader makes with a -0 where this makes a +0 is not the same pose.
+  const std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
+  if (!poses) return;
+  for (std::size_t k = 0; k < poses->size(); ++k)
+    if (std::memcmp((*poses)[k].matrix().data(), result.model.instances[k].pose.matrix().data(), 16 * sizeof(double)) != 0)
+      return;
+  std::string why;
+  write_cache_entry(options.cache_dir, placements_key(path, options), placements_payload(text->skeleton, file_key, p, free), why);
+}
+
+// The file at `path` when the cache holds an earlier version of it that differs only in its
+// placements' numbers: that version's model with each instance's pose computed from `bytes`.
+// A damaged placements entry adds a warning to `notes` (the file is then read, and the entry
+// rewritten).
+std::optional<ImportResult> placed_import(const std::string& path, const std::string& bytes, const ImportOptions& options,
+                                          std::vector<Diagnostic>& notes) {
+  const CacheRead index = read_cache_entry(options.cache_dir, placements_key(path, options));
+  if (!index.damaged.empty())
+    notes.push_back(cache_warning(path, std::string(kCacheNote) + index.file + " is damaged (" + index.damaged +
+                                            "); the file was read and the entry rewritten"));
+  if (!index.payload) return std::nullopt;
+  ByteReader r{*index.payload};
+  const std::string skeleton = r.str(), file_key = r.str(), recipe = r.str();
+  std::vector<std::int64_t> free(r.count(8));
+  for (std::int64_t& id : free) id = r.i64();
+  Placements p;
+  if (!r.ok || r.at != index.payload->size() || !load_placements(recipe, p)) return std::nullopt;
+  const std::optional<PlacementText> text = placement_text(bytes, p.value_ids(), free);
+  if (!text || text->skeleton != skeleton) return std::nullopt;
+  const std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
+  if (!poses) return std::nullopt;  // read: the reader says what is wrong with the new poses
+  const CacheRead file = read_cache_entry(options.cache_dir, file_key);
+  ImportResult placed;
+  std::string why;
+  if (!file.payload || !load_import(*file.payload, placed, why) || placed.model.instances.size() != poses->size())
+    return std::nullopt;
+  placed.files.assign(1, FileImport{path, CacheUse::Placements, {}});
+  if (options.lazy) {  // triangles a check makes go to the entry the parts came from
+    auto record = std::make_shared<CacheRecord>();
+    record->dir = options.cache_dir;
+    record->max_bytes = options.cache_max_bytes;
+    record->file = record_entry(file_key, placed);
+    placed.files.back().cache_record = std::move(record);
+  }
+  for (std::size_t k = 0; k < poses->size(); ++k) placed.model.instances[k].pose = (*poses)[k];
+  return placed;
+}
+
+}  // namespace
+
+std::string placements_entry_name(const std::string& path, const ImportOptions& options) {
+  return entry_name(placements_key(path, options));
+}
+
 std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options) {
   const std::optional<std::string> bytes = file_bytes(path);
   if (!bytes) return std::nullopt;
@@ -311,7 +410,18 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
                                       "); the file was read again and the entry rewritten");
   }
 
+  std::vector<Diagnostic> placed_notes;
+  if (!damaged) {
+    const auto placed_start = std::chrono::steady_clock::now();
+    if (std::optional<ImportResult> placed = placed_import(path, *bytes, options, placed_notes)) {
+      placed->files.back().timings.read = seconds_since(placed_start);
+      prune_cache(options.cache_dir, options.cache_max_bytes);
+      return std::move(*placed);
+    }
+  }
+
   ImportResult result = read();
+  result.diagnostics.insert(result.diagnostics.begin(), placed_notes.begin(), placed_notes.end());
   result.files.front().cache = damaged ? CacheUse::Rebuilt : CacheUse::Miss;
   if (stopped_by_time_limit(result, options)) return result;
   // Stored without this run's warning about the damaged entry: a later run read from it says what
@@ -345,6 +455,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
       if (!is_cache_note(d)) stored.diagnostics.push_back(d);
     record->file = record_entry(key, std::move(stored));
   }
+  if (!ec && why.empty()) store_placements(path, *bytes, options, key, result);
   prune_cache(options.cache_dir, options.cache_max_bytes);
   return result;
 }

@@ -20,6 +20,9 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
 // The file name of the entry for `path` read with `options` ("<64 hex digits>.entry"); nullopt when
 // the file cannot be read. For the tests, which damage entries on purpose.
 std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options);
+// The file name of the placements entry of the file at `path` read with `options` (step_placements.h:
+// the entry that lets an edit of its placements' numbers reuse the model read before).
+std::string placements_entry_name(const std::string& path, const ImportOptions& options);
 
 // One file's result as an entry's contents, and back. std::nullopt when the model holds a part whose
 // source cannot be stored (neither none nor a BrepSource). load_import returns false and `why` when

@@ -35,7 +35,7 @@ bool import_from_description(std::string_view bytes, ImportResult& out, std::str
   for (FileImport& f : out.files) {
     f.path = r.str();
     const std::uint64_t cache = r.u64();
-    f.cache = cache <= static_cast<std::uint64_t>(CacheUse::Rebuilt) ? static_cast<CacheUse>(cache) : CacheUse::Off;
+    f.cache = cache <= static_cast<std::uint64_t>(CacheUse::Placements) ? static_cast<CacheUse>(cache) : CacheUse::Off;
     ImportTimings& t = f.timings;
     for (double* x : {&t.read, &t.transfer, &t.heal, &t.tessellate, &t.total}) *x = r.f64();
   }

@@ -59,6 +59,7 @@ const char* cache_use_name(CacheUse c) {
     case CacheUse::Hit: return "hit";
     case CacheUse::Miss: return "miss";
     case CacheUse::Rebuilt: return "rebuilt";
+    case CacheUse::Placements: return "placements";
   }
   return "off";
 }

@@ -213,6 +213,7 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
   result.faces = map_face_entities(
       *process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) { return describe_face(entity, label, out); },
       bound.tags);
+  if (!run.cache_dir.empty()) result.placements = component_placements(result.doc, *process, reader.GetShapeLabelMap(), label);
 }
 
 // The parsed model into shapes: its products, or its face entities one by one when the attempt

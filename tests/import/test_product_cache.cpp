@@ -4,10 +4,12 @@
 // afresh gives; damaged entries of products are never trusted.
 #include "cadclash/import.h"
 #include "../test_temp.h"
+#include "import_cache.h"
 #include "import_compare.h"
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -111,9 +113,14 @@ std::string with_one_vertex_moved(std::string text) {
 
 // What reading the file afresh gives, compared with a read through the cache: the same scene,
 // diagnostics, completeness and answers of a certified check (which queries the exact faces).
-void expect_as_read_afresh(const std::string& path, const ImportResult& cached) {
+// `like`: the options of the cached read (their cache left out); default: two workers, eager.
+void expect_as_read_afresh(const std::string& path, const ImportResult& cached, const ImportOptions* like = nullptr) {
   ImportOptions plain;
   plain.transfer_workers = 2;
+  if (like) {
+    plain = *like;
+    plain.cache_dir.clear();
+  }
   const ImportResult fresh = import_file(path, plain);
   EXPECT_EQ(messages(cached), messages(fresh));
   EXPECT_EQ(cached.complete, fresh.complete);
@@ -138,6 +145,12 @@ CachedBoard cached_board(const std::string& name, bool lazy) {
 }
 
 bool have_data() { return fs::exists(std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp"); }
+
+// The cache without its placements entry for the file at `path`: an edit of a placement is then
+// read through the products' entries (step_placements.h serves it otherwise).
+void forget_placements(const std::string& path, const ImportOptions& options) {
+  fs::remove(fs::path(options.cache_dir) / detail::placements_entry_name(path, options));
+}
 
 TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
   if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
@@ -169,6 +182,7 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
     SCOPED_TRACE(e.what);
     write_bytes(path, e.text);
     options.transfer_workers = e.workers;
+    forget_placements(path, options);
     const ImportResult warm = import_file(path, options);
     ASSERT_EQ(warm.files.size(), 1u);
     EXPECT_EQ(warm.files[0].cache, CacheUse::Miss);  // the file changed: no whole entry
@@ -186,10 +200,11 @@ TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
   if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
   const auto [path, original, options] = cached_board("product_cache_damaged", false);
   const ImportResult cold = import_file(path, options);
-  const std::size_t entries = cold.files[0].pieces + cold.model.parts.size();
+  std::size_t entries = cold.files[0].pieces + cold.model.parts.size();
   std::vector<std::string> files;
   for (const auto& f : fs::directory_iterator(options.cache_dir)) files.push_back(f.path().string());
-  ASSERT_EQ(files.size(), entries + 1);  // and the whole file's
+  ASSERT_EQ(files.size(), entries + 2);  // and the whole file's and its placements'
+  ++entries;                             // each damaged entry is named
   std::size_t k = 0;
   for (const std::string& f : files) {
     std::string bytes = read_bytes(f);
@@ -215,6 +230,7 @@ TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
   expect_as_read_afresh(path, without);
 
   write_bytes(path, with_placement_moved(with_placement_moved(original)));
+  forget_placements(path, options);
   const ImportResult again = import_file(path, options);
   EXPECT_EQ(again.files[0].pieces_cached, again.files[0].pieces);
   EXPECT_EQ(again.files[0].parts_cached, again.model.parts.size());
@@ -246,11 +262,90 @@ TEST(ProductCache, TrianglesAChecksMadeAreKeptForTheNextRun) {
 
   write_bytes(path, with_placement_moved(original));
   const ImportResult moved = import_file(path, options);
-  EXPECT_EQ(moved.files[0].parts_cached, moved.model.parts.size());
+  EXPECT_EQ(moved.files[0].cache, CacheUse::Placements);  // the model of the file's entry, its poses recomputed
   const ImportResult fresh = import_file(path, plain);
   EXPECT_EQ(messages(moved), messages(fresh));
   EXPECT_TRUE(same_bytes(everything(moved), everything(fresh)));
   EXPECT_EQ(check_text(moved), check_text(fresh));
+}
+
+// A copy of `text` with `from` replaced by `to` (once; it must be there).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// A file edited only in the numbers of its placements is the model of the version the cache read
+// before with the poses its new numbers give (CacheUse::Placements): the same as reading it afresh,
+// down to the bits of every pose and the answers of a certified check. Any other edit is read.
+TEST(PlacementCache, EditedPlacementsAreRecomputed) {
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  for (const bool lazy : {false, true}) {
+    SCOPED_TRACE(lazy ? "lazy" : "eager");
+    auto [path, original, options] = cached_board(lazy ? "placements_lazy" : "placements_eager", lazy);
+    const ImportResult cold = import_file(path, options);
+    ASSERT_EQ(cold.files[0].cache, CacheUse::Miss);
+    EXPECT_TRUE(fs::exists(fs::path(options.cache_dir) / detail::placements_entry_name(path, options)));
+
+    struct Edit {
+      const char* what;
+      std::string text;
+      CacheUse use;
+    };
+    const std::vector<Edit> edits{
+        {"a placement moved", with_placement_moved(original), CacheUse::Placements},
+        {"moved again", with_placement_moved(with_placement_moved(original)), CacheUse::Placements},
+        {"the placement and a product's vertex moved", with_one_vertex_moved(with_placement_moved(original)), CacheUse::Miss},
+        {"every id renumbered", renumbered(original), CacheUse::Miss},
+        {"the placement moved in the renumbered file", with_placement_moved(renumbered(original)), CacheUse::Placements},
+    };
+    for (const Edit& e : edits) {
+      SCOPED_TRACE(e.what);
+      write_bytes(path, e.text);
+      const ImportResult warm = import_file(path, options);
+      ASSERT_EQ(warm.files.size(), 1u);
+      EXPECT_EQ(warm.files[0].cache, e.use);
+      expect_as_read_afresh(path, warm, &options);
+    }
+  }
+}
+
+// On as1, some axis placements of occurrences are also the origins of mapped items: their numbers
+// place geometry too, so a file with one of them edited is read; an occurrence's own axis is not.
+// A pose moved outside the supported range is read too (the reader reports it).
+TEST(PlacementCache, NumbersThatPlaceMoreThanOccurrencesAreRead) {
+  const std::string as1 = std::string(CADCLASH_DATA_DIR) + "/external/as1-tu-203.stp";
+  if (!fs::exists(as1)) GTEST_SKIP() << "run scripts/setup.sh";
+  const std::string path = (fs::path(testing::scratch_dir()) / "placements_as1.stp").string();
+  const std::string original = read_bytes(as1);
+  ImportOptions options;
+  options.cache_dir = (fs::path(testing::scratch_dir()) / "placements_as1-cache").string();
+  fs::remove_all(options.cache_dir);
+  write_bytes(path, original);
+  ASSERT_EQ(import_file(path, options).files[0].cache, CacheUse::Miss);
+  const std::string own = "#338=CARTESIAN_POINT('#338',(-10.,-7.5,185.));";      // an axis of an occurrence only
+  const std::string shared = "#298=CARTESIAN_POINT('#298',(0.0,0.0,0.0));";      // also a mapped item's origin
+  struct Edit {
+    const char* what;
+    std::string text;
+    CacheUse use;
+  };
+  const std::vector<Edit> edits{
+      {"an occurrence's axis moved", replaced(original, own, "#338=CARTESIAN_POINT('#338',(-10.,-7.5,185.5));"), CacheUse::Placements},
+      {"an occurrence's axis turned", replaced(original, "#340=DIRECTION('#340',(0.0,0.0,1.0));", "#340=DIRECTION('#340',(0.0,0.6,0.8));"),
+       CacheUse::Placements},
+      {"a mapped item's origin moved", replaced(original, shared, "#298=CARTESIAN_POINT('#298',(0.0,0.0,0.25));"), CacheUse::Miss},
+      {"an occurrence placed out of range", replaced(original, own, "#338=CARTESIAN_POINT('#338',(-10.,-7.5,1.E39));"), CacheUse::Miss},
+  };
+  for (const Edit& e : edits) {
+    SCOPED_TRACE(e.what);
+    write_bytes(path, e.text);
+    const ImportResult warm = import_file(path, options);
+    EXPECT_EQ(warm.files[0].cache, e.use);
+    expect_as_read_afresh(path, warm, &options);
+  }
 }
 
 }  // namespace

@@ -144,14 +144,18 @@ struct ImportTimings {
   double total = 0.0;       // the whole file, storing its cache entry included
 };
 
-// What the cache did for one file: not asked, gave it, did not hold it (now stored), or held a
-// damaged entry (read again and rewritten).
-enum class CacheUse : std::uint8_t { Off, Hit, Miss, Rebuilt };
-// Returns "off", "hit", "miss" or "rebuilt".
+// What the cache did for one file: not asked, gave it, did not hold it (now stored), held a
+// damaged entry (read again and rewritten), or held the entry of an earlier version of the file
+// at the same path that differs only in the numbers of its assembly placements (Placements: the
+// model read from that entry, each instance's pose computed from the new numbers as the reader
+// would; docs/import.md, "A cache per product").
+enum class CacheUse : std::uint8_t { Off, Hit, Miss, Rebuilt, Placements };
+// Returns "off", "hit", "miss", "rebuilt" or "placements".
 const char* cache_use_name(CacheUse c);
 
 namespace detail {
 struct CacheRecord;  // what store_triangles_in_cache needs of a file read through the cache (import_cache.h)
+struct Placements;   // how a STEP file's numbers place its instances (step_placements.h)
 }
 
 struct FileImport {
@@ -168,6 +172,8 @@ struct FileImport {
   std::size_t parts_cached = 0;
   // A lazy import through a cache: the entries its B-rep parts came from or went to.
   std::shared_ptr<detail::CacheRecord> cache_record = nullptr;
+  // STEP assemblies: how the file's numbers place its instances, for the cache's recomputed poses.
+  std::shared_ptr<const detail::Placements> placements = nullptr;
 };
 
 struct ImportResult {
