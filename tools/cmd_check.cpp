@@ -4,6 +4,7 @@
 #include "check_review.h"
 #include "cli_common.h"
 #include "cmd_check_mpi.h"
+#include "html_path.h"
 #include "html_report.h"
 #include "import_stages.h"
 #include "mpi_inputs.h"
@@ -132,6 +133,7 @@ struct CheckOutcome {
   std::string stopped_by;               // first budget that ran out; empty when every query finished
   std::vector<Diagnostic> diagnostics;  // the queries' own
   Report shown;                         // what --html shows: the query, or a trajectory's last step
+  std::optional<HtmlPath> path;         // --continuous with --html: what the page's time slider plays
   bool unreadable = false;              // an input file could not be read again for --volume
   bool bad_path = false;                // the path has an error (--continuous: steps not ascending)
 };
@@ -219,7 +221,7 @@ void print_timeline(const CheckOptions& o, const Model& m, const PathResult& p) 
 
 // The trajectory replayed on the prepared scene: one line per step on stdout, each step into `report`;
 // with --continuous the motion between the steps too.
-CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runner& run,
+CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Scene& scene, const Runner& run,
                               const std::vector<TrajectoryRow>& rows, const CollideOptions& copt, CheckReport& report) {
   CheckOutcome out;
   std::vector<Diagnostic> ds;
@@ -271,6 +273,14 @@ CheckOutcome check_trajectory(const CheckOptions& o, const Model& m, const Runne
   report.stopped_by = out.stopped_by;
   for (const Diagnostic& d : ds) report.diagnostics.push_back(format_diagnostic(d));
   if (path) print_timeline(o, m, *path);
+  if (path && !o.html.empty()) {
+    std::vector<std::int64_t> checked;
+    for (const StepResult& s : steps) checked.push_back(s.step);
+    out.path = html_path(m, scene, rows, checked);
+    out.path->pairs = std::move(path->pairs);
+    out.path->resolution = o.time_resolution;
+    out.path->complete = path->complete;
+  }
   if (!steps.empty()) out.shown = std::move(steps.back().report);
   return out;
 }
@@ -285,7 +295,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
   report.files = o.in.files;
   report.settings = report_settings_of(o, copt);
   CheckOutcome run = rows.empty() ? check_once(o, m, runner, copt, review, report)
-                                  : check_trajectory(o, m, runner, rows, copt, report);
+                                  : check_trajectory(o, m, scene, runner, rows, copt, report);
   print_diagnostics(run.diagnostics);
   const bool input_error = has_error(imported.diagnostics) || has_error(run.diagnostics);
   for (const Diagnostic& d : imported.diagnostics) report.diagnostics.push_back(format_diagnostic(d));
@@ -311,7 +321,7 @@ int finish_check(const CheckOptions& o, ImportResult& imported, const std::vecto
     }
   }
   if (primary && !o.html.empty() && runner.before_html && !runner.before_html()) return kExitInputError;
-  if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j))
+  if (primary && !o.html.empty() && !save_html_report(o.html, m, scene, run.shown, j, run.path ? &*run.path : nullptr))
     return kExitInputError;
   if (input_error || run.unreadable || run.bad_path) return kExitInputError;
   if (o.fail_on_collision && run.collision) return kExitCollision;  // a definite finding, partial report or not

@@ -2,6 +2,7 @@
 #include "html_report.h"
 
 #include "cli_common.h"
+#include "html_path.h"
 
 #include "cadclash/report.h"
 
@@ -25,8 +26,9 @@ extern const char* const kHtmlViewerScript;
 namespace {
 
 // Version of the data the page reads (viewer/src); bump with any incompatible change. Fields added
-// to a record (the pairs' decided_by and distance_interval) are compatible: the page and its data
-// are always written together, and a reader of version 1 ignores them.
+// to a record (the pairs' decided_by and distance_interval, the top-level "path" of --continuous)
+// are compatible: the page and its data are always written together, and a reader of version 1
+// ignores them.
 constexpr int kHtmlDataVersion = 1;
 
 constexpr std::string_view kTitleMarker = "<!--cadclash:title-->";
@@ -115,7 +117,8 @@ nlohmann::json signed_id(std::uint32_t id) {
   return id == kInvalidId ? nlohmann::json(-1) : nlohmann::json(id);
 }
 
-nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Report& r, const nlohmann::json& meta) {
+nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Report& r, const nlohmann::json& meta,
+                         const HtmlPath* path) {
   nlohmann::json j{{"schema", "cadclash-html-report"}, {"version", kHtmlDataVersion}};
   for (const char* key : {"settings", "summary"}) j[key] = meta.value(key, nlohmann::json::object());
   j["files"] = meta.value("files", nlohmann::json::array());
@@ -157,6 +160,8 @@ nlohmann::json data_json(const Model& m, std::span<const Pose> poses, const Repo
   j["surfaces"] = std::move(surfaces);
   j["instances"] = std::move(instances);
   j["pairs"] = std::move(pairs);
+  // Only a path checked continuously has a timeline to play: without it the page has no slider.
+  if (path != nullptr) j["path"] = path_json(*path);
   return j;
 }
 
@@ -192,13 +197,13 @@ std::string html_escape(std::string_view text) {
 bool html_report_available() { return CADCLASH_HTML_VIEWER != 0; }
 
 bool write_html_report(std::ostream& os, const Model& model, std::span<const Pose> poses, const Report& report,
-                       const nlohmann::json& meta) {
+                       const nlohmann::json& meta, const HtmlPath* path) {
 #if CADCLASH_HTML_VIEWER
   const std::string_view page = kHtmlViewerTemplate;
   std::string title;
   for (const nlohmann::json& f : meta.value("files", nlohmann::json::array()))
     if (f.is_string()) title += (title.empty() ? "" : ", ") + f.get<std::string>();
-  const nlohmann::json data = data_json(model, poses, report, meta);
+  const nlohmann::json data = data_json(model, poses, report, meta, path);
   // The template holds each marker once, in this order (viewer/src/report.html).
   const std::size_t t = page.find(kTitleMarker), d = page.find(kDataMarker), s = page.find(kScriptMarker);
   os << page.substr(0, t) << html_escape(title);
@@ -208,13 +213,13 @@ bool write_html_report(std::ostream& os, const Model& model, std::span<const Pos
   os.flush();
   return static_cast<bool>(os);
 #else
-  (void)os, (void)model, (void)poses, (void)report, (void)meta;
+  (void)os, (void)model, (void)poses, (void)report, (void)meta, (void)path;
   return false;
 #endif
 }
 
 bool save_html_report(const std::string& path, Model& model, const Scene& scene, const Report& report,
-                      const nlohmann::json& meta) {
+                      const nlohmann::json& meta, const HtmlPath* motion) {
   std::vector<SurfaceId> missing;
   for (SurfaceId s = 0; s < model.surfaces.size(); ++s)
     if (!model.surfaces[s].has_triangles) missing.push_back(s);
@@ -223,7 +228,7 @@ bool save_html_report(const std::string& path, Model& model, const Scene& scene,
   poses.reserve(model.instances.size());
   for (InstanceId i = 0; i < model.instances.size(); ++i) poses.push_back(scene.pose(i));
   std::ofstream f(path, std::ios::binary);
-  if (!f || !write_html_report(f, model, poses, report, meta)) {
+  if (!f || !write_html_report(f, model, poses, report, meta, motion)) {
     std::cerr << path << ": error: cannot write the HTML report\n";
     return false;
   }

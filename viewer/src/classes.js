@@ -50,3 +50,10 @@ export function formatNumber(v) {
   if (v === 0) return '0';
   return Number(v.toPrecision(4)).toString();
 }
+
+// The time slider's colours (timeline.js): a surface pair of the timeline whose span holds the
+// shown time is in contact there (the span was proved in contact at both ends) or may begin, end or
+// hold a contact there (a narrow span proved neither way; drawn like undecided, for the same reason).
+export const TIME_STATES = ['contact', 'may'];
+export const TIME_COLOURS = { contact: 0xff8c1a, may: 0xf032e6 };
+export const TIME_LABELS = { contact: 'in contact', may: 'contact may begin or end here (not proved)' };

@@ -4,7 +4,8 @@
 // When everything is drawn the page sets <html data-cadclash-ready="1"> (or data-cadclash-error)
 // and exposes window.cadclashViewer for scripted checks (tests/viewer) and load-time measurements.
 // <html data-cadclash-filter> holds the filter text last applied (the box applies it after a pause
-// in typing) and data-cadclash-selected the selected pair's index.
+// in typing) and data-cadclash-selected the selected pair's index; with a time slider (a path
+// checked continuously) data-cadclash-time holds the time last drawn.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { assertLittleEndian } from './decode.js';
@@ -12,7 +13,10 @@ import { ClashScene } from './scene.js';
 import { fillClassToggles, fillLegend, showClassCounts, showSelection } from './panel.js';
 import { PairFilter } from './filter.js';
 import { PairTable } from './pairtable.js';
-import { CLASSES } from './classes.js';
+import { CLASSES, TIME_LABELS, TIME_STATES } from './classes.js';
+import { PathPlayer, poseMatrix } from './path.js';
+import { PathBar } from './pathbar.js';
+import { TimelineLayer } from './timeline.js';
 import { ReviewState, fillReviewBar, showClash, showReviewCounts } from './review.js';
 
 // Pause in typing before the filter applies: one pass over 60 000 pairs is cheap, but redrawing a
@@ -59,10 +63,30 @@ function start() {
   const sun = new THREE.DirectionalLight(0xffffff, 1.4);
   scene.add(sun);
 
+  // A path checked continuously: the moving instances go where the slider says, and the timeline's
+  // contacts at that time replace the class colours of the last step's check.
+  const player = data.path && data.path.steps.length ? new PathPlayer(data.path, data) : null;
+  let timeLayer = null;
+  const moved = new THREE.Matrix4();
+  function placeAt(t) {
+    for (const { instance, pose } of player.posesAt(t)) clash.moveInstance(instance, moved.fromArray(poseMatrix(pose)));
+  }
+  if (player) {
+    timeLayer = new TimelineLayer(clash, player);
+    clash.replaceHighlights(timeLayer);
+  }
+
   const camera = new THREE.PerspectiveCamera(40, 1, 1, 10);
   camera.up.set(0, 0, 1);
   const controls = new OrbitControls(camera, renderer.domElement);
+  // With a path, the box of every step's scene: the camera frames the whole motion.
   const sceneBox = clash.sceneBox();
+  if (player) {
+    for (const step of player.steps) {
+      placeAt(step);
+      sceneBox.union(clash.sceneBox());
+    }
+  }
   controls.maxDistanceHint = sceneBox.isEmpty() ? 1 : sceneBox.getSize(new THREE.Vector3()).length() * 4;
 
   // Draw on demand only: a big assembly costs nothing while nobody moves it. While the user drags,
@@ -115,7 +139,7 @@ function start() {
   fillLegend(document.getElementById('legend'), ({ context }) => {
     showContext = context;
     requestDraw();
-  });
+  }, player ? TIME_STATES.map((st) => [st, TIME_LABELS[st]]) : undefined);
   const warnings = [...data.diagnostics];
   if (data.stopped_by) warnings.unshift(`PARTIAL REPORT: the ${data.stopped_by} ran out before every pair was examined`);
   else if (data.complete === false) warnings.unshift('PARTIAL REPORT: some input could not be read (see below)');
@@ -200,6 +224,25 @@ function start() {
   });
   applyFilter();
 
+  let pathBar = null;
+  function showTime(t) {
+    placeAt(t);
+    timeLayer.show(player.surfacesAt(t));
+    requestDraw();
+    document.documentElement.dataset.cadclashTime = String(t);
+  }
+  if (player) {
+    pathBar = new PathBar(document.getElementById('path-bar'), document.getElementById('timeline'), data, player, {
+      onTime: showTime,
+      onPick(pair) {  // a timeline row: its two surfaces as sides A and B, framed where they are now
+        clash.select(pair);
+        fitCamera(camera, controls, clash.worldBox(pair.instance_a, pair.surface_a).union(clash.worldBox(pair.instance_b, pair.surface_b)));
+        requestDraw();
+      },
+    });
+    pathBar.setTime(player.last);  // as without a slider: the scene of the last step
+  }
+
   // Moves the selection by `step` listed rows (from the nearest listed row when the selected pair
   // is filtered out, from the first or last row when none is selected).
   function moveSelection(step) {
@@ -274,6 +317,28 @@ function start() {
     highlightCounts: () => clash.highlightCounts(),
     // Scrolls the table to a listed pair's row (false when the filter hides it).
     scrollToPair: (index) => table.scrollToPair(index),
+    // With a time slider: shows time t (as dragging the slider there) and draws it; state() is what
+    // is drawn: the time, each moving instance's world matrix (column-major, as its grey copy is
+    // drawn) and each coloured surface with its state and colour.
+    path: player && {
+      first: player.first,
+      last: player.last,
+      setTime(t) {
+        pathBar.pause();
+        pathBar.setTime(t);
+        dragging = false;
+        draw();
+      },
+      play: () => pathBar.play(),
+      pause: () => pathBar.pause(),
+      playing: () => pathBar.playing,
+      state: () => ({
+        time: pathBar.time,
+        instances: data.path.moving.map((i) => ({ instance: i, path: data.instances[i].path, matrix: [...clash.drawnMatrix(i).elements] })),
+        coloured: timeLayer.drawn().map((c) => ({ ...c, path: data.instances[c.instance].path, name: data.surfaces[c.surface].name })),
+        classColoursShown: clash.highlights.visible,
+      }),
+    },
     // Fits the whole assembly in view (the selection stays).
     frameAll() {
       fitCamera(camera, controls, sceneBox);

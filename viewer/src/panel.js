@@ -12,9 +12,10 @@ export function surfaceLabel(surface) {
   return surface.source_name || surface.name;
 }
 
-// The colour key over the 3D view, with the box that hides the grey context.
-export function fillLegend(legend, onChange) {
-  const items = CLASSES.map((c) => `<span class="${c}"><span class="chip"></span>${c}</span>`);
+// The colour key over the 3D view, with the box that hides the grey context. `keys` ([css class,
+// label]) replaces the classes: the time slider colours contact states instead.
+export function fillLegend(legend, onChange, keys = CLASSES.map((c) => [c, c])) {
+  const items = keys.map(([c, label]) => `<span class="${c}"><span class="chip"></span>${escapeHtml(label)}</span>`);
   items.push('<label><input type="checkbox" id="show-context" checked>other surfaces</label>');
   items.push('<span><span class="chip selA"></span>A</span><span><span class="chip selB"></span>B</span>');
   legend.innerHTML = items.join('');

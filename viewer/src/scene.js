@@ -81,11 +81,15 @@ export class ClashScene {
       if (!byPart.has(inst.part)) byPart.set(inst.part, []);
       byPart.get(inst.part).push(i);
     });
+    this.contextSlots = new Map();  // instance -> [its part's context mesh, its index there]
     for (const [part, instances] of byPart) {
       const g = this.parts[part];
       if (!g) continue;
       const mesh = new THREE.InstancedMesh(g, this.contextMaterial, instances.length);
-      instances.forEach((inst, k) => mesh.setMatrixAt(k, this.matrices[inst]));
+      instances.forEach((inst, k) => {
+        mesh.setMatrixAt(k, this.matrices[inst]);
+        this.contextSlots.set(inst, [mesh, k]);
+      });
       mesh.computeBoundingSphere();
       this.context.add(mesh);
       this.triangles += (g.index.count / 3) * instances.length;
@@ -229,15 +233,57 @@ export class ClashScene {
       mesh.matrix.copy(this.matrices[inst]);
       mesh.renderOrder = 10 + k;
       mesh.userData.side = k;
+      mesh.userData.instance = inst;
       mesh.frustumCulled = false;
       this.selection.add(mesh);
     });
   }
 
-  // Which layers are drawn: the pixel checks of the test draw one selected side alone.
+  // Which layers are drawn: the pixel checks of the test draw one selected side alone. With a time
+  // slider (timeline.js) its layer takes the place of the class highlights.
   setLayers({ context = true, highlights = true, sides = [true, true] } = {}) {
     this.context.visible = context;
-    this.highlights.visible = highlights;
+    this.highlights.visible = highlights && !this.timeLayer;
+    if (this.timeLayer) this.timeLayer.visible = highlights;
     this.selection.children.forEach((m) => { m.visible = sides[m.userData.side] !== false; });
+  }
+
+  // A layer drawn instead of the class highlights (the time slider's); hides them.
+  replaceHighlights(layer) {
+    this.timeLayer = layer;
+    this.root.add(layer);
+    this.highlights.visible = false;
+  }
+
+  // Places an instance (a path's moving one) at a new world matrix: its context copy, its class
+  // highlights (a copy the filter hides stays hidden) and its selected sides follow.
+  moveInstance(instance, matrix) {
+    this.matrices[instance].copy(matrix);
+    const slot = this.contextSlots.get(instance);
+    if (slot) {
+      slot[0].setMatrixAt(slot[1], matrix);
+      slot[0].instanceMatrix.needsUpdate = true;
+      slot[0].computeBoundingSphere();
+    }
+    const m = new THREE.Matrix4();
+    for (const mesh of this.highlights.children) {
+      const k = mesh.userData.instances.indexOf(instance);
+      if (k < 0) continue;
+      mesh.getMatrixAt(k, m);
+      if (m.elements[0] === 0 && m.elements[1] === 0 && m.elements[2] === 0) continue;  // scaled to nothing: filtered out
+      mesh.setMatrixAt(k, matrix);
+      mesh.instanceMatrix.needsUpdate = true;
+      mesh.computeBoundingSphere();
+    }
+    for (const mesh of this.selection.children)
+      if (mesh.userData.instance === instance) mesh.matrix.copy(matrix);
+  }
+
+  // The world matrix an instance is drawn with (its context copy's; tests/viewer reads it).
+  drawnMatrix(instance) {
+    const slot = this.contextSlots.get(instance);
+    const m = new THREE.Matrix4();
+    if (slot) slot[0].getMatrixAt(slot[1], m);
+    return m;
   }
 }
