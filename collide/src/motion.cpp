@@ -83,18 +83,27 @@ using PairKey = std::tuple<InstanceId, InstanceId, SurfaceId, SurfaceId>;
 struct Contacts {
   std::set<PairKey> contact;
   std::set<PairKey> open;  // in contact or undecided: not cleared
+  // Per open key, a certified lower bound of its exact distance less the faces' uncertainties (the
+  // least over the instance pair's surface pairs for an instance key; -inf for containment, and for
+  // every key of a check whose bounds are not certified).
+  std::map<PairKey, double> margin;
   bool complete = true;
 };
 
-Contacts contacts_of(const Report& r) {
+Contacts contacts_of(const Report& r, bool certified) {
   Contacts c;
   c.complete = r.complete;
   for (const SurfacePairResult& p : r.pairs) {
     if (p.contact == ContactClass::Clearance) continue;
+    const double margin = certified && p.contact != ContactClass::Containment
+                              ? p.distance_lo - p.uncertainty_a - p.uncertainty_b
+                              : -std::numeric_limits<double>::infinity();
     for (const PairKey& k : {PairKey{p.instance_a, p.instance_b, kInvalidId, kInvalidId},
                              PairKey{p.instance_a, p.instance_b, p.surface_a, p.surface_b}}) {
       c.open.insert(k);
       if (p.contact != ContactClass::Undecided) c.contact.insert(k);
+      auto [it, fresh] = c.margin.try_emplace(k, margin);
+      if (!fresh) it->second = std::min(it->second, margin);
     }
   }
   return c;
@@ -113,8 +122,33 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     for (SurfaceId s = part.first_surface; s < part.first_surface + part.surface_count; ++s)
       boxes[i].extend(model.surfaces[s].aabb.isEmpty() ? mesh_aabb(model.surfaces[s].mesh) : model.surfaces[s].aabb);
   }
-  // A pair moves apart or together over [s0, s1] by at most its two sides' travel: at most the two
-  // largest.
+  // A pair moves apart or together over [s0, s1] by at most its two sides' travel (a side that does
+  // not move: none). When neither side turns, the translation they share does not move them
+  // relative to each other: their travel is what their shifts differ by, plus each side's travel
+  // with its shift left out (the rotation interpolate_pose computes for no turn, and the rounding of
+  // the poses). So parts moved together keep their gap, wherever the assembly is placed.
+  std::map<InstanceId, std::size_t> index;
+  for (std::size_t i = 0; i < moving.size(); ++i) index.emplace(moving[i], i);
+  auto shift_only = [&](std::size_t i) { return from[i].linear() == to[i].linear(); };
+  auto pair_travel = [&](InstanceId a, InstanceId b, double s0, double s1) {
+    const auto ia = index.find(a), ib = index.find(b);
+    const bool together = ia != index.end() && ib != index.end() && shift_only(ia->second) && shift_only(ib->second);
+    auto own = [&](const auto& it) {
+      if (it == index.end() || boxes[it->second].isEmpty()) return 0.0;
+      const std::size_t i = it->second;
+      if (!together) return travel_bound(from[i], to[i], boxes[i], s0, s1);
+      Pose unshifted = to[i];
+      unshifted.translation() = from[i].translation();
+      return travel_bound(from[i], unshifted, boxes[i], s0, s1);
+    };
+    if (!together) return own(ia) + own(ib);
+    const Vec3 da = to[ia->second].translation() - from[ia->second].translation();
+    const Vec3 db = to[ib->second].translation() - from[ib->second].translation();
+    // The difference with its rounding (each shift's, and the subtraction's).
+    const double apart = (da - db).norm() * (1.0 + 16.0 * kUnit) + 8.0 * kUnit * (da.norm() + db.norm());
+    return (s1 - s0) * apart * (1.0 + 16.0 * kUnit) + own(ia) + own(ib);
+  };
+  // Any pair's: at most the two largest.
   auto travel_over = [&](double s0, double s1) {
     double first = 0.0, second = 0.0;
     for (std::size_t i = 0; i < moving.size(); ++i) {
@@ -129,13 +163,14 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   auto place = [&](double s) {
     for (std::size_t i = 0; i < moving.size(); ++i) scene.set_pose(moving[i], interpolate_pose(from[i], to[i], s));
   };
+  const bool certified = options.decision != DecisionMode::Fast;
   auto check = [&](double s, double tolerance) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o));
+    return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o), certified);
   };
   std::map<double, Contacts> at;  // the static check at T, by s
   auto contacts_at = [&](double s) -> const Contacts& {
@@ -158,11 +193,21 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     auto concerns = [&](const PairKey& k) { return st.all || st.pairs.count(k) > 0; };
     const bool budget = out.checks + 3 <= motion.max_checks;
     std::set<PairKey> suspect;
+    Contacts grown;
     if (budget) {
-      const Contacts grown = check(st.s0, options.tolerance + travel_over(st.s0, st.s1));
+      // Checked in the middle of the stretch: every pose of it is within half its travel of there.
+      const double mid = 0.5 * (st.s0 + st.s1);
+      auto half = [&](const auto& travel) { return std::max(travel(st.s0, mid), travel(mid, st.s1)); };
+      grown = check(mid, options.tolerance + half(travel_over));
       if (grown.complete) {
-        for (const PairKey& k : grown.open)
-          if (concerns(k)) suspect.insert(k);
+        // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
+        // middle less what its two sides can travel from there stays above T where its lower bound
+        // says so.
+        for (const PairKey& k : grown.open) {
+          const auto [a, b, sa, sb] = k;
+          const double travel = half([&](double u0, double u1) { return pair_travel(a, b, u0, u1); });
+          if (concerns(k) && !(grown.margin.at(k) > options.tolerance + travel)) suspect.insert(k);
+        }
       } else {
         out.complete = false;
       }
@@ -178,11 +223,13 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       for (const PairKey& k : keep) spans[k].push_back({st.s0, st.s1, false});
       continue;
     }
-    const Contacts& c0 = contacts_at(st.s0);
-    const Contacts& c1 = contacts_at(st.s1);
     std::set<PairKey> halve;
     for (const PairKey& k : suspect) {
-      if (c0.contact.count(k) && c1.contact.count(k)) spans[k].push_back({st.s0, st.s1, true});
+      // Only a pair that may touch in the middle can be in contact over the whole stretch: the
+      // checks at its ends (at T) are run for such pairs only.
+      if (!(grown.margin.at(k) > options.tolerance) && contacts_at(st.s0).contact.count(k) &&
+          contacts_at(st.s1).contact.count(k))
+        spans[k].push_back({st.s0, st.s1, true});
       else if (st.s1 - st.s0 <= motion.resolution) spans[k].push_back({st.s0, st.s1, false});
       else halve.insert(k);
     }

@@ -39,6 +39,46 @@ void expect_spans(const MotionResult& r, double lo, double hi, double before, do
   EXPECT_GE(covered, hi);
 }
 
+// Two cubes 0.05 apart moved 30 mm by the same translation (a sub-assembly pulled out): their gap
+// stays, so they are never listed, and the stretch is proved on a few checks (each side's travel
+// would be 30 mm; theirs relative to each other is the poses' rounding). Touching, they are in
+// contact over the whole stretch: one span, proved at its ends.
+TEST(ContinuousMotion, PartsMovedTogetherKeepTheirGap) {
+  // The same wherever the whole scene is placed: as built, and turned and moved 10^6 mm away (the
+  // two shifts then differ in their last bits).
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1e6, -4e5, 3e5));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  for (const Pose& where : {Pose::Identity(), far})
+  for (const double gap : {0.05, 0.0}) {
+    SCOPED_TRACE(gap);
+    Model m;
+    const InstanceId a = add_instance(m, "/a", add_part(m, "a", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2)));
+    const InstanceId b = add_instance(m, "/b", add_part(m, "b", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2)));
+    Scene scene(m);
+    const Pose from_a = where * translation(0, 0, 0), from_b = where * translation(2 + gap, 0, 0);
+    const Pose to_a = where * translation(0, 0, -30), to_b = where * translation(2 + gap, 0, -30);
+    scene.set_pose(a, from_a);
+    scene.set_pose(b, from_b);
+    CollideOptions o;
+    o.tolerance = 0.01;
+    const InstanceId moving[] = {a, b};
+    const Pose from[] = {from_a, from_b}, to[] = {to_a, to_b};
+    const MotionResult r = check_motion(scene, m, moving, from, to, o);
+    EXPECT_TRUE(r.complete);
+    EXPECT_LE(r.checks, 4u);
+    if (gap > 0.0) {
+      EXPECT_TRUE(r.pairs.empty());
+    } else {
+      ASSERT_EQ(r.pairs.size(), 1u);
+      ASSERT_EQ(r.pairs[0].spans.size(), 1u);
+      EXPECT_EQ(r.pairs[0].spans[0].s0, 0.0);
+      EXPECT_EQ(r.pairs[0].spans[0].s1, 1.0);
+      EXPECT_TRUE(r.pairs[0].spans[0].contact_at_ends);
+    }
+  }
+}
+
 // The cube falls through the plate within one step: at both ends it is clear (a discrete check sees
 // nothing); in between it passes through z in [0, 1] for s in [0.4, 0.7] (bottom 5 - 10 s, top 7 - 10 s).
 TEST(ContinuousMotion, APartPassingThroughAThinPlateBetweenTwoStepsIsFound) {
