@@ -2,6 +2,7 @@
 // and a bound on how far a part's points travel over a stretch of it.
 #include "cadclash/trajectory.h"
 #include "closest.h"
+#include "restricted_check.h"
 
 #include <algorithm>
 #include <cassert>
@@ -90,16 +91,29 @@ struct Contacts {
   bool complete = true;
 };
 
-Contacts contacts_of(const Report& r, bool certified) {
+// `keys` (null: all): the pairs a check is about; the report's other pairs are left out, so a check
+// restricted to them (restricted_check.h) and a whole one (a distributed run's) say the same.
+Contacts contacts_of(const Report& r, bool certified, const std::set<PairKey>* keys) {
   Contacts c;
   c.complete = r.complete;
   for (const SurfacePairResult& p : r.pairs) {
     if (p.contact == ContactClass::Clearance) continue;
+    // A pair's instance key may be settled while some of its surface pairs are not (a contact proved
+    // at both ends of the stretch), and the other way round: each key takes the results it is about.
+    // An instance key still open has every surface pair that can touch it in `keys` (the others were
+    // proved apart over a stretch holding this one), so its state is theirs and its containment's.
+    const bool containment = p.contact == ContactClass::Containment;
+    const PairKey whole{p.instance_a, p.instance_b, kInvalidId, kInvalidId};
+    const PairKey surface{p.instance_a, p.instance_b, p.surface_a, p.surface_b};
+    const bool listed = !keys || containment || keys->count(surface) > 0;
+    const bool about_whole = listed && (!keys || keys->count(whole) > 0);
+    const bool about_surface = listed && !containment;
+    if (!about_whole && !about_surface) continue;
     const double margin = certified && p.contact != ContactClass::Containment
                               ? p.distance_lo - p.uncertainty_a - p.uncertainty_b
                               : -std::numeric_limits<double>::infinity();
-    for (const PairKey& k : {PairKey{p.instance_a, p.instance_b, kInvalidId, kInvalidId},
-                             PairKey{p.instance_a, p.instance_b, p.surface_a, p.surface_b}}) {
+    for (const PairKey& k : {whole, surface}) {
+      if (!(k == whole ? about_whole : about_surface)) continue;
       c.open.insert(k);
       if (p.contact != ContactClass::Undecided) c.contact.insert(k);
       auto [it, fresh] = c.margin.try_emplace(k, margin);
@@ -164,18 +178,28 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     for (std::size_t i = 0; i < moving.size(); ++i) scene.set_pose(moving[i], interpolate_pose(from[i], to[i], s));
   };
   const bool certified = options.decision != DecisionMode::Fast;
-  auto check = [&](double s, double tolerance) {
+  // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
+  // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
+  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o), certified);
+    if (motion.check || keys == nullptr) return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o), certified, keys);
+    detail::CheckRestriction only;
+    for (const auto& [a, b, sa, sb] : *keys) {
+      auto& surfaces = only.pairs[{a, b}];
+      if (sa != kInvalidId) surfaces.insert({sa, sb});
+    }
+    return contacts_of(detail::restricted_check(scene, o, only), certified, keys);
   };
-  std::map<double, Contacts> at;  // the static check at T, by s
-  auto contacts_at = [&](double s) -> const Contacts& {
-    auto it = at.find(s);
-    if (it == at.end()) it = at.emplace(s, check(s, options.tolerance)).first;
+  // The static checks at T, by s and the pairs they are about (empty: all).
+  std::map<std::pair<double, std::set<PairKey>>, Contacts> at;
+  auto contacts_at = [&](double s, const std::set<PairKey>* keys) -> const Contacts& {
+    std::pair<double, std::set<PairKey>> key{s, keys ? *keys : std::set<PairKey>{}};
+    auto it = at.find(key);
+    if (it == at.end()) it = at.emplace(std::move(key), check(s, options.tolerance, keys)).first;
     return it->second;
   };
   std::map<PairKey, std::vector<MotionSpan>> spans;
@@ -198,7 +222,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       // Checked in the middle of the stretch: every pose of it is within half its travel of there.
       const double mid = 0.5 * (st.s0 + st.s1);
       auto half = [&](const auto& travel) { return std::max(travel(st.s0, mid), travel(mid, st.s1)); };
-      grown = check(mid, options.tolerance + half(travel_over));
+      grown = check(mid, options.tolerance + half(travel_over), st.all ? nullptr : &st.pairs);
       if (grown.complete) {
         // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound
@@ -227,8 +251,9 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     for (const PairKey& k : suspect) {
       // Only a pair that may touch in the middle can be in contact over the whole stretch: the
       // checks at its ends (at T) are run for such pairs only.
-      if (!(grown.margin.at(k) > options.tolerance) && contacts_at(st.s0).contact.count(k) &&
-          contacts_at(st.s1).contact.count(k))
+      const std::set<PairKey>* keys = st.all ? nullptr : &st.pairs;
+      if (!(grown.margin.at(k) > options.tolerance) && contacts_at(st.s0, keys).contact.count(k) &&
+          contacts_at(st.s1, keys).contact.count(k))
         spans[k].push_back({st.s0, st.s1, true});
       else if (st.s1 - st.s0 <= motion.resolution) spans[k].push_back({st.s0, st.s1, false});
       else halve.insert(k);

@@ -19,6 +19,8 @@
 #include <span>
 #include <string>
 #include <unordered_map>
+#include <map>
+#include <set>
 #include <vector>
 
 namespace cadclash::detail {
@@ -128,8 +130,16 @@ struct Task {
   SurfaceId sa = kInvalidId, sb = kInvalidId;
 };
 
+// A check of some instance pairs only and, of each, some surface pairs (restricted_check.h).
+struct CheckRestriction {
+  // Per instance pair (a < b): the surface pairs (of a's part, of b's) examined; its containment is
+  // tested as check() tests it.
+  std::map<std::pair<InstanceId, InstanceId>, std::set<std::pair<SurfaceId, SurfaceId>>> pairs;
+};
+
 struct QueryState {
   const CollideOptions& o;
+  const CheckRestriction* only = nullptr;  // null: every pair the broad phase finds
   std::chrono::steady_clock::time_point t0;
   Deadline deadline;
   int threads = 1;

@@ -30,7 +30,20 @@ bool worth_a_team(const SceneData& s, const std::vector<InstancePair>& pairs) {
 }
 
 // `part_share`: SceneData::part_reach_shares.
-void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share) {
+void surface_pairs(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share);
+
+// The candidate surface pairs of a restricted check (CheckRestriction) are those it names.
+void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share,
+                   const CheckRestriction* only) {
+  surface_pairs(s, ip, o, part_share);
+  if (only == nullptr) return;
+  const auto it = only->pairs.find({ip.a, ip.b});
+  std::erase_if(ip.candidates, [&](const std::array<SurfaceId, 2>& c) {
+    return it == only->pairs.end() || !it->second.count({c[0], c[1]});
+  });
+}
+
+void surface_pairs(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share) {
   const Model& model = s.model;
   const Instance& ia = model.instances[ip.a];
   const Instance& ib = model.instances[ip.b];
@@ -106,7 +119,7 @@ void surface_level_stage(SceneData& s, QueryState& q) {
   runtime_loop(npairs, q.threads, team, [&](std::ptrdiff_t k) {
     InstancePair& ip = q.pairs[static_cast<std::size_t>(k)];
     if (q.deadline.expired()) ip.cut = true;
-    else surface_level(s, ip, q.o, part_share);
+    else surface_level(s, ip, q.o, part_share, q.only);
     meter.add();
   });
   meter.finish();

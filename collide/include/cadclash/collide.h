@@ -332,6 +332,10 @@ struct PartialCheck {
   std::vector<SurfaceWork> surfaces;  // ascending surface id
 };
 
+namespace detail {
+struct SceneAccess;  // the library's own restricted checks (continuous motion)
+}
+
 // A prepared scene: per-surface BVHs and instance world boxes are built once; each check() updates
 // only the instances moved by set_pose since the last check.
 // The model must outlive the scene; the scene writes only surfaces' triangles (lazy tessellation).
@@ -377,6 +381,7 @@ class Scene {
   void note_deflection(SurfaceId s, double deflection, std::uint64_t triangles = kUntessellatedCost);
 
  private:
+  friend struct detail::SceneAccess;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
