@@ -9,6 +9,7 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -71,6 +72,7 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
     }
     std::size_t next = k;
     const std::map<InstanceId, Pose> to = detail::step_poses(scene, rows, next, diagnostics, file);
+    std::optional<Report> checked;  // the step's check
     if (out.steps.empty()) {
       for (const auto& [id, pose] : to) scene.set_pose(id, pose);
     } else {
@@ -81,7 +83,16 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
         a.push_back(scene.pose(id));
         b.push_back(pose);
       }
-      const MotionResult m = check_motion(scene, model, moving, a, b, step_options, motion);
+      // The step's own check first (at its poses): without a clearance it is the check the motion
+      // needs at the stretch's end, as the previous step's is at its start.
+      for (const auto& [id, pose] : to) scene.set_pose(id, pose);
+      checked.emplace(motion.check ? motion.check(scene, step_options) : scene.check(step_options));
+      MotionOptions ends = motion;
+      if (options.clearance == 0.0) {
+        ends.at_start = &out.steps.back().report;
+        ends.at_end = &*checked;
+      }
+      const MotionResult m = check_motion(scene, model, moving, a, b, step_options, ends);
       out.checks += m.checks;
       out.complete = out.complete && m.complete;
       const auto t0 = static_cast<double>(out.steps.back().step), t1 = static_cast<double>(step);
@@ -98,7 +109,8 @@ PathResult replay_continuous(Scene& scene, const Model& model, std::span<const T
       }
     }
     k = next;
-    out.steps.push_back({step, motion.check ? motion.check(scene, step_options) : scene.check(step_options)});
+    if (!checked) checked.emplace(motion.check ? motion.check(scene, step_options) : scene.check(step_options));
+    out.steps.push_back({step, std::move(*checked)});
     if (meter.active()) meter.add(1, std::to_string(step));
   }
   meter.finish();

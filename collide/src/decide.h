@@ -168,6 +168,8 @@ struct DecideResult {
 // `outlines` its cache of the surfaces' outlines (made here for the surfaces of open pairs).
 // Adds the decided_* / ambiguous / refined / exact / dismissed counters to `counters`, and the
 // seconds each step took to `timings`' decide_* fields.
+// Without `depth` the depth step is not run: a contact it would prove penetrating stays touching
+// (for callers that ask only whether pairs are in contact: continuous motion).
 // `eps` holds every surface's effective_uncertainty (the contact band), `slack` its face_slack (how
 // far the points taken as the face's may lie off it), `bvh` the tree of every surface with triangles.
 std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose> poses, std::span<const double> eps,
@@ -175,7 +177,7 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        RefineCache& refined, OutlineCache& outlines,
                                        const CollideOptions& options, int threads, const Deadline& deadline,
-                                       CollideCounters& counters, CollideTimings& timings);
+                                       CollideCounters& counters, CollideTimings& timings, bool depth = true);
 
 // decide_pairs in two halves (certified or exact decision), for a caller that starts each task's
 // decision as soon as its triangles are done, on the thread that did them: early(k) runs steps 1 to
@@ -190,7 +192,8 @@ class DecisionRun {
  public:
   DecisionRun(const Model& model, std::span<const Pose> poses, std::span<const double> eps, std::span<const double> slack,
               std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks, RefineCache& refined,
-              OutlineCache& outlines, const CollideOptions& options, int threads, const Deadline& deadline);
+              OutlineCache& outlines, const CollideOptions& options, int threads, const Deadline& deadline,
+              bool depth = true);
   ~DecisionRun();
   DecisionRun(const DecisionRun&) = delete;
   DecisionRun& operator=(const DecisionRun&) = delete;

@@ -174,8 +174,12 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     return first + second;
   };
   MotionResult out;
+  // At the ends, the poses given (the steps' own, whose checks a path has made already); between
+  // them interpolate_pose's, which differ from those at the ends by its rounding only (travel_bound
+  // covers it).
   auto place = [&](double s) {
-    for (std::size_t i = 0; i < moving.size(); ++i) scene.set_pose(moving[i], interpolate_pose(from[i], to[i], s));
+    for (std::size_t i = 0; i < moving.size(); ++i)
+      scene.set_pose(moving[i], s == 0.0 ? from[i] : s == 1.0 ? to[i] : interpolate_pose(from[i], to[i], s));
   };
   const bool certified = options.decision != DecisionMode::Fast;
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
@@ -186,16 +190,19 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    if (motion.check || keys == nullptr) return contacts_of(motion.check ? motion.check(scene, o) : scene.check(o), certified, keys);
+    if (motion.check) return contacts_of(motion.check(scene, o), certified, keys);
     detail::CheckRestriction only;
-    for (const auto& [a, b, sa, sb] : *keys) {
-      auto& surfaces = only.pairs[{a, b}];
-      if (sa != kInvalidId) surfaces.insert({sa, sb});
-    }
-    return contacts_of(detail::restricted_check(scene, o, only), certified, keys);
+    if (keys)
+      for (const auto& [a, b, sa, sb] : *keys) {
+        auto& surfaces = only.pairs[{a, b}];
+        if (sa != kInvalidId) surfaces.insert({sa, sb});
+      }
+    return contacts_of(detail::restricted_check(scene, o, keys ? &only : nullptr), certified, keys);
   };
   // The static checks at T, by s and the pairs they are about (empty: all).
   std::map<std::pair<double, std::set<PairKey>>, Contacts> at;
+  if (motion.at_start) at.emplace(std::pair{0.0, std::set<PairKey>{}}, contacts_of(*motion.at_start, certified, nullptr));
+  if (motion.at_end) at.emplace(std::pair{1.0, std::set<PairKey>{}}, contacts_of(*motion.at_end, certified, nullptr));
   auto contacts_at = [&](double s, const std::set<PairKey>* keys) -> const Contacts& {
     std::pair<double, std::set<PairKey>> key{s, keys ? *keys : std::set<PairKey>{}};
     auto it = at.find(key);

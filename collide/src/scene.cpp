@@ -107,21 +107,24 @@ struct SceneAccess {
   static SceneData& data(Scene& scene) { return *scene.impl_; }
 };
 
-Report restricted_check(Scene& scene, const CollideOptions& o, const CheckRestriction& only) {
+Report restricted_check(Scene& scene, const CollideOptions& o, const CheckRestriction* only) {
   assert(o.tolerance >= 0.0 && o.clearance >= 0.0 && o.time_budget_seconds >= 0.0);
   SceneData& s = SceneAccess::data(scene);
   QueryState q(o, std::chrono::steady_clock::now());
   q.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   q.progress = &o.progress;
-  q.only = &only;
+  q.only = only;
+  q.depth = false;  // in contact or not is all its callers ask
   if (std::vector<Diagnostic> e = range_errors(s, o); !e.empty()) {
     refuse(q.report, std::move(e));
     return std::move(q.report);
   }
   set_schedule(o.schedule);
   broad_phase_stage(s, q);
-  std::erase_if(q.pairs, [&](const InstancePair& ip) { return !only.pairs.count({ip.a, ip.b}); });
-  q.report.counters.instance_pairs = q.pairs.size();
+  if (only) {
+    std::erase_if(q.pairs, [&](const InstancePair& ip) { return !only->pairs.count({ip.a, ip.b}); });
+    q.report.counters.instance_pairs = q.pairs.size();
+  }
   q.report.timings.broad = seconds_since(q.t0);
   narrow_stages(s, q);
   return std::move(q.report);

@@ -140,6 +140,7 @@ struct CheckRestriction {
 struct QueryState {
   const CollideOptions& o;
   const CheckRestriction* only = nullptr;  // null: every pair the broad phase finds
+  bool depth = true;  // false: contacts are not told penetrating by the depth step (decide_pairs)
   std::chrono::steady_clock::time_point t0;
   Deadline deadline;
   int threads = 1;

@@ -89,6 +89,7 @@ struct DecisionRun::Impl {
   const CollideOptions& o;
   int threads;
   const Deadline& deadline;
+  bool depth;  // run the depth step (decide_pairs)
   std::vector<Pending> pending = std::vector<Pending>(tasks.size());
   std::vector<CollideCounters> task_counters = std::vector<CollideCounters>(tasks.size());
   std::vector<char> state = std::vector<char>(tasks.size(), 0);  // EarlyState bits
@@ -153,7 +154,7 @@ struct DecisionRun::Impl {
   // penetrating on the exact surfaces where it can be (depth_step), whichever step proved the
   // contact. Past the deadline the pair is cut, as any unfinished step leaves it.
   void deepen(std::size_t k, Pending& p, CollideCounters& c) {
-    if (!depth_step_applies(model, tasks[k], p)) return;
+    if (!depth || !depth_step_applies(model, tasks[k], p)) return;
     if (deadline.expired()) {
       p.cut = true;
       return;
@@ -363,13 +364,13 @@ std::vector<DecideResult> decide_pairs(const Model& model, std::span<const Pose>
                                        std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                                        RefineCache& refined, OutlineCache& outline_cache,
                                        const CollideOptions& o, int threads, const Deadline& deadline,
-                                       CollideCounters& counters, CollideTimings& timings) {
+                                       CollideCounters& counters, CollideTimings& timings, bool depth) {
   if (o.decision == DecisionMode::Fast) {
     std::vector<DecideResult> results(tasks.size());
     for (std::size_t k = 0; k < tasks.size(); ++k) results[k].result = fast(model, tasks[k], o);
     return results;
   }
-  DecisionRun run(model, poses, eps, slack, bvh, tasks, refined, outline_cache, o, threads, deadline);
+  DecisionRun run(model, poses, eps, slack, bvh, tasks, refined, outline_cache, o, threads, deadline, depth);
   const auto n = static_cast<std::ptrdiff_t>(tasks.size());
   dynamic_loop(n, threads, true, [&](std::ptrdiff_t k) { run.early(static_cast<std::size_t>(k)); });
   return run.finish(counters, timings);
@@ -379,12 +380,12 @@ DecisionRun::DecisionRun(const Model& model, std::span<const Pose> poses, std::s
                          std::span<const double> slack,
                          std::span<const SurfaceBvh> bvh, std::span<const DecideTask> tasks,
                          RefineCache& refined, OutlineCache& outlines, const CollideOptions& o,
-                         int threads, const Deadline& deadline) {
+                         int threads, const Deadline& deadline, bool depth) {
   assert(o.decision != DecisionMode::Fast);
   // Outlines are made on first need (step 2b) unless the Scene has them already.
   outlines.outline.resize(model.surfaces.size());
   outlines.ready.resize(model.surfaces.size(), 0);
-  impl_ = std::unique_ptr<Impl>(new Impl{model, poses, eps, slack, bvh, tasks, refined, outlines, o, threads, deadline});
+  impl_ = std::unique_ptr<Impl>(new Impl{model, poses, eps, slack, bvh, tasks, refined, outlines, o, threads, deadline, depth});
 }
 
 DecisionRun::~DecisionRun() = default;
@@ -408,7 +409,7 @@ std::vector<DecideResult> DecisionRun::finish(CollideCounters& counters, Collide
   // The contacts steps 4 to 6 proved, as early() does for its own.
   std::vector<std::size_t> late;
   for (std::size_t k = 0; k < run.tasks.size(); ++k)
-    if (!(run.state[k] & kAnswered) && depth_step_applies(run.model, run.tasks[k], run.pending[k])) late.push_back(k);
+    if (!(run.state[k] & kAnswered) && run.depth && depth_step_applies(run.model, run.tasks[k], run.pending[k])) late.push_back(k);
   dynamic_loop(static_cast<std::ptrdiff_t>(late.size()), run.threads, true, [&](std::ptrdiff_t i) {
     const std::size_t k = late[static_cast<std::size_t>(i)];
     timed(run.seconds[k].depth, [&] { run.deepen(k, run.pending[k], run.task_counters[k]); });
@@ -522,7 +523,7 @@ void decision_stage(SceneData& s, QueryState& q) {
   ProgressMeter meter(q.progress, ProgressStage::CheckPairs, q.pairs.size(), "decisions");
   std::vector<DecideResult> results =
       decide_pairs(model, s.poses, s.eps, s.slack, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline,
-                   q.report.counters, q.report.timings);
+                   q.report.counters, q.report.timings, q.depth);
   conclude(q, results, task_of, /*by_task=*/false, meter);
 }
 
@@ -540,7 +541,7 @@ void triangle_and_decision_stage(SceneData& s, QueryState& q) {
   std::vector<DecideTask> decide;
   decide.reserve(ntasks);
   for (std::size_t k = 0; k < ntasks; ++k) decide.push_back(decide_task(q, k, nullptr));
-  DecisionRun run(model, s.poses, s.eps, s.slack, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline);
+  DecisionRun run(model, s.poses, s.eps, s.slack, s.bvh, decide, s.refined, s.outlines, q.o, q.threads, q.deadline, q.depth);
   triangle_level_stage(s, q, [&](std::size_t k) {
     if (q.task_cut[k] || q.outcomes[k].cut) {
       run.skip(k);  // cut by the deadline: no answer, as decision_stage leaves it

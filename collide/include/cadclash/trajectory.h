@@ -91,6 +91,12 @@ struct MotionOptions {
   // passes its own: it must return, on every process, reports with the same pairs (ids, classes and
   // distance bounds) and the same `complete`, so that every process takes the same stretches.
   std::function<Report(Scene&, const CollideOptions&)> check;
+  // The static checks a caller has made already at the stretch's ends (the moving instances at
+  // `from`, and at `to`; the others where the scene has them), with options.tolerance and no
+  // clearance (options as check_motion's; their time budget may differ): used instead of checking
+  // there again. Null: checked here. replay_continuous passes its steps' checks.
+  const Report* at_start = nullptr;
+  const Report* at_end = nullptr;
 };
 struct MotionSpan {
   double s0 = 0.0, s1 = 0.0;
@@ -126,7 +132,8 @@ struct MotionResult {
   bool complete = true;           // false: max_checks ran out, the spans of the unfinished parts are listed whole
 };
 
-// Checks one stretch continuously (see above) and leaves the moving instances at `to`. Uses the
+// Checks one stretch continuously (see above) and leaves the moving instances at `to`. At s = 0 and
+// s = 1 the moving instances are checked at `from` and `to` themselves. Uses the
 // scene's selection and `options` (its tolerance and decision; its budgets apply to each static check,
 // and a partial check clears nothing). Preconditions: moving, from and to have one entry per
 // moving instance; the poses are rigid; resolution > 0.
