@@ -235,7 +235,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
         // middle less what its two sides can travel from there stays above T where its lower bound
         // says so.
         for (const PairKey& k : grown.open) {
-          const auto [a, b, sa, sb] = k;
+          const InstanceId a = std::get<0>(k), b = std::get<1>(k);  // a lambda cannot capture a structured binding (C++17)
           const double travel = half([&](double u0, double u1) { return pair_travel(a, b, u0, u1); });
           if (concerns(k) && !(grown.margin.at(k) > options.tolerance + travel)) suspect.insert(k);
         }
