@@ -4,7 +4,8 @@
 # into out/import_cache_bench/ so that edits keep its path, `cadclash check --cache DIR --json`:
 #   cold        an empty cache;
 #   unchanged   the same file again (its whole entry);
-#   placement   the last occurrence's placement lifted 0.5 mm along z (the main text changed);
+#   placement   the last occurrence's placement lifted 0.5 mm along z (the main text changed: the
+#               placements entry gives the file's model with its poses recomputed);
 #   model       one component model's vertex moved 1e-9 mm (one product's geometry changed);
 #   renumbered  every id + 1,000,000 (another export of the same products).
 # Per run: wall time, its share of the cold run, the import's stages, pieces and parts from the cache.
@@ -91,7 +92,8 @@ for name in ['cold', 'unchanged', 'placement', 'model', 'renumbered']:
     j = json.load(open(f'{out}/{name}.{round_}.json'))
     f = j['import_timings']['files'][0]
     q = j.get('timings', {}).get('total', 0.0)
-    pieces = f"{f.get('pieces_cached', 0)} / {f.get('pieces', 0)}" if f['cache'] != 'hit' else 'whole file'
+    pieces = {'hit': 'whole file', 'placements': "file's model, poses recomputed"}.get(
+        f['cache'], f"{f.get('pieces_cached', 0)} / {f.get('pieces', 0)}")
     rows.append(f"| {name} | {wall:.2f} | {100 * wall / cold:.0f} % | {f['total']:.2f} ({f['read']:.2f} / "
                 f"{f['transfer']:.2f} / {f['heal']:.2f}) | {q:.2f} | {pieces} | {f.get('parts_cached', 0)} |")
 text = (f"Import cache on re-runs of {board.split('/')[-1]} (cadclash {commit}, `check --cache`, default settings; "
