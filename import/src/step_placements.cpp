@@ -1,5 +1,6 @@
 // Poses recomputed from a STEP file's numbers (step_placements.h).
 #include "step_placements.h"
+#include "step_statements.h"
 
 #include <Geom_Axis2Placement.hxx>
 #include <Geom_Direction.hxx>
@@ -150,7 +151,6 @@ std::optional<TopLoc_Location> component_location(const ComponentPlacement& c, c
   return TopLoc_Location(trsf);
 }
 
-bool is_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
 
 // "(x,y,z)" at text[i] (spaces allowed around the numbers): the three numbers and the position
 // after ')'; nullopt otherwise.
@@ -166,7 +166,7 @@ std::optional<std::pair<std::array<double, 3>, std::size_t>> three_numbers(std::
     v[static_cast<std::size_t>(k)] = std::strtod(at, &end);
     if (end == at) return std::nullopt;
     at = end;
-    while (is_space(*at)) ++at;
+    while (step_space(*at)) ++at;
     if (k < 2 && *at++ != ',') return std::nullopt;
   }
   if (*at != '\0') return std::nullopt;
@@ -353,69 +353,6 @@ std::optional<std::vector<Pose>> placement_poses(const Placements& p, const Plac
 
 namespace {
 
-// Calls visit(id, type, begin, end) for each statement of the DATA section (begin: just after the
-// type; end: just after its ';'); false when the text cannot be scanned. visit returns false to stop
-// (then the scan returns false too).
-template <class Visit>
-bool for_each_statement(std::string_view text, Visit&& visit) {
-  const std::size_t data = text.find("DATA;");
-  if (data == std::string_view::npos || text.find("DATA;", data + 5) != std::string_view::npos) return false;
-  const std::size_t n = text.size();
-  std::size_t i = data + 5;
-  for (;;) {
-    while (i < n && is_space(text[i])) ++i;
-    if (i >= n) return false;
-    if (text.compare(i, 7, "ENDSEC;") == 0) return true;
-    if (text[i] != '#') return false;
-    std::int64_t id = 0;
-    ++i;
-    while (i < n && std::isdigit(static_cast<unsigned char>(text[i])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[i++] - '0');
-    while (i < n && is_space(text[i])) ++i;
-    if (i >= n || text[i] != '=') return false;
-    ++i;
-    while (i < n && is_space(text[i])) ++i;
-    const std::size_t type_at = i;
-    while (i < n && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '_')) ++i;
-    const std::size_t begin = i;
-    bool quoted = false;
-    for (; i < n; ++i) {
-      const char c = text[i];
-      if (quoted) {
-        quoted = c != '\'';  // '' closes and reopens: the same
-      } else if (c == '\'') {
-        quoted = true;
-      } else if (c == ';') {
-        break;
-      } else if (c == '/' && i + 1 < n && text[i + 1] == '*') {
-        return false;
-      }
-    }
-    if (i >= n) return false;
-    ++i;
-    if (!visit(id, text.substr(type_at, begin - type_at), begin, i)) return false;
-  }
-}
-
-// Each "#digits" of text[begin, end) outside quoted strings.
-template <class Visit>
-void for_each_reference(std::string_view text, std::size_t begin, std::size_t end, Visit&& visit) {
-  bool quoted = false;
-  for (std::size_t i = begin; i < end; ++i) {
-    const char c = text[i];
-    if (quoted) {
-      quoted = c != '\'';
-    } else if (c == '\'') {
-      quoted = true;
-    } else if (c == '#') {
-      std::int64_t ref = 0;
-      std::size_t j = i + 1;
-      while (j < end && std::isdigit(static_cast<unsigned char>(text[j])) && ref < (std::int64_t{1} << 50)) ref = ref * 10 + (text[j++] - '0');
-      if (j > i + 1) visit(ref);
-      i = j - 1;
-    }
-  }
-}
-
 bool ends_with(std::string_view s, std::string_view tail) {
   return s.size() >= tail.size() && s.substr(s.size() - tail.size()) == tail;
 }
@@ -428,24 +365,30 @@ std::vector<std::int64_t> free_placement_values(std::string_view text, std::span
   std::unordered_set<std::int64_t> bound;  // values referenced by a statement other than an axis
   std::unordered_set<std::int64_t> fixed;  // axes referenced by a statement that uses them for more than placing occurrences
   std::unordered_map<std::int64_t, std::vector<std::int64_t>> of_axis;  // the values each axis references
-  const bool scanned = for_each_statement(text, [&](std::int64_t id, std::string_view type, std::size_t begin, std::size_t end) {
-    const bool axis = axis_set.count(id) > 0;
-    // An axis placement that is an item of a shape representation and used by an item-defined
-    // transformation is skipped by OCCT's transfer of the representation: it places nothing else.
-    const bool places_only = type == "ITEM_DEFINED_TRANSFORMATION" ||
-                             (ends_with(type, "SHAPE_REPRESENTATION") && type != "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION");
-    for_each_reference(text, begin, end, [&](std::int64_t ref) {
-      if (values.count(ref)) {
-        if (axis) of_axis[id].push_back(ref);
-        else bound.insert(ref);
-      }
-      if (axis_set.count(ref) && !places_only) fixed.insert(ref);
-    });
-    return true;
-  });
+  std::vector<std::int64_t> refs;  // the statement's, as they are read
+  std::string why;
+  const bool scanned = for_each_statement(
+      text,
+      [&](const StatementSpan& s) {
+        const bool axis = axis_set.count(s.id) > 0;
+        // An axis placement that is an item of a shape representation and used by an item-defined
+        // transformation is skipped by OCCT's transfer of the representation: it places nothing else.
+        const bool places_only = s.type == "ITEM_DEFINED_TRANSFORMATION" ||
+                                 (ends_with(s.type, "SHAPE_REPRESENTATION") && s.type != "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION");
+        for (const std::int64_t ref : refs) {
+          if (values.count(ref)) {
+            if (axis) of_axis[s.id].push_back(ref);
+            else bound.insert(ref);
+          }
+          if (axis_set.count(ref) && !places_only) fixed.insert(ref);
+        }
+        refs.clear();
+        return true;
+      },
+      [&](std::int64_t ref) { refs.push_back(ref); }, why);
   if (!scanned) return {};
-  for (const auto& [axis, refs] : of_axis)
-    if (fixed.count(axis)) bound.insert(refs.begin(), refs.end());
+  for (const auto& [axis, refs_of] : of_axis)
+    if (fixed.count(axis)) bound.insert(refs_of.begin(), refs_of.end());
   std::vector<std::int64_t> out;
   for (const std::int64_t id : ids)
     if (!bound.count(id)) out.push_back(id);
@@ -459,13 +402,15 @@ std::optional<PlacementText> placement_text(std::string_view text, std::span<con
   PlacementText out;
   Hasher hash;
   std::size_t kept = 0;  // the text before this is hashed (or left out)
-  const bool scanned = for_each_statement(text, [&](std::int64_t id, std::string_view type, std::size_t begin, std::size_t end) {
-    if (!wanted.count(id)) return true;
+  std::string why;
+  const auto statement = [&](const StatementSpan& s) {
+    if (!wanted.count(s.id)) return true;
     // TYPE('name',(x,y,z)): the numbers read, and left out of the hash when free.
-    if (type != "CARTESIAN_POINT" && type != "DIRECTION") return false;
-    std::size_t i = begin;
+    if (s.type != "CARTESIAN_POINT" && s.type != "DIRECTION") return false;
+    const std::size_t end = s.end;
+    std::size_t i = s.after_type;
     auto skip = [&] {
-      while (i < end && is_space(text[i])) ++i;
+      while (i < end && step_space(text[i])) ++i;
     };
     skip();
     if (i >= end || text[i++] != '(') return false;
@@ -481,14 +426,15 @@ std::optional<PlacementText> placement_text(std::string_view text, std::span<con
     if (i >= end || text[i++] != ',') return false;
     skip();
     const auto numbers = three_numbers(text.substr(0, end), i);
-    if (!numbers || !out.values.emplace(id, numbers->first).second) return false;  // not three numbers, or defined twice
-    if (left_out.count(id)) {
+    if (!numbers || !out.values.emplace(s.id, numbers->first).second) return false;  // not three numbers, or defined twice
+    if (left_out.count(s.id)) {
       hash.add(text.substr(kept, i - kept));
       hash.add("()");
       kept = numbers->second;
     }
     return true;
-  });
+  };
+  const bool scanned = for_each_statement(text, statement, [](std::int64_t) {}, why);
   if (!scanned || out.values.size() != wanted.size()) return std::nullopt;
   hash.add(text.substr(kept));
   out.skeleton = hash.hex();

@@ -1,5 +1,6 @@
 // A STEP file's text cut into pieces by B-rep item (step_split_text.h).
 #include "step_split_text.h"
+#include "step_statements.h"
 
 #include <algorithm>
 #include <cassert>
@@ -28,80 +29,30 @@ struct Scan {
   std::vector<std::uint32_t> refs;  // statement indices
 };
 
-bool is_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
-
 // Every statement of the DATA section with what it references; nullopt (and why) when the text is
 // not plain enough to cut.
 std::optional<Scan> scan(const std::string& text, std::string& why) {
-  const std::size_t data = text.find("DATA;");
-  if (data == std::string::npos || text.find("DATA;", data + 5) != std::string::npos) {
-    why = "not one DATA section";
-    return std::nullopt;
-  }
   Scan out;
-  out.header = std::string_view(text).substr(0, data);
+  out.header = std::string_view(text).substr(0, text.find("DATA;"));
   std::vector<std::int64_t> raw;  // referenced ids, resolved to statements below
-  std::size_t i = data + 5;
-  const std::size_t n = text.size();
-  for (;;) {
-    while (i < n && is_space(text[i])) ++i;
-    if (i >= n) {
-      why = "the DATA section does not end";
-      return std::nullopt;
-    }
-    if (text.compare(i, 7, "ENDSEC;") == 0) break;
-    if (text[i] != '#') {
-      why = text.compare(i, 2, "/*") == 0 ? "a comment in the DATA section" : "unexpected text in the DATA section";
-      return std::nullopt;
-    }
-    Statement s;
-    s.begin = i++;
-    while (i < n && std::isdigit(static_cast<unsigned char>(text[i])) && s.id < (std::int64_t{1} << 50)) s.id = s.id * 10 + (text[i++] - '0');
-    while (i < n && is_space(text[i])) ++i;
-    if (i >= n || text[i] != '=') {
-      why = "a statement without '='";
-      return std::nullopt;
-    }
-    s.body = ++i;
-    while (i < n && is_space(text[i])) ++i;
-    if (i < n && text[i] != '(') {
-      const std::size_t t = i;
-      while (i < n && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '_')) ++i;
-      s.type = std::string_view(text).substr(t, i - t);
-    }
-    s.first_ref = raw.size();
-    bool quoted = false;
-    for (; i < n; ++i) {
-      const char c = text[i];
-      if (quoted) {
-        quoted = c != '\'';  // '' closes and reopens: the same
-      } else if (c == '\'') {
-        quoted = true;
-      } else if (c == ';') {
-        break;
-      } else if (c == '#') {
-        std::int64_t id = 0;
-        std::size_t j = i + 1;
-        while (j < n && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
-        if (j > i + 1) raw.push_back(id);
-        i = j - 1;
-      } else if (c == '/' && i + 1 < n && text[i + 1] == '*') {
-        why = "a comment in the DATA section";
-        return std::nullopt;
-      }
-    }
-    if (i >= n) {
-      why = "a statement does not end";
-      return std::nullopt;
-    }
-    s.end = ++i;
-    s.refs = raw.size() - s.first_ref;
-    out.statements.push_back(s);
-  }
-  if (text.find("END-ISO-10303-21", i) == std::string::npos) {
-    why = "the file does not end";
-    return std::nullopt;
-  }
+  std::size_t first_ref = 0;
+  const bool scanned = for_each_statement(
+      text,
+      [&](const StatementSpan& span) {
+        Statement s;
+        s.id = span.id;
+        s.begin = span.begin;
+        s.end = span.end;
+        s.body = span.body;
+        s.type = span.type;
+        s.first_ref = first_ref;
+        s.refs = raw.size() - first_ref;
+        first_ref = raw.size();
+        out.statements.push_back(s);
+        return true;
+      },
+      [&](std::int64_t id) { raw.push_back(id); }, why);
+  if (!scanned) return std::nullopt;
   std::unordered_map<std::int64_t, std::uint32_t> index;
   index.reserve(out.statements.size());
   for (std::size_t k = 0; k < out.statements.size(); ++k)
@@ -143,7 +94,7 @@ std::string_view first_parameter(const std::string& text, const Statement& s) {
   std::size_t i = text.find('(', s.body);
   if (i == std::string::npos || i >= s.end) return "''";
   ++i;
-  while (i < s.end && is_space(text[i])) ++i;
+  while (i < s.end && step_space(text[i])) ++i;
   if (i < s.end && text[i] == '\'') {
     std::size_t j = i + 1;
     for (; j < s.end; ++j)
