@@ -19,39 +19,18 @@
 //
 // Usage: node path_test.mjs --cadclash EXE --viewer-dir DIR --out DIR --data DIR
 // Exit codes: 0 pass, 1 fail, 77 skipped (the data is missing).
-import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport } from './browser_common.mjs';
 
-const CHROMIUM = '/usr/bin/chromium';
-const CHROMIUM_ARGS = [
-  '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-];
 // The page's colours of the two time states (viewer/src/classes.js, TIME_COLOURS).
 const STATE_COLOUR = { contact: 0xff8c1a, may: 0xf032e6 };
 // The instance matrices are drawn from Float32 buffers.
 const POSE_TOLERANCE = 1e-5;
 
-class Failure extends Error {}
-function check(condition, message) {
-  if (!condition) throw new Failure(message);
-}
-
 function args() {
-  const out = {};
-  const argv = process.argv.slice(2);
-  for (let i = 0; i < argv.length; i += 2) out[argv[i].replace(/^--/, '')] = argv[i + 1];
-  for (const key of ['cadclash', 'viewer-dir', 'out', 'data']) if (!out[key]) throw new Error(`missing --${key}`);
-  return out;
-}
-
-function cadclash(exe, argv) {
-  const run = spawnSync(exe, argv, { encoding: 'utf8', timeout: 120000 });
-  check(run.status === 0, `cadclash ${argv.join(' ')} exited ${run.status}:\n${run.stdout}\n${run.stderr}`);
-  return run;
+  return keyArgs(['cadclash', 'viewer-dir', 'out', 'data']);
 }
 
 // The CSV's poses per step, read here: {steps: [numbers], poses: Map path -> per step [t, q]}
@@ -147,20 +126,7 @@ function expectedColoured(report, t) {
   return out;
 }
 
-async function openPage(browser, html) {
-  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
-  const errors = [], requests = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('request', (r) => { if (!r.url().startsWith('file:')) requests.push(r.url()); });
-  await page.goto(pathToFileURL(html).href);
-  await page.waitForSelector('html[data-cadclash-ready], html[data-cadclash-error]', { state: 'attached', timeout: 60000 });
-  const failed = await page.getAttribute('html', 'data-cadclash-error');
-  check(failed === null, `the viewer reported: ${failed}`);
-  check(errors.length === 0, `page errors: ${errors.join('; ')}`);
-  check(requests.length === 0, `the report fetched ${requests.join(', ')}`);
-  return page;
-}
+const openPage = (browser, html) => openReport(browser, html);
 
 // Moves the slider to t as a user does (its input event), and returns what the page draws then.
 async function slideTo(page, t) {

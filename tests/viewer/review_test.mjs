@@ -8,36 +8,15 @@
 //
 // Usage: node review_test.mjs --cadclash EXE --viewer-dir DIR --out DIR --as1 FILE
 // Exit codes: 0 pass, 1 fail, 77 skipped (as1 missing).
-import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport } from './browser_common.mjs';
 
-const CHROMIUM = '/usr/bin/chromium';
-const CHROMIUM_ARGS = [
-  '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-];
 const TODAY = '2026-06-01';
 
-class Failure extends Error {}
-function check(condition, message) {
-  if (!condition) throw new Failure(message);
-}
-
 function args() {
-  const out = {};
-  const argv = process.argv.slice(2);
-  for (let i = 0; i < argv.length; i += 2) out[argv[i].replace(/^--/, '')] = argv[i + 1];
-  for (const key of ['cadclash', 'viewer-dir', 'out', 'as1']) if (!out[key]) throw new Error(`missing --${key}`);
-  return out;
-}
-
-function cadclash(exe, argv) {
-  const run = spawnSync(exe, argv, { encoding: 'utf8', timeout: 120000 });
-  check(run.status === 0, `cadclash ${argv.join(' ')} exited ${run.status}:\n${run.stderr}`);
-  return run;
+  return keyArgs(['cadclash', 'viewer-dir', 'out', 'as1']);
 }
 
 // The listed pair indices the table would hold with these toggles, from the JSON report alone.
@@ -87,12 +66,7 @@ async function main() {
   const { chromium } = createRequire(join(a['viewer-dir'], 'package.json'))('playwright-core');
   const browser = await chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS });
   try {
-    const page = await browser.newPage({ viewport: { width: 1400, height: 800 }, acceptDownloads: true });
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(pathToFileURL(html).href);
-    await page.waitForSelector('html[data-cadclash-ready], html[data-cadclash-error]', { state: 'attached', timeout: 60000 });
-    check(await page.getAttribute('html', 'data-cadclash-error') === null, 'the viewer failed');
+    const page = await openReport(browser, html, { viewport: { width: 1400, height: 800 }, acceptDownloads: true });
 
     // Counts per status and approval, as the JSON report has them.
     const count = async (f) => Number(await page.innerText(`[data-review-count="${f}"]`));
@@ -151,7 +125,7 @@ async function main() {
       const expected = c.id === target.id || (c.id !== byId.id && was.approval === 1);
       check((c.approval !== null) === expected, `clash ${c.id}: approved ${c.approval !== null} by the exported file, expected ${expected}`);
     }
-    check(errors.length === 0, `page errors: ${errors.join('; ')}`);
+    check(page.pageErrors.length === 0, `page errors: ${page.pageErrors.join('; ')}`);
     await page.screenshot({ path: join(out, 'review.png') });
     console.log(`review: ${JSON.stringify(s)}; approved ${target.id} and unapproved ${byId.id} in the page; export checked by the CLI`);
   } finally {

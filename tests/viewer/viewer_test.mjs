@@ -21,15 +21,8 @@ import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, check, openReport } from './browser_common.mjs';
 
-const CHROMIUM = '/usr/bin/chromium';
-// Without the background-networking switches Chromium keeps calling home, which a closed network
-// refuses; SwiftShader gives WebGL without a GPU.
-const CHROMIUM_ARGS = [
-  '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-];
 
 function parseArgs(argv) {
   const args = { cases: [] };
@@ -49,10 +42,6 @@ function parseArgs(argv) {
   return args;
 }
 
-class Failure extends Error {}
-function check(condition, message) {
-  if (!condition) throw new Failure(message);
-}
 
 async function main() {
   const args = parseArgs(process.argv.slice(2));
@@ -107,21 +96,8 @@ async function checkCase(browser, args, { name, inputs, options, tessellate, exp
 
   // 900 px high: with the clash review bar and clash line the table still shows 8 rows, so a filter
   // listing up to 20 pairs has every row drawn (visible rows plus the table's overscan of 12).
-  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const page = await openReport(browser, html);
   try {
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(e.message));
-    page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-    // The report must open offline: any request other than the file itself is a failure.
-    const requests = [];
-    page.on('request', (r) => { if (!r.url().startsWith('file:')) requests.push(r.url()); });
-
-    await page.goto(pathToFileURL(html).href);
-    await page.waitForSelector('html[data-cadclash-ready], html[data-cadclash-error]', { state: 'attached', timeout: 60000 });
-    const failed = await page.getAttribute('html', 'data-cadclash-error');
-    check(failed === null, `the viewer reported: ${failed}`);
-    check(errors.length === 0, `page errors: ${errors.join('; ')}`);
-    check(requests.length === 0, `the report fetched ${requests.join(', ')}`);
     const stats = await page.evaluate(() => window.cadclashViewer.stats);
     console.log(`viewer stats: ${JSON.stringify(stats)}`);
     // Every pair is listed; the table draws only the rows around the visible ones, but scrolls the
