@@ -51,3 +51,12 @@ export async function openReport(browser, html, pageOptions = {}) {
   page.pageErrors = errors;
   return page;
 }
+
+// Runs the test's async main: its exit code, or 1 with the failure's message (a Failure) or the
+// error itself.
+export function runTest(main) {
+  main().then((code) => process.exit(code), (e) => {
+    console.error(e instanceof Failure ? `FAIL: ${e.message}` : e);
+    process.exit(1);
+  });
+}

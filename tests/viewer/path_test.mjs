@@ -22,7 +22,7 @@
 import { existsSync, mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport } from './browser_common.mjs';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport, runTest } from './browser_common.mjs';
 
 // The page's colours of the two time states (viewer/src/classes.js, TIME_COLOURS).
 const STATE_COLOUR = { contact: 0xff8c1a, may: 0xf032e6 };
@@ -313,7 +313,4 @@ async function main() {
   return 0;
 }
 
-main().then((code) => process.exit(code), (e) => {
-  console.error(e instanceof Failure ? `FAIL: ${e.message}` : e);
-  process.exit(1);
-});
+runTest(main);

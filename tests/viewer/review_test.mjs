@@ -11,7 +11,7 @@
 import { existsSync, mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport } from './browser_common.mjs';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, cadclash, check, keyArgs, openReport, runTest } from './browser_common.mjs';
 
 const TODAY = '2026-06-01';
 
@@ -134,7 +134,4 @@ async function main() {
   return 0;
 }
 
-main().then((code) => process.exit(code), (e) => {
-  console.error(e instanceof Failure ? `FAIL: ${e.message}` : e);
-  process.exit(1);
-});
+runTest(main);

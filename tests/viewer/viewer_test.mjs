@@ -21,7 +21,7 @@ import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, resolve } from 'node:path';
-import { CHROMIUM, CHROMIUM_ARGS, Failure, check, openReport } from './browser_common.mjs';
+import { CHROMIUM, CHROMIUM_ARGS, Failure, check, openReport, runTest } from './browser_common.mjs';
 
 
 function parseArgs(argv) {
@@ -382,7 +382,4 @@ async function checkFilterAndKeys(page, pairs, index) {
   await checkListed(page, pairs, expectedRows(pairs, '', rareShown ? null : rare), 'after Escape', []);
 }
 
-main().then((code) => process.exit(code), (e) => {
-  console.error(e instanceof Failure ? `FAIL: ${e.message}` : e);
-  process.exit(1);
-});
+runTest(main);
