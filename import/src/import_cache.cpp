@@ -314,11 +314,11 @@ void store_placements(const std::string& path, const std::string& bytes, const I
   if (p.components.empty() || p.chains.size() != result.model.instances.size()) return;
   for (const Diagnostic& d : result.diagnostics)  // a pose the walk warned about or dropped
     if (d.message.find(" is placed ") != std::string::npos) return;
-  const std::vector<std::int64_t> ids = p.value_ids();
-  const std::vector<std::int64_t> free = free_placement_values(bytes, ids, p.axis_ids());
-  if (free.empty()) return;  // no number of this file can change without changing more than poses
-  const std::optional<PlacementText> text = placement_text(bytes, ids, free);
-  if (!text) return;
+  const std::optional<FreePlacementText> scanned = free_placement_text(bytes, p.value_ids(), p.axis_ids());
+  // None, or no number of this file can change without changing more than poses.
+  if (!scanned || scanned->free.empty()) return;
+  const std::vector<std::int64_t>& free = scanned->free;
+  const PlacementText* text = &scanned->text;
   // Bit for bit: a pose the reader makes with a -0 where this makes a +0 is not the same pose.
   const std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
   if (!poses) return;

@@ -30,6 +30,7 @@
 #include <openssl/evp.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -359,53 +360,42 @@ bool ends_with(std::string_view s, std::string_view tail) {
 
 }  // namespace
 
-std::vector<std::int64_t> free_placement_values(std::string_view text, std::span<const std::int64_t> ids,
-                                                std::span<const std::int64_t> axes) {
-  const std::unordered_set<std::int64_t> values(ids.begin(), ids.end()), axis_set(axes.begin(), axes.end());
+namespace {
+
+// One pass over the text: the numbers of the statements `ids` and where they stand, and, with
+// `axes`, which of them place occurrences and nothing else (free_values); nullopt when the text
+// cannot be scanned or one of `ids` is missing or not a CARTESIAN_POINT / DIRECTION('name',(x,y,z)).
+struct NumberScan {
+  PlacementValues values;
+  std::map<std::size_t, std::pair<std::size_t, std::int64_t>> spans;  // by where the numbers begin: their end and id
+  std::vector<std::int64_t> free;                                    // with axes: ascending
+};
+std::optional<NumberScan> scan_numbers(std::string_view text, std::span<const std::int64_t> ids,
+                                       std::span<const std::int64_t> axes) {
+  const std::unordered_set<std::int64_t> wanted(ids.begin(), ids.end()), axis_set(axes.begin(), axes.end());
+  NumberScan out;
   std::unordered_set<std::int64_t> bound;  // values referenced by a statement other than an axis
   std::unordered_set<std::int64_t> fixed;  // axes referenced by a statement that uses them for more than placing occurrences
   std::unordered_map<std::int64_t, std::vector<std::int64_t>> of_axis;  // the values each axis references
   std::vector<std::int64_t> refs;  // the statement's, as they are read
-  std::string why;
-  const bool scanned = for_each_statement(
-      text,
-      [&](const StatementSpan& s) {
-        const bool axis = axis_set.count(s.id) > 0;
-        // An axis placement that is an item of a shape representation and used by an item-defined
-        // transformation is skipped by OCCT's transfer of the representation: it places nothing else.
-        const bool places_only = s.type == "ITEM_DEFINED_TRANSFORMATION" ||
-                                 (ends_with(s.type, "SHAPE_REPRESENTATION") && s.type != "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION");
-        for (const std::int64_t ref : refs) {
-          if (values.count(ref)) {
-            if (axis) of_axis[s.id].push_back(ref);
-            else bound.insert(ref);
-          }
-          if (axis_set.count(ref) && !places_only) fixed.insert(ref);
-        }
-        refs.clear();
-        return true;
-      },
-      [&](std::int64_t ref) { refs.push_back(ref); }, why);
-  if (!scanned) return {};
-  for (const auto& [axis, refs_of] : of_axis)
-    if (fixed.count(axis)) bound.insert(refs_of.begin(), refs_of.end());
-  std::vector<std::int64_t> out;
-  for (const std::int64_t id : ids)
-    if (!bound.count(id)) out.push_back(id);
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-std::optional<PlacementText> placement_text(std::string_view text, std::span<const std::int64_t> ids,
-                                            std::span<const std::int64_t> free) {
-  const std::unordered_set<std::int64_t> wanted(ids.begin(), ids.end()), left_out(free.begin(), free.end());
-  PlacementText out;
-  Hasher hash;
-  std::size_t kept = 0;  // the text before this is hashed (or left out)
-  std::string why;
   const auto statement = [&](const StatementSpan& s) {
+    if (!axes.empty()) {
+      const bool axis = axis_set.count(s.id) > 0;
+      // An axis placement that is an item of a shape representation and used by an item-defined
+      // transformation is skipped by OCCT's transfer of the representation: it places nothing else.
+      const bool places_only = s.type == "ITEM_DEFINED_TRANSFORMATION" ||
+                               (ends_with(s.type, "SHAPE_REPRESENTATION") && s.type != "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION");
+      for (const std::int64_t ref : refs) {
+        if (wanted.count(ref)) {
+          if (axis) of_axis[s.id].push_back(ref);
+          else bound.insert(ref);
+        }
+        if (axis_set.count(ref) && !places_only) fixed.insert(ref);
+      }
+      refs.clear();
+    }
     if (!wanted.count(s.id)) return true;
-    // TYPE('name',(x,y,z)): the numbers read, and left out of the hash when free.
+    // TYPE('name',(x,y,z))
     if (s.type != "CARTESIAN_POINT" && s.type != "DIRECTION") return false;
     const std::size_t end = s.end;
     std::size_t i = s.after_type;
@@ -427,19 +417,61 @@ std::optional<PlacementText> placement_text(std::string_view text, std::span<con
     skip();
     const auto numbers = three_numbers(text.substr(0, end), i);
     if (!numbers || !out.values.emplace(s.id, numbers->first).second) return false;  // not three numbers, or defined twice
-    if (left_out.count(s.id)) {
-      hash.add(text.substr(kept, i - kept));
-      hash.add("()");
-      kept = numbers->second;
-    }
+    out.spans.emplace(i, std::pair{numbers->second, s.id});
     return true;
   };
-  const bool scanned = for_each_statement(text, statement, [](std::int64_t) {}, why);
-  if (!scanned || out.values.size() != wanted.size()) return std::nullopt;
-  hash.add(text.substr(kept));
-  out.skeleton = hash.hex();
+  std::string why;
+  const auto reference = [&](std::int64_t ref) {
+    if (!axes.empty()) refs.push_back(ref);
+  };
+  if (!for_each_statement(text, statement, reference, why) || out.values.size() != wanted.size()) return std::nullopt;
+  if (!axes.empty()) {
+    for (const auto& [axis, refs_of] : of_axis)
+      if (fixed.count(axis)) bound.insert(refs_of.begin(), refs_of.end());
+    for (const std::int64_t id : ids)
+      if (!bound.count(id)) out.free.push_back(id);
+    std::sort(out.free.begin(), out.free.end());
+  }
   return out;
 }
 
+// SHA-256 (hex) of the text with the numbers of `free` left out.
+std::string skeleton_of(std::string_view text, const NumberScan& scan, std::span<const std::int64_t> free) {
+  const std::unordered_set<std::int64_t> left_out(free.begin(), free.end());
+  Hasher hash;
+  std::size_t kept = 0;  // the text before this is hashed (or left out)
+  for (const auto& [begin, to] : scan.spans) {
+    if (!left_out.count(to.second)) continue;
+    hash.add(text.substr(kept, begin - kept));
+    hash.add("()");
+    kept = to.first;
+  }
+  hash.add(text.substr(kept));
+  return hash.hex();
+}
+
+}  // namespace
+
+std::optional<FreePlacementText> free_placement_text(std::string_view text, std::span<const std::int64_t> ids,
+                                                     std::span<const std::int64_t> axes) {
+  assert(!axes.empty());
+  std::optional<NumberScan> scan = scan_numbers(text, ids, axes);
+  if (!scan) return std::nullopt;
+  FreePlacementText out;
+  out.free = std::move(scan->free);
+  out.text.skeleton = skeleton_of(text, *scan, out.free);
+  out.text.values = std::move(scan->values);
+  return out;
+}
+
+std::optional<PlacementText> placement_text(std::string_view text, std::span<const std::int64_t> ids,
+                                            std::span<const std::int64_t> free) {
+  std::optional<NumberScan> scan = scan_numbers(text, ids, {});
+  if (!scan) return std::nullopt;
+  PlacementText out;
+  out.skeleton = skeleton_of(text, *scan, free);
+  out.values = std::move(scan->values);
+  return out;
+}
 
 }  // namespace cadclash::detail

@@ -83,23 +83,26 @@ using PlacementValues = std::unordered_map<std::int64_t, std::array<double, 3>>;
 // the walk warns about or drops) or a value is missing.
 std::optional<std::vector<Pose>> placement_poses(const Placements& p, const PlacementValues& values);
 
-// Of the points and directions `ids` of a STEP file's text, those that place occurrences and
-// nothing else: referenced only by the axes `axes`, each referenced only by
-// ITEM_DEFINED_TRANSFORMATIONs and shape representations (whose transfer skips an axis an
-// item-defined transformation uses). Ascending; empty when the text cannot be scanned (not one DATA
-// section, a comment, a statement that does not end).
-std::vector<std::int64_t> free_placement_values(std::string_view text, std::span<const std::int64_t> ids,
-                                                std::span<const std::int64_t> axes);
-
 // The statements `ids` of a STEP file's text (each a CARTESIAN_POINT or DIRECTION of a name and
 // three numbers): their numbers, and a SHA-256 (hex) of the text with the numbers of `free` (a
-// subset of `ids`) left out. nullopt when the text cannot be scanned or one of `ids` is missing or
-// not such a statement.
+// subset of `ids`) left out. nullopt when the text cannot be scanned (for_each_statement) or one of
+// `ids` is missing or not such a statement.
 struct PlacementText {
   std::string skeleton;
   PlacementValues values;
 };
 std::optional<PlacementText> placement_text(std::string_view text, std::span<const std::int64_t> ids,
                                             std::span<const std::int64_t> free);
+
+// placement_text, in the same one pass finding `free`: those of `ids` that place occurrences and
+// nothing else (referenced only by the axes `axes`, each referenced only by
+// ITEM_DEFINED_TRANSFORMATIONs and shape representations, whose transfer skips an axis an
+// item-defined transformation uses), ascending. Precondition: axes not empty.
+struct FreePlacementText {
+  std::vector<std::int64_t> free;
+  PlacementText text;
+};
+std::optional<FreePlacementText> free_placement_text(std::string_view text, std::span<const std::int64_t> ids,
+                                                     std::span<const std::int64_t> axes);
 
 }  // namespace cadclash::detail
