@@ -255,12 +255,15 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       continue;
     }
     std::set<PairKey> halve;
+    // Only a pair that may touch in the middle can be in contact over the whole stretch: the checks
+    // at its ends (at T) are run, once for the stretch, when such a pair is there.
+    const Contacts* ends[2] = {nullptr, nullptr};
+    auto in_contact_at = [&](int end, const PairKey& k) {
+      if (!ends[end]) ends[end] = &contacts_at(end == 0 ? st.s0 : st.s1, st.all ? nullptr : &st.pairs);
+      return ends[end]->contact.count(k) > 0;
+    };
     for (const PairKey& k : suspect) {
-      // Only a pair that may touch in the middle can be in contact over the whole stretch: the
-      // checks at its ends (at T) are run for such pairs only.
-      const std::set<PairKey>* keys = st.all ? nullptr : &st.pairs;
-      if (!(grown.margin.at(k) > options.tolerance) && contacts_at(st.s0, keys).contact.count(k) &&
-          contacts_at(st.s1, keys).contact.count(k))
+      if (!(grown.margin.at(k) > options.tolerance) && in_contact_at(0, k) && in_contact_at(1, k))
         spans[k].push_back({st.s0, st.s1, true});
       else if (st.s1 - st.s0 <= motion.resolution) spans[k].push_back({st.s0, st.s1, false});
       else halve.insert(k);
