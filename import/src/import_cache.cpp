@@ -62,7 +62,7 @@ std::optional<std::string> file_bytes(const std::string& path) {
 }
 
 // The build of cadclash reading the files: the file this code was loaded from (the program, or the
-// Python module), its size and modification time. Any rebuild changes it, so an entry written by
+// Python module) by its canonical path, its size and modification time. Any rebuild changes it, so an entry written by
 // another build, whose readers or tessellation may differ, is never looked up; stat is all it costs.
 std::string build_identity() {
   static const std::string id = [] {
@@ -71,6 +71,10 @@ std::string build_identity() {
     if (dladdr(reinterpret_cast<const void*>(&build_identity), &info) != 0 && info.dli_fname != nullptr &&
         info.dli_fname[0] == '/')
       file = info.dli_fname;
+    // The same build by whatever name it was started (a relative path, /proc/self/exe, a link):
+    // the key names the file itself, or every entry would miss when the command is typed differently.
+    std::error_code ec;
+    if (const std::filesystem::path real = std::filesystem::canonical(file, ec); !ec) file = real.string();
     struct stat st {};
     if (stat(file.c_str(), &st) != 0) return std::string("build unknown");
     return "build " + file + " " + std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <string>
+#include <sys/wait.h>
 
 namespace {
 
@@ -49,6 +50,28 @@ TEST(CliImport, ParallelAndCachedReportsAreTheReference) {
   EXPECT_EQ(report_of(files, "--no-timings --cache '" + cache + "'"), reference);  // warm
   EXPECT_EQ(report_of(files, "--no-timings --lazy --cache '" + cache + "'"),
             report_of(files, "--no-timings --lazy"));
+}
+
+// The cache is keyed by the build that wrote it, not by how the command was typed: a run started
+// by a relative path or through a link finds what a run started by the full path stored.
+TEST(CliImport, CacheIsFoundHoweverTheProgramIsStarted) {
+  const std::string as1 = kExternal + "as1-tu-203.stp";
+  if (const std::string m = missing({as1}); !m.empty()) GTEST_SKIP() << m << " missing: run scripts/setup.sh";
+  const std::string dir = cadclash::testing::scratch_dir();
+  const std::string cache = dir + "/started-cache", json = dir + "/started.json", link = dir + "/cadclash-link";
+  fs::remove_all(cache);
+  fs::remove(link);
+  fs::create_symlink(CADCLASH_EXE, link);
+  (void)report_of("'" + as1 + "'", "--cache '" + cache + "'");  // stored by the full path
+  const fs::path exe(CADCLASH_EXE);
+  for (const std::string& start : {"cd '" + exe.parent_path().string() + "' && ./" + exe.filename().string(), "'" + link + "'"}) {
+    fs::remove(json);
+    const std::string command = start + " check '" + as1 + "' --cache '" + cache + "' --json '" + json + "' >/dev/null 2>&1";
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 3)) << command;
+    const nlohmann::json j = nlohmann::json::parse(cadclash::testing::slurp(json));
+    EXPECT_EQ(j["import_timings"]["files"][0]["cache"], "hit") << command;
+  }
 }
 
 TEST(CliImport, StagesAreInTheTableAndTheJson) {
