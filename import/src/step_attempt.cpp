@@ -14,12 +14,18 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <Interface_Static.hxx>
 #include <STEPCAFControl_Reader.hxx>
+#include <STEPConstruct_Styles.hxx>
+#include <StepVisual_Colour.hxx>
+#include <StepVisual_StyledItem.hxx>
+#include <StepVisual_StyledItemTarget.hxx>
 #include <StepRepr_RepresentationItem.hxx>
 #include <StepShape_Face.hxx>
 #include <TCollection_HAsciiString.hxx>
 #include <TDF_LabelSequence.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <XSControl_TransferReader.hxx>
@@ -147,6 +153,29 @@ std::string read_step_pieces(const std::string& path, const std::vector<StepPiec
   return std::move(w.out);
 }
 
+// The styled faces of the pieces coloured in the document as STEPCAFControl_Reader::ReadColors
+// colours a face it finds styled in the file: on the face's sub-shape label of the part holding it,
+// else on the labels of the face's wires.
+void colour_styled_faces(const Handle(TDocStd_Document)& doc, const std::vector<FaceStyle>& styles) {
+  if (styles.empty() || doc.IsNull()) return;
+  const Handle(XCAFDoc_ColorTool) colours = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  auto set = [&](const TDF_Label& label, const FaceStyle& style) {
+    if (style.surface) colours->SetColor(label, *style.surface, XCAFDoc_ColorSurf);
+    if (style.boundary) colours->SetColor(label, *style.boundary, XCAFDoc_ColorCurv);
+    if (style.curve) colours->SetColor(label, *style.curve, XCAFDoc_ColorCurv);
+  };
+  for (const FaceStyle& style : styles) {
+    TDF_Label label;
+    if (shapes->SearchUsingMap(style.face, label, Standard_False, Standard_True)) {
+      set(label, style);
+      continue;
+    }
+    for (TopoDS_Iterator it(style.face); it.More(); it.Next())
+      if (shapes->SearchUsingMap(it.Value(), label, Standard_False, Standard_True)) set(label, style);
+  }
+}
+
 // The pieces' shapes bound to the main text's stand-ins, by #id, the workers' stored in the cache:
 // false when a worker failed (nothing is bound then).
 bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
@@ -209,6 +238,7 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
       transfer_document(reader, ws, model, label, path, "STEP", result);
   run.mark(kTransferred);
   if (!process) return;
+  colour_styled_faces(result.doc, bound.styles);
   if (has_faces(result.doc)) run.mark(kShapes);
   result.faces = map_face_entities(
       *process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) { return describe_face(entity, label, out); },
@@ -285,6 +315,42 @@ std::string read_step_piece(const std::string& path, const StepPiece& piece) {
       if (shape.IsNull()) continue;
       const bool single = shape.ShapeType() == TopAbs_FACE;
       for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next()) out.tag(f.Current(), tag, single);
+    }
+    // The piece's styled faces (step_split_text.h) and their colours, read as ReadColors reads them
+    // from the whole file; the main reader sets them (colour_styled_faces).
+    const STEPConstruct_Styles styles(ws);
+    for (Standard_Integer e = 1; e <= model->NbEntities(); ++e) {
+      const Handle(StepVisual_StyledItem) item = Handle(StepVisual_StyledItem)::DownCast(model->Value(e));
+      if (item.IsNull() || item->DynamicType() != STANDARD_TYPE(StepVisual_StyledItem)) continue;
+      Handle(StepVisual_Colour) surface, boundary, curve, rendering;
+      Standard_Real transparency = 0.0;
+      Standard_Boolean component = Standard_False;
+      if (!styles.GetColors(item, surface, boundary, curve, rendering, transparency, component)) continue;
+      if (item->ItemAP242().IsNull()) continue;
+      const Standard_Integer index = process->MapIndex(item->ItemAP242().Value());
+      FaceStyle style;
+      if (index > 0) style.face = TransferBRep::ShapeResult(process->MapItem(index));
+      if (style.face.IsNull()) continue;
+      if (!surface.IsNull() || !rendering.IsNull()) {
+        Quantity_Color surface_colour, rendering_colour;  // as ReadColors: a colour it cannot decode stays the default
+        Quantity_ColorRGBA full;
+        if (!surface.IsNull()) {
+          STEPConstruct_Styles::DecodeColor(surface, surface_colour);
+          full = Quantity_ColorRGBA(surface_colour);
+        }
+        if (!rendering.IsNull()) {
+          STEPConstruct_Styles::DecodeColor(rendering, rendering_colour);
+          full = Quantity_ColorRGBA(rendering_colour, static_cast<float>(1.0f - transparency));
+        }
+        style.surface = full;
+      }
+      for (auto [from, to] : {std::pair{&boundary, &style.boundary}, std::pair{&curve, &style.curve}}) {
+        if (from->IsNull()) continue;
+        Quantity_Color colour;
+        STEPConstruct_Styles::DecodeColor(*from, colour);
+        *to = colour;
+      }
+      out.style(style);
     }
     return out.bytes(parse_seconds);
   } catch (const Standard_Failure&) {

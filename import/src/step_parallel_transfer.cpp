@@ -195,12 +195,75 @@ std::string transfer_share(const Handle(StepData_StepModel)& model, const Handle
 
 }  // namespace
 
+namespace {
+
+// Styles as bytes: the face's index and orientation, which colours are set, their linear RGB (and
+// the surface's alpha) as Quantity_Color holds them, so they come back bit for bit.
+using IndexedStyle = std::pair<std::int64_t, FaceStyle>;
+
+void write_rgb(ByteWriter& w, const Quantity_Color& c) {
+  w.f64(c.Red());
+  w.f64(c.Green());
+  w.f64(c.Blue());
+}
+
+void write_styles(ByteWriter& w, const std::vector<IndexedStyle>& styles) {
+  w.u64(styles.size());
+  for (const auto& [index, s] : styles) {
+    w.i64(index);
+    w.u64(static_cast<std::uint64_t>(s.face.Orientation()));
+    w.u64((s.surface ? 1u : 0u) | (s.boundary ? 2u : 0u) | (s.curve ? 4u : 0u));
+    if (s.surface) {
+      write_rgb(w, s.surface->GetRGB());
+      w.f64(s.surface->Alpha());
+    }
+    if (s.boundary) write_rgb(w, *s.boundary);
+    if (s.curve) write_rgb(w, *s.curve);
+  }
+}
+
+std::optional<Quantity_Color> read_rgb(ByteReader& r) {
+  const double red = r.f64(), green = r.f64(), blue = r.f64();
+  auto unit = [](double v) { return v >= 0.0 && v <= 1.0; };
+  if (!r.ok || !unit(red) || !unit(green) || !unit(blue)) {
+    r.ok = false;
+    return std::nullopt;
+  }
+  return Quantity_Color(red, green, blue, Quantity_TOC_RGB);
+}
+
+// Styles with `face` null and its orientation in `orientation`; false when the bytes are not whole.
+bool read_styles(ByteReader& r, std::vector<IndexedStyle>& styles) {
+  styles.resize(r.ok ? r.count(24) : 0);
+  for (auto& [index, s] : styles) {
+    index = r.i64();
+    const std::uint64_t orientation = r.u64(), set = r.u64();
+    if (!r.ok || orientation > TopAbs_EXTERNAL || set > 7) return r.ok = false;
+    s.face.Orientation(static_cast<TopAbs_Orientation>(orientation));
+    if ((set & 1u) != 0) {
+      const std::optional<Quantity_Color> rgb = read_rgb(r);
+      const double alpha = r.f64();
+      if (!rgb || !r.ok || !(alpha >= 0.0 && alpha <= 1.0)) return r.ok = false;
+      s.surface = Quantity_ColorRGBA(*rgb, static_cast<float>(alpha));
+    }
+    if ((set & 2u) != 0 && !(s.boundary = read_rgb(r))) return false;
+    if ((set & 4u) != 0 && !(s.curve = read_rgb(r))) return false;
+  }
+  return r.ok;
+}
+
+}  // namespace
+
 void ShapeBindings::bind(std::int64_t key, const TopoDS_Shape& shape) {
   bindings_.push_back({key, index_of(shape), static_cast<std::uint64_t>(shape.Orientation())});
 }
 
 void ShapeBindings::tag(const TopoDS_Shape& face, const FaceEntity& entity, bool single) {
   tags_.push_back({index_of(face), entity, single});
+}
+
+void ShapeBindings::style(const FaceStyle& style) {
+  styles_.emplace_back(index_of(style.face), style);
 }
 
 std::int64_t ShapeBindings::index_of(const TopoDS_Shape& shape) {
@@ -228,6 +291,7 @@ std::string ShapeBindings::bytes(double parse_seconds) const {
     w.str(t.entity.name);
     w.u64(t.single ? 1 : 0);
   }
+  write_styles(w, styles_);
   std::ostringstream stored;
   if (!compound_.IsNull()) BinTools::Write(compound_, stored, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
   w.str(stored.str());
@@ -252,6 +316,7 @@ namespace {
 // ShapeBindings' bytes up to its shapes, and where the shapes start.
 struct BindingHead {
   double parse_seconds = 0.0;
+  std::vector<IndexedStyle> styles;
   struct Raw {
     std::int64_t key, shape;
     std::uint64_t orientation;
@@ -276,7 +341,7 @@ bool read_head(ByteReader& r, BindingHead& h) {
     t.entity.name = r.str();
     t.single = r.u64() == 1;
   }
-  return r.ok;
+  return read_styles(r, h.styles);
 }
 
 }  // namespace
@@ -319,6 +384,14 @@ bool read_binding_bytes(std::string_view payload, ReadBindings& out, std::string
     }
     out.tags.push_back({shapes(static_cast<Standard_Integer>(t.shape)).TShape().get(), std::move(t.entity), t.single});
   }
+  for (auto& [index, style] : head.styles) {
+    if (!valid(index)) {
+      why = "a worker's shapes came back incomplete";
+      return false;
+    }
+    style.face = shapes(static_cast<Standard_Integer>(index)).Oriented(style.face.Orientation());
+    out.styles.push_back(std::move(style));
+  }
   out.keep.push_back(all);
   return true;
 }
@@ -349,6 +422,7 @@ std::optional<std::string> renumber_bindings(std::string_view payload, const std
     w.str(t.entity.name);
     w.u64(t.single ? 1 : 0);
   }
+  write_styles(w, head.styles);
   w.str(shapes);
   std::string out = "O";
   out += w.out;

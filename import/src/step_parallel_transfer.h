@@ -8,6 +8,8 @@
 #include "cad_xcaf.h"
 #include "isolated_run.h"
 
+#include <Quantity_Color.hxx>
+#include <Quantity_ColorRGBA.hxx>
 #include <STEPControl_Reader.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS_Compound.hxx>
@@ -25,6 +27,14 @@
 
 namespace cadclash::detail {
 
+// A styled face's colours, as STEPCAFControl_Reader::ReadColors sets them on the face's label: the
+// surface colour (XCAFDoc_ColorSurf), then the boundary's and the curve's (XCAFDoc_ColorCurv).
+struct FaceStyle {
+  TopoDS_Shape face;
+  std::optional<Quantity_ColorRGBA> surface;
+  std::optional<Quantity_Color> boundary, curve;
+};
+
 // Shapes made in a worker, on their way back: each bound to a key (an entity's number or #id), and
 // faces tagged with their entities; as bytes, one compound in OCCT's binary format (shared
 // sub-shapes stay shared) and indices into it.
@@ -32,6 +42,7 @@ class ShapeBindings {
  public:
   void bind(std::int64_t key, const TopoDS_Shape& shape);
   void tag(const TopoDS_Shape& face, const FaceEntity& entity, bool single);
+  void style(const FaceStyle& style);
   // The bytes read_bindings reads; `parse_seconds` is the worker's time for parsing.
   std::string bytes(double parse_seconds = 0.0) const;
 
@@ -50,6 +61,7 @@ class ShapeBindings {
   TopTools_IndexedMapOfShape shapes_;  // of compound_'s children in turn (TopExp::MapShapes)
   std::vector<Binding> bindings_;
   std::vector<Tag> tags_;
+  std::vector<std::pair<std::int64_t, FaceStyle>> styles_;  // the face's index, the style
 };
 
 // Every worker's bytes back, in worker order; false (and why) when a worker crashed, reported a
@@ -57,6 +69,7 @@ class ShapeBindings {
 struct ReadBindings {
   std::vector<std::pair<std::int64_t, TopoDS_Shape>> shapes;
   std::vector<FaceTag> tags;
+  std::vector<FaceStyle> styles;   // the workers' styled faces, in worker and file order
   std::vector<TopoDS_Shape> keep;  // what the tags' TShape pointers point into
   double parse_seconds = 0.0;      // the slowest worker's
 };

@@ -108,6 +108,40 @@ std::string_view first_parameter(const std::string& text, const Statement& s) {
   return "''";
 }
 
+// What a styled item's styles may reach for the item to go with its face into a piece: the
+// presentation entities STEPConstruct_Styles::GetColors reads, nothing that names a representation
+// (a style by context: a component's colour) or a shape.
+bool is_style_entity(std::string_view t) {
+  return t == "PRESENTATION_STYLE_ASSIGNMENT" || t == "SURFACE_STYLE_USAGE" || t == "SURFACE_SIDE_STYLE" ||
+         t == "SURFACE_STYLE_FILL_AREA" || t == "FILL_AREA_STYLE" || t == "FILL_AREA_STYLE_COLOUR" || t == "COLOUR_RGB" ||
+         t == "DRAUGHTING_PRE_DEFINED_COLOUR" || t == "SURFACE_STYLE_BOUNDARY" || t == "CURVE_STYLE" ||
+         t == "DRAUGHTING_PRE_DEFINED_CURVE_FONT" || t == "SURFACE_STYLE_RENDERING" ||
+         t == "SURFACE_STYLE_RENDERING_WITH_PROPERTIES" || t == "SURFACE_STYLE_TRANSPARENT";
+}
+
+// Representations that list styled items for OCCT's colour reading (STEPConstruct_Styles::LoadStyles).
+bool is_style_container(std::string_view t) {
+  return t == "MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION_REPRESENTATION" || t == "DRAUGHTING_MODEL";
+}
+
+std::string ref_text(std::int64_t id) {
+  std::string r = "#";  // two steps: GCC 12 warns falsely (-Wrestrict) on "#" + string
+  r += std::to_string(id);
+  return r;
+}
+
+// The statement without blanks outside quoted strings.
+std::string compact(std::string_view statement) {
+  std::string out;
+  out.reserve(statement.size());
+  bool quoted = false;
+  for (const char c : statement) {
+    if (c == '\'') quoted = !quoted;
+    if (quoted || !step_space(c)) out += c;
+  }
+  return out;
+}
+
 struct UnionFind {
   std::vector<std::uint32_t> parent;
   explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
@@ -268,6 +302,74 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       return std::nullopt;
     }
 
+  // Styled faces: a STYLED_ITEM that is the only outside name of a face inside an item, whose styles
+  // reach presentation entities only and which nothing but style containers lists, goes into its
+  // face's piece with its styles (a worker reads its colours with OCCT's own code, step_attempt.cpp):
+  // the main text then holds neither the item nor a stand-in for the face. Style entities other
+  // statements of the main text still name stay there too.
+  std::vector<char> moved(n, 0), style(n, 0);  // moved styled items; their styles
+  std::vector<std::uint32_t> outside_names(n, 0);
+  std::vector<char> named_elsewhere(n, 0);  // by a statement other than a style container
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const bool container = is_style_container(st[k].type);
+    for (const std::uint32_t r : refs_of(k)) {
+      if (owner[k] == kNone) ++outside_names[r];
+      if (!container) named_elsewhere[r] = 1;
+    }
+  }
+  std::vector<std::vector<std::uint32_t>> styles_of(used);  // per piece: its styled items and their styles
+  {
+    std::vector<std::uint32_t> chain;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const auto refs = refs_of(k);
+      if (st[k].type != "STYLED_ITEM" || refs.size() < 2 || named_elsewhere[k] != 0) continue;
+      const std::uint32_t face = refs.back();
+      if ((st[face].type != "ADVANCED_FACE" && st[face].type != "FACE_SURFACE") || owner[face] == kNone ||
+          outside_names[face] != 1)
+        continue;
+      chain.clear();
+      bool plain = true;
+      stack.assign(refs.begin(), refs.end() - 1);
+      while (!stack.empty() && plain) {
+        const std::uint32_t e = stack.back();
+        stack.pop_back();
+        if (std::find(chain.begin(), chain.end(), e) != chain.end()) continue;
+        plain = is_style_entity(st[e].type);
+        chain.push_back(e);
+        for (const std::uint32_t r : refs_of(e)) stack.push_back(r);
+      }
+      if (!plain) continue;
+      moved[k] = 1;
+      std::vector<std::uint32_t>& into = styles_of[worker_of(face)];
+      into.push_back(k);
+      for (const std::uint32_t e : chain) {
+        style[e] = 1;
+        into.push_back(e);
+      }
+    }
+  }
+  // A container's list without the moved items must be one the main text can hold: its statement
+  // rewritten exactly (name, items, context), and not emptied while something names it.
+  std::vector<char> rewritten(n, 0);  // containers that lose items (dropped when they lose all)
+  for (std::uint32_t k = 0; k < n; ++k) {
+    if (!is_style_container(st[k].type)) continue;
+    const auto refs = refs_of(k);
+    std::size_t losing = 0;
+    for (std::size_t r = 0; r + 1 < refs.size(); ++r) losing += moved[refs[r]];
+    if (losing == 0) continue;
+    std::string whole = ref_text(st[k].id) + "=" + std::string(st[k].type) + "(" + std::string(first_parameter(text, st[k])) + ",(";
+    for (std::size_t r = 0; r + 1 < refs.size(); ++r) whole += (r ? "," : "") + ref_text(st[refs[r]].id);
+    whole += ")," + ref_text(st[refs.back()].id) + ");";
+    const bool exact = compact(std::string_view(text).substr(st[k].begin, st[k].end - st[k].begin)) == whole;
+    if (exact && (losing + 1 < refs.size() || outside_names[k] == 0)) {
+      rewritten[k] = 1;
+      continue;
+    }
+    for (std::size_t r = 0; r + 1 < refs.size(); ++r) moved[refs[r]] = 0;  // stays in the main text
+  }
+  for (std::uint32_t w = 0; w < used; ++w)
+    std::erase_if(styles_of[w], [&](std::uint32_t k) { return st[k].type == "STYLED_ITEM" && moved[k] == 0; });
+
   // Pieces: per worker, its items' whole insides (leaves included) and, per context, a shape
   // representation of its items with that context and what the context reaches.
   StepSplit out;
@@ -330,17 +432,37 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       synthetic_reps[w].push_back({next_id, context, ids});
       out.pieces[w].reps.push_back(next_id++);
     }
+    for (const std::uint32_t k : styles_of[w])
+      if (stamp[k] != w) {
+        stamp[k] = w;
+        members[w].push_back(k);
+      }
     std::sort(members[w].begin(), members[w].end());
   }
 
   // The main text: every statement no piece took as an item's inside, the leaves they reach, and a
   // placeholder for each item or inside entity they name.
   std::vector<char> keep(n, 0), stand_in(n, 0);
-  for (std::uint32_t k = 0; k < n; ++k) keep[k] = in_items[k] == 0 || context_statement[k] != 0 ? 1 : 0;
+  for (std::uint32_t k = 0; k < n; ++k)
+    keep[k] = (in_items[k] == 0 || context_statement[k] != 0) && moved[k] == 0 && style[k] == 0 ? 1 : 0;
+  for (std::uint32_t k = 0; k < n; ++k) {  // styles the main text still names (its own styled items')
+    if (keep[k] == 0 || style[k] != 0) continue;
+    for (const std::uint32_t r : refs_of(k)) {
+      if (style[r] == 0 || keep[r] != 0) continue;
+      stack.assign(1, r);
+      while (!stack.empty()) {
+        const std::uint32_t e = stack.back();
+        stack.pop_back();
+        if (keep[e] != 0) continue;
+        keep[e] = 1;
+        for (const std::uint32_t q : refs_of(e)) stack.push_back(q);
+      }
+    }
+  }
   for (std::uint32_t k = 0; k < n; ++k) {
     if (keep[k] == 0 || is_leaf(st[k].type)) continue;
     for (const std::uint32_t r : refs_of(k)) {
-      if (keep[r] != 0) continue;
+      if (keep[r] != 0 || moved[r] != 0) continue;
       if (!is_leaf(st[r].type)) {
         stand_in[r] = 1;
         continue;
@@ -363,17 +485,23 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
   // Placeholders share one small valid face (never transferred: their ids are bound first).
   const std::int64_t point = next_id++, axes = next_id++, plane = next_id++, vertex = next_id++, loop = next_id++,
                      bound = next_id++, face = next_id++, closed = next_id++, open = next_id++, void_shell = next_id++;
-  auto ref = [](std::int64_t id) {
-    std::string r = "#";  // two steps: GCC 12 warns falsely (-Wrestrict) on "#" + string
-    r += std::to_string(id);
-    return r;
-  };
+  const auto ref = ref_text;
   std::string& main = out.main_text;
   main.reserve(text.size() / 4);
   main.append(sc.header);
   main += "DATA;\n";
   for (std::uint32_t k = 0; k < n; ++k) {
     const Statement& s = st[k];
+    if (keep[k] != 0 && rewritten[k] != 0) {  // a style container without the moved items
+      const auto refs = refs_of(k);
+      std::string list;
+      for (std::size_t r = 0; r + 1 < refs.size(); ++r)
+        if (moved[refs[r]] == 0) list += (list.empty() ? "" : ",") + ref(st[refs[r]].id);
+      if (!list.empty())
+        main += ref(s.id) + "=" + std::string(s.type) + "(" + std::string(first_parameter(text, s)) + ",(" + list + ")," +
+                ref(st[refs.back()].id) + ");\n";
+      continue;
+    }
     if (keep[k] != 0) {
       main.append(text, s.begin, s.end - s.begin);
       main += '\n';
