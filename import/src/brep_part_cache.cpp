@@ -121,20 +121,29 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
   std::vector<std::size_t> missing;
   std::vector<BrepPartInput> to_make;
   const auto load_start = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < n; ++k) {
+  // Each part keyed (its shape written out and hashed) and looked up on its own, on every thread;
+  // what was found is gathered in part order.
+  std::vector<std::optional<Diagnostic>> damaged(n);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+    const auto k = static_cast<std::size_t>(i);
     keys[k] = part_key(parts[k], options);
-    if (keys[k]) {
-      const CacheRead read = read_cache_entry(options.cache_dir, *keys[k]);
-      std::string why = read.damaged;
-      if (read.payload && load_part(*read.payload, parts[k], made[k], why)) {
-        held[k] = 1;
-        continue;
-      }
-      if (!why.empty())
-        notes.push_back({Severity::Warning, parts[k].source_file, 0, -1,
-                         std::string(kCacheNote) + read.file + " is damaged (" + why + "); part '" + parts[k].name +
-                             "' was checked and healed again and the entry rewritten"});
+    if (!keys[k]) continue;
+    const CacheRead read = read_cache_entry(options.cache_dir, *keys[k]);
+    std::string why = read.damaged;
+    if (read.payload && load_part(*read.payload, parts[k], made[k], why)) {
+      held[k] = 1;
+      continue;
     }
+    made[k] = OnePart{};
+    if (!why.empty())
+      damaged[k] = Diagnostic{Severity::Warning, parts[k].source_file, 0, -1,
+                              std::string(kCacheNote) + read.file + " is damaged (" + why + "); part '" + parts[k].name +
+                                  "' was checked and healed again and the entry rewritten"};
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (damaged[k]) notes.push_back(std::move(*damaged[k]));
+    if (held[k] != 0) continue;
     missing.push_back(k);
     to_make.push_back(parts[k]);
   }

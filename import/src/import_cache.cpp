@@ -18,8 +18,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <system_error>
+#include <thread>
 
 #include <dlfcn.h>
 #include <sys/stat.h>
@@ -52,14 +54,34 @@ std::string hex(const Digest& d) {
   return out;
 }
 
+}  // namespace
+
 std::optional<std::string> file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
+  // Sized once and read in one call: a stream copy of a 40 MB file costs several times more.
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size > std::numeric_limits<std::size_t>::max() / 2) {
+    std::ostringstream buffer;  // not a regular file: as the stream gives it
+    buffer << in.rdbuf();
+    if (in.bad()) return std::nullopt;
+    return std::move(buffer).str();
+  }
+  std::string out(static_cast<std::size_t>(size), '\0');
+  in.read(out.data(), static_cast<std::streamsize>(out.size()));
+  out.resize(static_cast<std::size_t>(in.gcount()));
   if (in.bad()) return std::nullopt;
-  return std::move(buffer).str();
+  char more = 0;
+  if (in.get(more)) {  // grew since its size was taken: the rest as the stream gives it
+    std::ostringstream rest;
+    rest << more << in.rdbuf();
+    out += std::move(rest).str();
+  }
+  return out;
 }
+
+namespace {
 
 // The build of cadclash reading the files: the file this code was loaded from (the program, or the
 // Python module) by its canonical path, its size and modification time. Any rebuild changes it, so an entry written by
@@ -307,30 +329,37 @@ std::string placements_payload(const std::string& skeleton, const std::string& f
   return std::move(w.out);
 }
 
-// After `result` was read from `bytes` and stored under `file_key`: the path's placements entry,
-// when its instances are placed by numbers this can recompute (step_placements.h) and recomputing
-// them from this text gives every pose bit for bit. Nothing said when it is not stored: the next
-// edit of the file is then read as any other file is.
-void store_placements(const std::string& path, const std::string& bytes, const ImportOptions& options,
-                      const std::string& file_key, const ImportResult& result) {
-  if (result.files.empty() || !result.files.front().placements) return;
+// After `result` was read from `bytes` and stored under `file_key`, the path's placements entry is
+// written when its instances are placed by numbers this can recompute (step_placements.h) and
+// recomputing them from this text gives every pose bit for bit. Nothing said when it is not stored:
+// the next edit of the file is then read as any other file is.
+// Whether the file's placements can be recorded at all: a walk that warned about or dropped a pose
+// placed it otherwise than its numbers say.
+bool placements_recordable(const ImportResult& result) {
+  if (result.files.empty() || !result.files.front().placements) return false;
   const Placements& p = *result.files.front().placements;
-  if (p.components.empty() || p.chains.size() != result.model.instances.size()) return;
-  for (const Diagnostic& d : result.diagnostics)  // a pose the walk warned about or dropped
-    if (d.message.find(" is placed ") != std::string::npos) return;
+  if (p.components.empty() || p.chains.size() != result.model.instances.size()) return false;
+  for (const Diagnostic& d : result.diagnostics)
+    if (d.message.find(" is placed ") != std::string::npos) return false;
+  return true;
+}
+
+// The placements entry's payload for the file's `bytes`; nullopt when no number of the file can
+// change without changing more than poses, or when the poses this makes of its numbers are not the
+// reader's (`instances`) bit for bit.
+std::optional<std::string> placements_record(const std::string& bytes, const std::string& file_key, const Placements& p,
+                                             const std::vector<Instance>& instances) {
   const std::optional<FreePlacementText> scanned = free_placement_text(bytes, p.value_ids(), p.axis_ids());
-  // None, or no number of this file can change without changing more than poses.
-  if (!scanned || scanned->free.empty()) return;
+  if (!scanned || scanned->free.empty()) return std::nullopt;
   const std::vector<std::int64_t>& free = scanned->free;
   const PlacementText* text = &scanned->text;
   // Bit for bit: a pose the reader makes with a -0 where this makes a +0 is not the same pose.
   const std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
-  if (!poses) return;
+  if (!poses) return std::nullopt;
   for (std::size_t k = 0; k < poses->size(); ++k)
-    if (std::memcmp((*poses)[k].matrix().data(), result.model.instances[k].pose.matrix().data(), 16 * sizeof(double)) != 0)
-      return;
-  std::string why;
-  write_cache_entry(options.cache_dir, placements_key(path, options), placements_payload(text->skeleton, file_key, p, free), why);
+    if (std::memcmp((*poses)[k].matrix().data(), instances[k].pose.matrix().data(), 16 * sizeof(double)) != 0)
+      return std::nullopt;
+  return placements_payload(text->skeleton, file_key, p, free);
 }
 
 // The file at `path` when the cache holds an earlier version of it that differs only in its
@@ -437,7 +466,14 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     notes.push_back(d);
     return true;
   });
+  // The placements' record (a pass over the text and its hash) is made while the model is written
+  // out; it reads only the placements, the poses and the text, which nothing here changes.
+  std::optional<std::string> placements;
+  std::thread recorder;
+  if (placements_recordable(result))
+    recorder = std::thread([&] { placements = placements_record(*bytes, key, *result.files.front().placements, result.model.instances); });
   const std::optional<std::string> payload = save_import(result);
+  if (recorder.joinable()) recorder.join();
   result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
   if (damaged) result.diagnostics.insert(result.diagnostics.begin(), *damaged);
   if (!payload) return result;  // a part this cache cannot store: read every time
@@ -459,7 +495,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
       if (!is_cache_note(d)) stored.diagnostics.push_back(d);
     record->file = record_entry(key, std::move(stored));
   }
-  if (!ec && why.empty()) store_placements(path, *bytes, options, key, result);
+  if (!ec && why.empty() && placements) write_cache_entry(options.cache_dir, placements_key(path, options), *placements, why);
   prune_cache(options.cache_dir, options.cache_max_bytes);
   return result;
 }

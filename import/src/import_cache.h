@@ -17,6 +17,9 @@ namespace cadclash::detail {
 ImportResult cached_import(const std::string& path, const ImportOptions& options,
                            const std::function<ImportResult()>& read);
 
+// The bytes of the file at `path`; nullopt when it cannot be opened or read.
+std::optional<std::string> file_bytes(const std::string& path);
+
 // The file name of the entry for `path` read with `options` ("<64 hex digits>.entry"); nullopt when
 // the file cannot be read. For the tests, which damage entries on purpose.
 std::optional<std::string> cache_entry_name(const std::string& path, const ImportOptions& options);

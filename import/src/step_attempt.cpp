@@ -4,6 +4,7 @@
 
 #include "cadclash/internal/byte_io.h"
 
+#include "import_cache.h"
 #include "step_model_repairs.h"
 #include "step_parallel_transfer.h"
 #include "step_piece_cache.h"
@@ -78,12 +79,7 @@ void configure(STEPCAFControl_Reader& reader) {
 }
 
 // The file's bytes; empty when it cannot be read.
-std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+std::string file_text(const std::string& path) { return file_bytes(path).value_or(std::string()); }
 
 // Parses the file into the reader's model. A truncated file is read up to its last complete entity,
 // and references to entities the file does not define are unset first (step_text.h): OCCT then

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 namespace cadclash::detail {
 namespace {
@@ -53,21 +54,37 @@ std::optional<Scan> scan(const std::string& text, std::string& why) {
       },
       [&](std::int64_t id) { raw.push_back(id); }, why);
   if (!scanned) return std::nullopt;
-  std::unordered_map<std::int64_t, std::uint32_t> index;
-  index.reserve(out.statements.size());
-  for (std::size_t k = 0; k < out.statements.size(); ++k)
-    if (!index.emplace(out.statements[k].id, static_cast<std::uint32_t>(k)).second) {
+  // Ids to statements: an array when the ids are about as many as the statements (exporters number
+  // 1, 2, ...), a hash map when they are sparse.
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::int64_t largest = 0;
+  for (const Statement& s : out.statements) largest = std::max(largest, s.id);
+  const bool dense = largest <= static_cast<std::int64_t>(8 * out.statements.size() + 1024);
+  std::vector<std::uint32_t> array(dense ? static_cast<std::size_t>(largest) + 1 : 0, kNone);
+  std::unordered_map<std::int64_t, std::uint32_t> map;
+  if (!dense) map.reserve(out.statements.size());
+  for (std::size_t k = 0; k < out.statements.size(); ++k) {
+    const std::int64_t id = out.statements[k].id;
+    const bool fresh = dense ? std::exchange(array[static_cast<std::size_t>(id)], static_cast<std::uint32_t>(k)) == kNone
+                             : map.emplace(id, static_cast<std::uint32_t>(k)).second;
+    if (!fresh) {
       why = "an id defined twice";
       return std::nullopt;
     }
+  }
   out.refs.resize(raw.size());
   for (std::size_t r = 0; r < raw.size(); ++r) {
-    const auto it = index.find(raw[r]);
-    if (it == index.end()) {
+    std::uint32_t k = kNone;
+    if (dense) {
+      if (raw[r] >= 0 && raw[r] <= largest) k = array[static_cast<std::size_t>(raw[r])];
+    } else if (const auto it = map.find(raw[r]); it != map.end()) {
+      k = it->second;
+    }
+    if (k == kNone) {
       why = "a reference to an undefined id";
       return std::nullopt;
     }
-    out.refs[r] = it->second;
+    out.refs[r] = k;
   }
   return out;
 }
@@ -163,30 +180,36 @@ std::string_view file_schema(std::string_view header) {
   return header.substr(at, end == std::string_view::npos ? std::string_view::npos : end + 1 - at);
 }
 
-// The statement with every id (its own and the ones it references) replaced by `number`'s, outside
-// quoted strings. Precondition: `number` holds every id the statement names.
-void renumbered(const std::string& text, const Statement& s, const std::unordered_map<std::int64_t, std::int64_t>& number,
-                std::string& out) {
-  bool quoted = false;
-  for (std::size_t i = s.begin; i < s.end; ++i) {
+// Statement k with its own id and the ones it references (`refs`, in the order for_each_statement
+// found them) replaced by `number`'s of their statements, copied in runs between them.
+void renumbered(const std::string& text, std::uint32_t k, const Statement& s, std::span<const std::uint32_t> refs,
+                const std::vector<std::int64_t>& number, std::string& out) {
+  auto id_end = [&](std::size_t hash) {  // just after the digits of the id at text[hash] == '#'
+    std::int64_t id = 0;
+    std::size_t j = hash + 1;
+    while (j < s.end && step_digit(text[j]) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
+    return j;
+  };
+  out += '#';
+  out += std::to_string(number[k]);
+  std::size_t from = id_end(s.begin), r = 0;
+  for (std::size_t i = s.body; i < s.end; ++i) {
     const char c = text[i];
-    if (quoted) {
-      quoted = c != '\'';
-    } else if (c == '\'') {
-      quoted = true;
+    if (c == '\'') {
+      i = text.find('\'', i + 1);  // the statement ends after its strings: found
     } else if (c == '#') {
-      std::int64_t id = 0;
-      std::size_t j = i + 1;
-      while (j < s.end && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
-      if (j > i + 1) {
-        out += '#';
-        out += std::to_string(number.at(id));
-        i = j - 1;
-        continue;
-      }
+      const std::size_t j = id_end(i);
+      if (j == i + 1) continue;
+      assert(r < refs.size());
+      out.append(text, from, i - from);
+      out += '#';
+      out += std::to_string(number[refs[r++]]);
+      from = j;
+      i = j - 1;
     }
-    out += c;
   }
+  assert(r == refs.size());
+  out.append(text, from, s.end - from);
 }
 
 }  // namespace
@@ -400,19 +423,20 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
   std::int64_t next_id = max_id + 1;
   std::vector<std::string> synthetic(used);
   struct Synthetic {
-    std::int64_t id, context;
-    std::vector<std::int64_t> items;
+    std::int64_t id;
+    std::uint32_t context_statement;
+    std::vector<std::uint32_t> item_statements;
   };
   std::vector<std::vector<Synthetic>> synthetic_reps(used);
   for (std::uint32_t w = 0; w < used; ++w) {
-    std::vector<std::pair<std::int64_t, std::vector<std::int64_t>>> by_context;
+    std::vector<std::pair<std::int64_t, std::vector<std::uint32_t>>> by_context;  // the items' statements
     for (const std::uint32_t h : items_of[w]) {
       take(items[h], w);
       auto it = std::find_if(by_context.begin(), by_context.end(), [&](const auto& c) { return c.first == context_of[h]; });
       if (it == by_context.end()) it = by_context.insert(by_context.end(), {context_of[h], {}});
-      it->second.push_back(st[items[h]].id);
+      it->second.push_back(items[h]);
     }
-    for (auto& [context, ids] : by_context) {
+    for (auto& [context, item_statements] : by_context) {
       const auto c = statement_of_id.find(context);
       if (c == statement_of_id.end()) {
         why_not = "a representation context that is not a context";
@@ -426,10 +450,11 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       }
       std::string rep = "#";
       rep += std::to_string(next_id) + "=SHAPE_REPRESENTATION('',(";
-      for (std::size_t k = 0; k < ids.size(); ++k) rep += (k ? ",#" : "#") + std::to_string(ids[k]);
+      for (std::size_t k = 0; k < item_statements.size(); ++k)
+        rep += (k ? ",#" : "#") + std::to_string(st[item_statements[k]].id);
       rep += "),#" + std::to_string(context) + ");\n";
       synthetic[w] += rep;
-      synthetic_reps[w].push_back({next_id, context, ids});
+      synthetic_reps[w].push_back({next_id, c->second, item_statements});
       out.pieces[w].reps.push_back(next_id++);
     }
     for (const std::uint32_t k : styles_of[w])
@@ -533,6 +558,7 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
           ref(closed) + ",.F.);\n";
   main += "ENDSEC;\nEND-ISO-10303-21;\n";
 
+  std::vector<std::int64_t> number(canonical ? n : 0);
   for (std::uint32_t w = 0; w < used; ++w) {
     StepPiece& piece = out.pieces[w];
     piece.text.append(sc.header);
@@ -546,33 +572,31 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
     std::sort(piece.bind.begin(), piece.bind.end());
     if (!canonical) continue;
     // Ids renumbered in the order the piece defines them: the same product written elsewhere in a
-    // file, or by another export that numbers the rest differently, reads the same.
-    std::unordered_map<std::int64_t, std::int64_t> number;
+    // file, or by another export that numbers the rest differently, reads the same. `number` is by
+    // statement; every statement a member names is a member, so it holds this piece's numbers.
     for (const std::uint32_t k : members[w]) {
       piece.ids.push_back(st[k].id);
-      number.emplace(st[k].id, static_cast<std::int64_t>(piece.ids.size()));
-    }
-    for (const Synthetic& r : synthetic_reps[w]) {
-      piece.ids.push_back(r.id);
-      number.emplace(r.id, static_cast<std::int64_t>(piece.ids.size()));
+      number[k] = static_cast<std::int64_t>(piece.ids.size());
     }
     std::string& c = piece.canonical;
+    c.reserve(piece.text.size());
     c.append(file_schema(sc.header));
     c += '\n';
     for (const std::uint32_t k : members[w]) {
-      renumbered(text, st[k], number, c);
+      renumbered(text, k, st[k], refs_of(k), number, c);
       c += '\n';
     }
     for (const Synthetic& r : synthetic_reps[w]) {  // appended piece by piece: GCC 12 warns falsely on "#" + string
+      piece.ids.push_back(r.id);
       c += '#';
-      c += std::to_string(number.at(r.id));
+      c += std::to_string(piece.ids.size());
       c += "=SHAPE_REPRESENTATION('',(";
-      for (std::size_t k = 0; k < r.items.size(); ++k) {
+      for (std::size_t k = 0; k < r.item_statements.size(); ++k) {
         c += k ? ",#" : "#";
-        c += std::to_string(number.at(r.items[k]));
+        c += std::to_string(number[r.item_statements[k]]);
       }
       c += "),#";
-      c += std::to_string(number.at(r.context));
+      c += std::to_string(number[r.context_statement]);
       c += ");\n";
     }
   }

@@ -11,6 +11,23 @@
 
 namespace cadclash::detail {
 
+// The index of the first ';' at or after i outside quoted strings ('' inside a string closes and
+// reopens it: the same); text.size() when there is none.
+inline std::size_t statement_end(std::string_view text, std::size_t i) {
+  const std::size_t n = text.size();
+  const char* data = text.data();
+  for (; i < n; ++i) {
+    const char c = data[i];
+    if (c == ';') return i;
+    if (c == '\'') {
+      const std::size_t close = text.find('\'', i + 1);
+      if (close == std::string_view::npos) return n;
+      i = close;
+    }
+  }
+  return n;
+}
+
 // "#id = TYPE(...);" or "#id = (A(...) B(...));" in the text.
 struct StatementSpan {
   std::int64_t id = 0;
@@ -20,7 +37,29 @@ struct StatementSpan {
   std::string_view type;           // the simple entity's type; empty for a complex entity
 };
 
-inline bool step_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+// The C locale's character classes, inline: the scans below look at every byte of files of
+// hundreds of MB, where a call to std::isspace per byte is most of their time.
+inline bool step_space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
+inline bool step_digit(char c) { return c >= '0' && c <= '9'; }
+inline bool step_word(char c) { return step_digit(c) || (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; }
+
+// Whether a byte may end a run of plain statement text: a quote, ';', '#' or '/'.
+inline bool step_stop(char c) { return c == '\'' || c == ';' || c == '#' || c == '/'; }
+
+// The first index >= i (and < n) of a byte step_stop is true of; n when none.
+inline std::size_t next_stop(std::string_view text, std::size_t i) {
+  static constexpr auto table = [] {
+    struct Table {
+      bool stop[256] = {};
+    } t;
+    for (const char c : {'\'', ';', '#', '/'}) t.stop[static_cast<unsigned char>(c)] = true;
+    return t;
+  }();
+  const std::size_t n = text.size();
+  const char* data = text.data();
+  while (i < n && !table.stop[static_cast<unsigned char>(data[i])]) ++i;
+  return i;
+}
 
 // Calls reference(id) for each "#id" a statement holds outside quoted strings, then
 // statement(StatementSpan) (which returns false to stop the walk), for every statement in order.
@@ -49,7 +88,7 @@ bool for_each_statement(std::string_view text, OnStatement&& statement, OnRefere
     }
     StatementSpan s;
     s.begin = i++;
-    while (i < n && std::isdigit(static_cast<unsigned char>(text[i])) && s.id < (std::int64_t{1} << 50)) s.id = s.id * 10 + (text[i++] - '0');
+    while (i < n && step_digit(text[i]) && s.id < (std::int64_t{1} << 50)) s.id = s.id * 10 + (text[i++] - '0');
     while (i < n && step_space(text[i])) ++i;
     if (i >= n || text[i] != '=') {
       why = "a statement without '='";
@@ -59,25 +98,23 @@ bool for_each_statement(std::string_view text, OnStatement&& statement, OnRefere
     while (i < n && step_space(text[i])) ++i;
     const std::size_t type_at = i;
     if (i < n && text[i] != '(')
-      while (i < n && (std::isalnum(static_cast<unsigned char>(text[i])) || text[i] == '_')) ++i;
+      while (i < n && step_word(text[i])) ++i;
     s.type = text.substr(type_at, i - type_at);
     s.after_type = i;
-    bool quoted = false;
-    for (; i < n; ++i) {
+    for (; (i = next_stop(text, i)) < n; ++i) {
       const char c = text[i];
-      if (quoted) {
-        quoted = c != '\'';  // '' closes and reopens: the same
-      } else if (c == '\'') {
-        quoted = true;
+      if (c == '\'') {  // a string: to its closing quote ('' closes and reopens: the same)
+        const std::size_t close = text.find('\'', i + 1);
+        i = close == std::string_view::npos ? n - 1 : close;
       } else if (c == ';') {
         break;
       } else if (c == '#') {
         std::int64_t id = 0;
         std::size_t j = i + 1;
-        while (j < n && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
+        while (j < n && step_digit(text[j]) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
         if (j > i + 1) reference(id);
         i = j - 1;
-      } else if (c == '/' && i + 1 < n && text[i + 1] == '*') {
+      } else if (i + 1 < n && text[i + 1] == '*') {  // '/'
         why = "a comment in the DATA section";
         return false;
       }

@@ -2,6 +2,7 @@
 #include "step_text.h"
 
 #include "mesh_common.h"
+#include "step_statements.h"
 
 #include <algorithm>
 #include <cctype>
@@ -161,7 +162,9 @@ std::optional<UnsetReferences> unset_undefined_references(const std::string& tex
 }
 
 std::vector<Diagnostic> unit_context_problems(const std::string& text, const std::string& path) {
-  std::unordered_map<std::int64_t, std::string_view> entities;
+  // Every statement's id and body in order, and the contexts' ids; the bodies wanted are looked up
+  // afterwards (the last statement of an id counts), with no map of every statement.
+  std::vector<std::pair<std::int64_t, std::string_view>> statements;
   std::vector<std::int64_t> contexts;
   std::size_t i = text.find("DATA;");
   while (i != std::string::npos && i < text.size()) {
@@ -169,25 +172,44 @@ std::vector<Diagnostic> unit_context_problems(const std::string& text, const std
     if (i == std::string::npos) break;
     std::size_t j = i + 1;
     std::int64_t id = 0;
-    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])) && id < (std::int64_t{1} << 50))
-      id = id * 10 + (text[j++] - '0');
+    while (j < text.size() && step_digit(text[j]) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
     std::size_t k = j;
-    while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+    while (k < text.size() && step_space(text[k])) ++k;
     if (j == i + 1 || k >= text.size() || text[k] != '=') {
       i = j;
       continue;
     }
-    bool quoted = false;  // ';' inside a string does not end the entity ('' is an escaped quote)
-    std::size_t end = k;
-    for (; end < text.size() && (quoted || text[end] != ';'); ++end)
-      if (text[end] == '\'') quoted = !quoted;
+    const std::size_t end = statement_end(text, k);  // ';' inside a string does not end the entity
     const std::string_view body(text.data() + k + 1, end - k - 1);
-    entities[id] = body;
+    statements.emplace_back(id, body);
     if (body.find("GEOMETRIC_REPRESENTATION_CONTEXT") != std::string_view::npos &&
         body.find("REPRESENTATION_CONTEXT(2)") == std::string_view::npos)  // 2D parameter spaces need no unit
       contexts.push_back(id);
     i = end;
   }
+  std::unordered_map<std::int64_t, std::string_view> entities;  // the contexts and the units they name
+  for (const std::int64_t id : contexts) entities.emplace(id, std::string_view());
+  for (const auto& [id, body] : statements)
+    if (const auto it = entities.find(id); it != entities.end()) it->second = body;
+  std::unordered_map<std::int64_t, std::string_view> units;
+  for (const std::int64_t id : contexts) {
+    const std::string_view body = entities[id];
+    const std::size_t at = body.find("GLOBAL_UNIT_ASSIGNED_CONTEXT");
+    if (at == std::string_view::npos) continue;
+    const std::size_t open = body.find('(', at), close = body.find(')', at);
+    for (std::size_t h = body.find('#', open); h != std::string_view::npos && h < close; h = body.find('#', h + 1)) {
+      std::int64_t ref = 0;
+      for (std::size_t d = h + 1; d < body.size() && step_digit(body[d]) && ref < (std::int64_t{1} << 50); ++d)
+        ref = ref * 10 + (body[d] - '0');
+      units.emplace(ref, std::string_view());
+    }
+  }
+  std::unordered_set<std::int64_t> defined;  // of the units: a reference to no statement is no unit
+  for (const auto& [id, body] : statements)
+    if (const auto it = units.find(id); it != units.end()) {
+      it->second = body;
+      defined.insert(id);
+    }
   std::vector<Diagnostic> out;
   for (const std::int64_t id : contexts) {
     const std::string_view body = entities[id];
@@ -203,11 +225,9 @@ std::vector<Diagnostic> unit_context_problems(const std::string& text, const std
     bool length = false;
     for (std::size_t h = body.find('#', open); h != std::string_view::npos && h < close; h = body.find('#', h + 1)) {
       std::int64_t ref = 0;
-      for (std::size_t d = h + 1; d < body.size() && std::isdigit(static_cast<unsigned char>(body[d])) &&
-                                  ref < (std::int64_t{1} << 50); ++d)  // the bound of the ids above: no overflow
+      for (std::size_t d = h + 1; d < body.size() && step_digit(body[d]) && ref < (std::int64_t{1} << 50); ++d)
         ref = ref * 10 + (body[d] - '0');
-      const auto unit = entities.find(ref);
-      length = length || (unit != entities.end() && unit->second.find("LENGTH_UNIT") != std::string_view::npos);
+      length = length || (defined.count(ref) > 0 && units[ref].find("LENGTH_UNIT") != std::string_view::npos);
     }
     if (!length)
       out.push_back({Severity::Warning, path, 0, id,

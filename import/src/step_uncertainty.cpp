@@ -2,6 +2,7 @@
 // in millimetres. OCCT's reader does not carry it into the shapes' tolerances, so it is read from the
 // text and made the floor of every face's model uncertainty (collide.h, Surface::uncertainty).
 #include "step_uncertainty.h"
+#include "step_statements.h"
 
 #include <algorithm>
 #include <cctype>
@@ -20,35 +21,22 @@ namespace {
 std::unordered_map<std::int64_t, std::string_view> entity_texts(const std::string& text,
                                                                  const std::unordered_set<std::int64_t>& ids) {
   std::unordered_map<std::int64_t, std::string_view> out;
-  bool quoted = false, statement_start = true;
-  for (std::size_t i = 0; i < text.size() && out.size() < ids.size(); ++i) {
-    const char c = text[i];
-    if (quoted) {
-      quoted = c != '\'';
-      continue;
-    }
-    if (c == '\'') {
-      quoted = true;
-      statement_start = false;
-    } else if (c == ';') {
-      statement_start = true;
-    } else if (c == '#' && statement_start) {
-      statement_start = false;
-      std::int64_t id = 0;
-      std::size_t k = i + 1;
-      while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[k++] - '0');
-      while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
-      if (k >= text.size() || text[k] != '=' || !ids.count(id)) continue;
-      const std::size_t end = text.find(';', k);
-      out.emplace(id, std::string_view(text).substr(k + 1, end == std::string::npos ? std::string::npos : end - k - 1));
-    } else if (!std::isspace(static_cast<unsigned char>(c))) {
-      statement_start = false;
-    }
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n && out.size() < ids.size(); i = statement_end(text, i) + 1) {
+    while (i < n && step_space(text[i])) ++i;  // a statement starts here
+    if (i >= n || text[i] != '#') continue;
+    std::int64_t id = 0;
+    std::size_t k = i + 1;
+    while (k < n && step_digit(text[k]) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[k++] - '0');
+    while (k < n && step_space(text[k])) ++k;
+    i = k;
+    if (k >= n || text[k] != '=' || !ids.count(id)) continue;
+    const std::size_t end = text.find(';', k);
+    out.emplace(id, std::string_view(text).substr(k + 1, end == std::string::npos ? std::string::npos : end - k - 1));
   }
   return out;
 }
 
-// Millimetres per unit of a LENGTH_UNIT entity; 0 when it is not understood.
 double millimetres_per(std::string_view unit) {
   if (unit.find("SI_UNIT") != std::string_view::npos && unit.find(".METRE.") != std::string_view::npos) {
     struct Prefix {
