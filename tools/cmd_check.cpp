@@ -15,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -443,7 +445,12 @@ int run_check(const CheckOptions& o, const Launch& launch) {
   std::vector<Diagnostic> stored;
   store_triangles_in_cache(imported, stored);
   print_diagnostics(stored);
-  return code;
+  // Done: the process ends here, without taking the model and OCCT's shapes apart piece by piece
+  // (a tenth of a second on a 40 MB board). Every file this wrote is closed; the streams are flushed.
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(code);
 }
 
 // `cadclash check`, in one process or as one rank of an MPI job (every rank imports, rank 0 reports).

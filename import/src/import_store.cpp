@@ -117,8 +117,17 @@ std::optional<std::string> save_import(const ImportResult& result, bool exact_fa
   write_diagnostics(w, result.diagnostics);
   w.u64(result.complete ? 1 : 0);
   const Model& m = result.model;
+  for (const Part& part : m.parts)
+    if (part.source && dynamic_cast<const BrepSource*>(part.source.get()) == nullptr) return std::nullopt;
+  // The parts' exact faces written out on every thread (each part's on its own), then in order.
+  std::vector<std::string> faces(exact_faces ? m.parts.size() : 0);
+#pragma omp parallel for schedule(dynamic, 1) if (faces.size() > 1)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(faces.size()); ++i)
+    if (const auto* brep = dynamic_cast<const BrepSource*>(m.parts[static_cast<std::size_t>(i)].source.get()))
+      faces[static_cast<std::size_t>(i)] = save_brep_source(*brep);
   w.u64(m.parts.size());
-  for (const Part& part : m.parts) {
+  for (std::size_t p = 0; p < m.parts.size(); ++p) {
+    const Part& part = m.parts[p];
     w.str(part.name);
     w.str(part.source_file);
     w.u64(part.first_surface);
@@ -127,15 +136,13 @@ std::optional<std::string> save_import(const ImportResult& result, bool exact_fa
       w.u64(0);
       continue;
     }
-    const auto* brep = dynamic_cast<const BrepSource*>(part.source.get());
-    if (!brep) return std::nullopt;
     if (!exact_faces) {
       w.u64(2);
-      w.f64(brep->default_deflection());
+      w.f64(static_cast<const BrepSource&>(*part.source).default_deflection());
       continue;
     }
     w.u64(1);
-    w.str(save_brep_source(*brep));
+    w.str(faces[p]);
   }
   w.u64(m.surfaces.size());
   for (const Surface& s : m.surfaces) put_surface(w, s);
@@ -156,7 +163,10 @@ bool load_import(std::string_view bytes, ImportResult& result, std::string& why,
   result.complete = r.u64() == 1;
   Model& m = result.model;
   m.parts.resize(r.count(40));
-  for (Part& part : m.parts) {
+  std::vector<std::string> stored(m.parts.size());  // the exact faces of the parts that hold them
+  std::vector<char> exact(m.parts.size(), 0);
+  for (std::size_t p = 0; p < m.parts.size(); ++p) {
+    Part& part = m.parts[p];
     part.name = r.str();
     part.source_file = r.str();
     part.first_surface = static_cast<SurfaceId>(r.u64());
@@ -168,16 +178,26 @@ bool load_import(std::string_view bytes, ImportResult& result, std::string& why,
       continue;
     }
     if (kind != 1) return false;
-    std::string source_why;
-    const std::string stored = r.str();
+    stored[p] = r.str();
+    exact[p] = 1;
     if (!r.ok) return false;
-    std::shared_ptr<BrepSource> source = load_brep_source(stored, source_why);
-    if (!source) {
-      why = "part '" + part.name + "': " + source_why;
+  }
+  // Read back on every thread, each part's on its own; judged in order.
+  std::vector<std::shared_ptr<BrepSource>> sources(m.parts.size());
+  std::vector<std::string> source_why(m.parts.size());
+#pragma omp parallel for schedule(dynamic, 1) if (m.parts.size() > 1)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(m.parts.size()); ++i) {
+    const auto p = static_cast<std::size_t>(i);
+    if (exact[p] != 0) sources[p] = load_brep_source(stored[p], source_why[p]);
+  }
+  for (std::size_t p = 0; p < m.parts.size(); ++p) {
+    if (exact[p] == 0) continue;
+    if (!sources[p]) {
+      why = "part '" + m.parts[p].name + "': " + source_why[p];
       return false;
     }
-    if (source->face_count() != part.surface_count) return false;
-    part.source = std::move(source);
+    if (sources[p]->face_count() != m.parts[p].surface_count) return false;
+    m.parts[p].source = std::move(sources[p]);
   }
   m.surfaces.resize(r.count(100));
   for (Surface& s : m.surfaces)
