@@ -5,10 +5,13 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <cstdint>
 #include <cstring>
 #include <mutex>
 #include <shared_mutex>
 #include <sstream>
+#include <system_error>
+#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -49,26 +52,62 @@ void default_crash_handlers() {
   } catch (...) {
     // An exception (bad_alloc, ...) is the parent's to meet again; it is not a crash.
   }
-  (void)!write(out, &kFinished, 1);
-  for (std::size_t at = 0; at < payload.size();) {
-    const ssize_t n = write(out, payload.data() + at, payload.size() - at);
+  // The end mark, the payload's size (8 bytes, little end first) and the payload: the parent stops
+  // reading when it has them all, without waiting for this process to give back its memory, which
+  // it does before its end of the pipe closes (a tenth of a second after a large file).
+  std::string tail(1, kFinished);
+  for (int b = 0; b < 8; ++b) tail += static_cast<char>((static_cast<std::uint64_t>(payload.size()) >> (8 * b)) & 0xff);
+  tail += payload;
+  for (std::size_t at = 0; at < tail.size();) {
+    const ssize_t n = write(out, tail.data() + at, tail.size() - at);
     if (n > 0) at += static_cast<std::size_t>(n);
     else if (errno != EINTR) break;
   }
   _exit(0);  // no atexit handlers or static destructors: they belong to the parent
 }
 
+// Whether `bytes` (what a child wrote so far) hold its end mark, the payload's size and the whole
+// payload.
+bool whole(const std::string& bytes) {
+  const std::size_t end = bytes.find(kFinished);
+  if (end == std::string::npos || bytes.size() < end + 9) return false;
+  std::uint64_t size = 0;
+  for (int b = 0; b < 8; ++b) size |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[end + 1 + b])) << (8 * b);
+  return bytes.size() - end - 9 >= size;
+}
+
+// A finished child is reaped by a thread of its own: its exit, after it gave back its memory, is
+// not waited for.
+void reap_later(pid_t pid) {
+  auto reap = [pid] {
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  };
+  try {
+    std::thread(reap).detach();
+  } catch (const std::system_error&) {
+    reap();  // no thread to spare: wait here
+  }
+}
+
 // How a finished child's bytes and exit status read: the payload split off the marks, and what ended it.
 void finish_run(ChildRun& run, pid_t pid) {
   const std::size_t end = run.marks.find(kFinished);
-  const bool finished = end != std::string::npos && !run.timed_out;
+  const bool finished = !run.timed_out && whole(run.marks);
   if (end != std::string::npos) {
-    run.payload = run.marks.substr(end + 1);
+    run.payload = run.marks.size() >= end + 9 ? run.marks.substr(end + 9) : std::string();
     run.marks.resize(end);
   }
   int status = 0;
   pid_t waited = -1;
-  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  // A child that sent all it had to say is done: its exit status is taken if it is there already,
+  // else it is reaped later. Any other child is waited for, to say how it ended.
+  while ((waited = waitpid(pid, &status, finished ? WNOHANG : 0)) < 0 && errno == EINTR) {
+  }
+  if (finished && waited == 0) {
+    reap_later(pid);
+    return;
   }
   if (run.timed_out) {
     run.crashed = true;
@@ -149,8 +188,8 @@ ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, 
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                             std::chrono::duration<double>(limited ? std::min(time_limit_seconds, 1e9) : 0.0));
-  char buffer[4096];
-  for (;;) {
+  char buffer[1 << 16];
+  while (!whole(run.marks)) {
     if (limited) {
       // A hanging child writes nothing: wait for its pipe no longer than the time left.
       const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
@@ -215,9 +254,8 @@ std::vector<ChildRun> Children::wait() {
     for (std::size_t i = pipes_.size(); i-- > 0;) {
       if (pipes_[i].revents == 0) continue;
       const ssize_t got = read(pipes_[i].fd, buffer, sizeof buffer);
-      if (got > 0) {
-        runs_[owner_[i]].marks.append(buffer, static_cast<std::size_t>(got));
-      } else if (got == 0 || errno != EINTR) {
+      if (got > 0) runs_[owner_[i]].marks.append(buffer, static_cast<std::size_t>(got));
+      if ((got > 0 && whole(runs_[owner_[i]].marks)) || got == 0 || (got < 0 && errno != EINTR)) {
         close(pipes_[i].fd);
         pipes_.erase(pipes_.begin() + static_cast<std::ptrdiff_t>(i));
         owner_.erase(owner_.begin() + static_cast<std::ptrdiff_t>(i));
