@@ -150,6 +150,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
   // Finding and loading the held parts stands in for checking and healing them.
   if (timings) timings->heal += std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
 
+  std::vector<char> written(n, 0);  // made parts whose entry was written
   if (!to_make.empty()) {
     Model fresh;
     std::vector<Diagnostic> said;
@@ -172,6 +173,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
       std::string why;
       const std::string bytes = save_import(one_part(p)).value_or(std::string());
       unwritable = bytes.empty() || !write_cache_entry(options.cache_dir, *keys[missing[m]], bytes, why);
+      written[missing[m]] = unwritable ? 0 : 1;
       if (unwritable)  // one warning, not one per part
         notes.push_back({Severity::Warning, parts[missing[m]].source_file, 0, -1,
                          std::string(kCacheNote) + "for part '" + parts[missing[m]].name + "' could not be written in " +
@@ -192,6 +194,8 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
       model.surfaces.push_back(std::move(s));
     }
     model.parts.push_back(std::move(p.part));
+    if (record != nullptr && keys[k] && (held[k] != 0 || written[k] != 0) && model.parts.back().source)
+      record->part_keys.emplace(model.parts.back().source.get(), *keys[k]);
     diagnostics.insert(diagnostics.end(), p.diagnostics.begin(), p.diagnostics.end());
     complete = complete && p.complete;
     out.push_back(id);

@@ -20,7 +20,8 @@ namespace cadclash::detail {
 // cache, with a tessellation time limit, or when two parts share an edge (one part's healing and
 // meshing then reach the other's), it is add_brep_parts. A damaged entry is made again, rewritten,
 // and named in a warning. `from_cache`, when given, gets how many parts came from entries; `record`,
-// when given and the import is lazy, gets each part's entry (store_triangles_in_cache).
+// when given, gets the key of each part that has an entry (for the file's entry, which names it)
+// and, when the import is lazy, each part's entry (store_triangles_in_cache).
 std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
                                           std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
                                           std::size_t* from_cache = nullptr, CacheRecord* record = nullptr);

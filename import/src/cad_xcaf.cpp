@@ -336,7 +336,7 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
                                                         result.complete, timings, &cached, record.get());
   if (!result.files.empty()) {
     result.files.back().parts_cached = cached;
-    if (!record->parts.empty()) result.files.back().cache_record = std::move(record);
+    if (!record->parts.empty() || !record->part_keys.empty()) result.files.back().cache_record = std::move(record);
   }
   std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];

@@ -32,7 +32,7 @@ namespace {
 
 // Bumped whenever the entry layout or what it stores (save_import, save_brep_source) changes; part
 // of every key, so entries of another version are never looked up.
-constexpr std::uint64_t kCacheFormat = 4;
+constexpr std::uint64_t kCacheFormat = 5;
 constexpr std::string_view kMagic = "CCIMPORT";
 constexpr std::size_t kDigestBytes = 32;
 using Digest = std::array<unsigned char, kDigestBytes>;
@@ -362,6 +362,56 @@ std::optional<std::string> placements_record(const std::string& bytes, const std
   return placements_payload(text->skeleton, file_key, p, free);
 }
 
+// A file's entry: its model, with the parts it holds by reference (save_import) read from their own
+// entries on every thread and given this file's face ids. False, with `why`, when it cannot be; `why`
+// empty when a part's entry is missing (the cache let it go: no damage, the file is read again).
+// `record`, when given, gets each part entry as it was read (store_triangles_in_cache).
+bool load_file_entry(std::string_view payload, const ImportOptions& options, ImportResult& out, std::string& why,
+                     CacheRecord* record) {
+  std::vector<std::pair<PartId, std::string>> referenced;
+  if (!load_import(payload, out, why, false, &referenced)) return false;
+  const std::size_t n = referenced.size();
+  std::vector<std::optional<ImportResult>> loaded(n);
+  std::vector<std::string> whys(n);
+#pragma omp parallel for schedule(dynamic, 1) if (n > 1)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto& [id, key] = referenced[k];
+    const Part& part = out.model.parts[id];
+    const CacheRead read = read_cache_entry(options.cache_dir, key);
+    if (!read.payload) {
+      if (!read.damaged.empty()) whys[k] = read.file + " is damaged (" + read.damaged + ")";
+      continue;
+    }
+    ImportResult one;
+    std::string one_why;
+    auto* source = load_import(*read.payload, one, one_why) && one.model.parts.size() == 1
+                       ? dynamic_cast<BrepSource*>(one.model.parts[0].source.get())
+                       : nullptr;
+    if (source == nullptr || source->face_count() != part.surface_count) {
+      whys[k] = read.file + " is damaged (" + (one_why.empty() ? "it holds no part '" + part.name + "'" : one_why) + ")";
+      continue;
+    }
+    std::vector<std::int64_t> ids(part.surface_count);
+    for (std::uint32_t f = 0; f < part.surface_count; ++f) ids[f] = out.model.surfaces[part.first_surface + f].provenance.step_id;
+    relabel_brep_faces(*source, ids);
+    loaded[k] = std::move(one);
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (!loaded[k]) {
+      why = whys[k];
+      return false;
+    }
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& [id, key] = referenced[k];
+    out.model.parts[id].source = loaded[k]->model.parts[0].source;
+    if (record == nullptr) continue;
+    record->part_keys.emplace(out.model.parts[id].source.get(), key);
+    if (options.lazy) record->parts.push_back(record_entry(key, std::move(*loaded[k])));
+  }
+  return true;
+}
+
 // The file at `path` when the cache holds an earlier version of it that differs only in its
 // placements' numbers: that version's model with each instance's pose computed from `bytes`.
 // A damaged placements entry adds a warning to `notes` (the file is then read, and the entry
@@ -386,13 +436,14 @@ std::optional<ImportResult> placed_import(const std::string& path, const std::st
   const CacheRead file = read_cache_entry(options.cache_dir, file_key);
   ImportResult placed;
   std::string why;
-  if (!file.payload || !load_import(*file.payload, placed, why) || placed.model.instances.size() != poses->size())
+  auto record = std::make_shared<CacheRecord>();
+  record->dir = options.cache_dir;
+  record->max_bytes = options.cache_max_bytes;
+  if (!file.payload || !load_file_entry(*file.payload, options, placed, why, record.get()) ||
+      placed.model.instances.size() != poses->size())
     return std::nullopt;
   placed.files.assign(1, FileImport{path, CacheUse::Placements, {}});
-  if (options.lazy) {  // triangles a check makes go to the entry the parts came from
-    auto record = std::make_shared<CacheRecord>();
-    record->dir = options.cache_dir;
-    record->max_bytes = options.cache_max_bytes;
+  if (options.lazy) {  // triangles a check makes go to the entries the parts came from
     record->file = record_entry(file_key, placed);
     placed.files.back().cache_record = std::move(record);
   }
@@ -425,22 +476,24 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     const auto load_start = std::chrono::steady_clock::now();
     std::string why;
     ImportResult hit;
-    if (const auto payload = entry_payload(*stored, key, why); payload && load_import(*payload, hit, why)) {
+    auto record = std::make_shared<CacheRecord>();
+    record->dir = options.cache_dir;
+    record->max_bytes = options.cache_max_bytes;
+    const auto payload = entry_payload(*stored, key, why);
+    if (payload && load_file_entry(*payload, options, hit, why, record.get())) {
       hit.files.assign(1, FileImport{path, CacheUse::Hit, {}});
       hit.files.back().timings.read = seconds_since(load_start);
       mark_used(entry.string());
       prune_cache(options.cache_dir, options.cache_max_bytes);
       if (options.lazy) {
-        auto record = std::make_shared<CacheRecord>();
-        record->dir = options.cache_dir;
-        record->max_bytes = options.cache_max_bytes;
         record->file = record_entry(key, hit);
         hit.files.back().cache_record = std::move(record);
       }
       return hit;
     }
-    damaged = cache_warning(path, std::string(kCacheNote) + entry.string() + " is damaged (" + why +
-                                      "); the file was read again and the entry rewritten");
+    if (!why.empty())
+      damaged = cache_warning(path, std::string(kCacheNote) + entry.string() + " is damaged (" + why +
+                                        "); the file was read again and the entry rewritten");
   }
 
   std::vector<Diagnostic> placed_notes;
@@ -472,7 +525,8 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
   std::thread recorder;
   if (placements_recordable(result))
     recorder = std::thread([&] { placements = placements_record(*bytes, key, *result.files.front().placements, result.model.instances); });
-  const std::optional<std::string> payload = save_import(result);
+  const std::shared_ptr<CacheRecord>& made = result.files.front().cache_record;
+  const std::optional<std::string> payload = save_import(result, true, made ? &made->part_keys : nullptr);
   if (recorder.joinable()) recorder.join();
   result.diagnostics.insert(result.diagnostics.begin(), notes.begin(), notes.end());
   if (damaged) result.diagnostics.insert(result.diagnostics.begin(), *damaged);
@@ -510,15 +564,18 @@ std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<D
     if (!f.cache_record) continue;
     detail::CacheRecord& record = *f.cache_record;
     bool unwritable = false;  // one warning per file, not one per entry
-    auto store = [&](detail::CacheRecord::Entry& e) {
+    // The file's entry holds the parts with entries of their own by reference: their triangles go
+    // to those entries, not to it.
+    auto store = [&](detail::CacheRecord::Entry& e, const detail::PartEntries* referenced) {
       if (unwritable) return;
       bool gained = false;
       std::vector<std::size_t> now;
-      for (const Part& part : e.stored.model.parts) now.push_back(detail::triangulated_faces(part));
+      for (const Part& part : e.stored.model.parts)
+        now.push_back(referenced && referenced->count(part.source.get()) ? 0 : detail::triangulated_faces(part));
       for (std::size_t p = 0; p < now.size(); ++p) gained = gained || now[p] > e.triangulated[p];
       if (!gained) return;
       std::string why = "a part cannot be stored";
-      const std::optional<std::string> payload = detail::save_import(e.stored);
+      const std::optional<std::string> payload = detail::save_import(e.stored, true, referenced);
       if (payload && detail::write_cache_entry(record.dir, e.key, *payload, why)) {
         e.triangulated = std::move(now);
         ++written;
@@ -529,8 +586,8 @@ std::size_t store_triangles_in_cache(const ImportResult& imported, std::vector<D
                              std::string(detail::kCacheNote) + "for the triangles of '" + f.path +
                                  "' could not be written in " + record.dir + " (" + why + ")"});
     };
-    if (record.file) store(*record.file);
-    for (detail::CacheRecord::Entry& e : record.parts) store(e);
+    if (record.file) store(*record.file, &record.part_keys);
+    for (detail::CacheRecord::Entry& e : record.parts) store(e, nullptr);
     detail::prune_cache(record.dir, record.max_bytes);
   }
   return written;

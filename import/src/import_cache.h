@@ -6,6 +6,9 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace cadclash::detail {
 
@@ -32,8 +35,14 @@ std::string placements_entry_name(const std::string& path, const ImportOptions& 
 // the contents are not whole. Without `exact_faces` a B-rep part is stored as its default deflection
 // only (import_description), which load_import accepts only with `stand_ins`: the part then gets a
 // source that knows that deflection and meshes nothing.
-std::optional<std::string> save_import(const ImportResult& r, bool exact_faces = true);
-bool load_import(std::string_view bytes, ImportResult& r, std::string& why, bool stand_ins = false);
+//
+// A file's entry holds the B-rep parts that have entries of their own (brep_part_cache.h) by those
+// entries' keys: save_import writes a part whose source `in_entries` names so, and load_import gives
+// such a part no source and lists it in `referenced` (without `referenced`, it fails on one).
+using PartEntries = std::unordered_map<const void*, std::string>;  // a part's source -> its entry's key
+std::optional<std::string> save_import(const ImportResult& r, bool exact_faces = true, const PartEntries* in_entries = nullptr);
+bool load_import(std::string_view bytes, ImportResult& r, std::string& why, bool stand_ins = false,
+                 std::vector<std::pair<PartId, std::string>>* referenced = nullptr);
 
 // The building blocks, for caches of pieces of files (step_piece_cache.h).
 //
@@ -70,6 +79,7 @@ struct CacheRecord {
   std::uint64_t max_bytes = 0;  // ImportOptions::cache_max_bytes
   std::optional<Entry> file;  // the whole file's entry
   std::vector<Entry> parts;   // each B-rep part's entry (brep_part_cache.h)
+  PartEntries part_keys;      // the parts (lazy or not) that have entries of their own, by source
 };
 // Removes the least recently used entries of `dir` (oldest modification time first, then by name)
 // until its entries take at most `max_bytes`; nothing when max_bytes is 0. Errors are ignored: an

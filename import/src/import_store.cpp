@@ -112,7 +112,7 @@ bool get_surface(ByteReader& r, Surface& s) {
 
 }  // namespace
 
-std::optional<std::string> save_import(const ImportResult& result, bool exact_faces) {
+std::optional<std::string> save_import(const ImportResult& result, bool exact_faces, const PartEntries* in_entries) {
   ByteWriter w;
   write_diagnostics(w, result.diagnostics);
   w.u64(result.complete ? 1 : 0);
@@ -120,11 +120,18 @@ std::optional<std::string> save_import(const ImportResult& result, bool exact_fa
   for (const Part& part : m.parts)
     if (part.source && dynamic_cast<const BrepSource*>(part.source.get()) == nullptr) return std::nullopt;
   // The parts' exact faces written out on every thread (each part's on its own), then in order.
+  auto entry_of = [&](const Part& part) -> const std::string* {
+    if (in_entries == nullptr || !part.source) return nullptr;
+    const auto it = in_entries->find(part.source.get());
+    return it == in_entries->end() ? nullptr : &it->second;
+  };
   std::vector<std::string> faces(exact_faces ? m.parts.size() : 0);
 #pragma omp parallel for schedule(dynamic, 1) if (faces.size() > 1)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(faces.size()); ++i)
-    if (const auto* brep = dynamic_cast<const BrepSource*>(m.parts[static_cast<std::size_t>(i)].source.get()))
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(faces.size()); ++i) {
+    const Part& part = m.parts[static_cast<std::size_t>(i)];
+    if (const auto* brep = dynamic_cast<const BrepSource*>(part.source.get()); brep && !entry_of(part))
       faces[static_cast<std::size_t>(i)] = save_brep_source(*brep);
+  }
   w.u64(m.parts.size());
   for (std::size_t p = 0; p < m.parts.size(); ++p) {
     const Part& part = m.parts[p];
@@ -139,6 +146,11 @@ std::optional<std::string> save_import(const ImportResult& result, bool exact_fa
     if (!exact_faces) {
       w.u64(2);
       w.f64(static_cast<const BrepSource&>(*part.source).default_deflection());
+      continue;
+    }
+    if (const std::string* key = entry_of(part)) {
+      w.u64(3);
+      w.str(*key);
       continue;
     }
     w.u64(1);
@@ -156,7 +168,8 @@ std::optional<std::string> save_import(const ImportResult& result, bool exact_fa
   return std::move(w.out);
 }
 
-bool load_import(std::string_view bytes, ImportResult& result, std::string& why, bool stand_ins) {
+bool load_import(std::string_view bytes, ImportResult& result, std::string& why, bool stand_ins,
+                 std::vector<std::pair<PartId, std::string>>* referenced) {
   ByteReader r{bytes};
   why = "its contents are cut short or inconsistent";
   result.diagnostics = read_diagnostics(r);
@@ -175,6 +188,10 @@ bool load_import(std::string_view bytes, ImportResult& result, std::string& why,
     if (kind == 0 || !r.ok) continue;
     if (kind == 2 && stand_ins) {
       part.source = std::make_shared<StandInSource>(r.f64());
+      continue;
+    }
+    if (kind == 3 && referenced != nullptr) {
+      referenced->emplace_back(static_cast<PartId>(p), r.str());
       continue;
     }
     if (kind != 1) return false;

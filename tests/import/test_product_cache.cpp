@@ -237,6 +237,49 @@ TEST(ProductCache, DamagedProductEntriesAreRebuilt) {
   expect_as_read_afresh(path, again);
 }
 
+// The whole file's entry names its parts' entries instead of holding their faces again: without
+// them it is no hit, and the file is read as if the cache had never held it (no warning: a cache
+// that lets entries go is not damaged); with a part's entry damaged, it is rebuilt and says so.
+TEST(ProductCache, TheFilesEntryNamesItsPartsEntries) {
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  for (const bool lazy : {false, true}) {
+    SCOPED_TRACE(lazy ? "lazy" : "eager");
+    const auto [path, original, options] = cached_board(lazy ? "file_entry_lazy" : "file_entry_eager", lazy);
+    (void)import_file(path, options);
+    const fs::path whole = fs::path(options.cache_dir) / detail::cache_entry_name(path, options).value();
+    ASSERT_TRUE(fs::exists(whole));
+    const std::string whole_bytes = read_bytes(whole.string());
+    const ImportResult hit = import_file(path, options);
+    ASSERT_EQ(hit.files[0].cache, CacheUse::Hit);
+    expect_as_read_afresh(path, hit, &options);
+
+    for (const auto& f : fs::directory_iterator(options.cache_dir))
+      if (f.path() != whole) fs::remove(f.path());
+    const ImportResult alone = import_file(path, options);
+    EXPECT_EQ(alone.files[0].cache, CacheUse::Miss);
+    EXPECT_EQ(alone.files[0].parts_cached, 0u);
+    expect_as_read_afresh(path, alone, &options);
+
+    std::size_t damaged = 0;
+    for (const auto& f : fs::directory_iterator(options.cache_dir)) {
+      if (f.path() == whole || f.path().filename() == detail::placements_entry_name(path, options)) continue;
+      std::string bytes = read_bytes(f.path().string());
+      bytes[bytes.size() / 2] ^= 0x20;
+      write_bytes(f.path().string(), bytes);
+      ++damaged;
+    }
+    ASSERT_GT(damaged, 0u);
+    const ImportResult rebuilt = import_file(path, options);
+    EXPECT_EQ(rebuilt.files[0].cache, CacheUse::Rebuilt);
+    ASSERT_FALSE(rebuilt.diagnostics.empty());
+    EXPECT_NE(rebuilt.diagnostics[0].message.find("is damaged"), std::string::npos) << rebuilt.diagnostics[0].message;
+    ImportResult without = rebuilt;
+    std::erase_if(without.diagnostics, [](const Diagnostic& d) { return d.message.find("is damaged") != std::string::npos; });
+    expect_as_read_afresh(path, without, &options);
+    EXPECT_EQ(read_bytes(whole.string()), whole_bytes);  // rewritten as it was
+  }
+}
+
 // A lazy import through the cache, checked: the faces the check meshed are written back into the
 // entries (store_triangles_in_cache), so the next run reads them instead of meshing (nothing is
 // left to store after its check), with the same report; and a run whose check reaches other faces
@@ -250,7 +293,8 @@ TEST(ProductCache, TrianglesAChecksMadeAreKeptForTheNextRun) {
   const ImportResult cold = import_file(path, options);
   const std::string report = check_text(cold);  // meshes the faces the check reaches, in the shared sources
   std::vector<Diagnostic> notes;
-  EXPECT_EQ(store_triangles_in_cache(cold, notes), 1 + cold.model.parts.size());  // the file's entry and every part's
+  // Every part's entry; the file's entry names them and holds no triangles of its own.
+  EXPECT_EQ(store_triangles_in_cache(cold, notes), cold.model.parts.size());
   EXPECT_TRUE(notes.empty());
   EXPECT_EQ(store_triangles_in_cache(cold, notes), 0u);  // nothing gained since
 
