@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <optional>
 #include <sstream>
 #include <unordered_map>
@@ -371,6 +372,18 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
       result.complete = false;
     }
     if (text.size() < run.parallel_min_bytes) run.workers = 1;
+    // The text's own checks (its unit contexts, its declared uncertainty) run on a thread of their
+    // own while the text is cut and parsed; it is done before this process forks any worker.
+    struct TextChecks {
+      std::vector<Diagnostic> units, uncertainty;
+      double declared = 0.0;
+    };
+    std::future<TextChecks> text_checks = std::async(std::launch::async, [&text, &path] {
+      TextChecks c;
+      c.units = unit_context_problems(text, path);
+      c.declared = declared_length_uncertainty(text, path, c.uncertainty);
+      return c;
+    });
     // A large file is cut into pieces that workers parse and transfer while this process parses
     // what is left (step_split_text.h), pieces the cache holds taken from it (step_piece_cache.h);
     // pieces that fail send read_step back to the whole file.
@@ -390,6 +403,7 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
           else missing.push_back(p);
         }
         read.shares = share_pieces(read.split.pieces, missing, run.workers);
+        text_checks.wait();  // no thread but this one when the workers are forked
         if (!read.shares.empty())
           read.workers.emplace(read.shares.size(), [&](std::size_t k, const Mark&) {
             return read_step_pieces(path, read.split.pieces, read.shares[k]);
@@ -420,11 +434,13 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     }
     run.mark(kParsed);
     if (load_fails > 0) result.complete = false;
-    for (Diagnostic& d : unit_context_problems(text, path)) {
+    TextChecks checked = text_checks.get();
+    for (Diagnostic& d : checked.units) {
       if (d.severity == Severity::Error) result.complete = false;
       result.diagnostics.push_back(std::move(d));
     }
-    result.declared_uncertainty = declared_length_uncertainty(text, path, result.diagnostics);
+    result.declared_uncertainty = checked.declared;
+    for (Diagnostic& d : checked.uncertainty) result.diagnostics.push_back(std::move(d));
     if (model.IsNull() || model->NbEntities() == 0) {
       result.diagnostics.push_back({Severity::Error, path, 0, -1, "STEP file has an empty DATA section"});
       result.complete = false;

@@ -365,6 +365,37 @@ namespace {
 // One pass over the text: the numbers of the statements `ids` and where they stand, and, with
 // `axes`, which of them place occurrences and nothing else (free_values); nullopt when the text
 // cannot be scanned or one of `ids` is missing or not a CARTESIAN_POINT / DIRECTION('name',(x,y,z)).
+// A set of ids asked for every statement and reference of the text: a bitmap over the ids up to the
+// largest (a few MB at most), where hashing each of millions of ids was most of a pass.
+class IdSet {
+ public:
+  explicit IdSet(std::span<const std::int64_t> ids) {
+    std::int64_t largest = -1;
+    for (const std::int64_t id : ids) largest = std::max(largest, id);
+    if (largest >= 0 && largest < (std::int64_t{1} << 27)) {
+      bits_.assign(static_cast<std::size_t>(largest) + 1, false);
+      for (const std::int64_t id : ids)
+        if (id >= 0 && !bits_[static_cast<std::size_t>(id)]) {
+          bits_[static_cast<std::size_t>(id)] = true;
+          ++size_;
+        }
+    } else {
+      sparse_.insert(ids.begin(), ids.end());
+      size_ = sparse_.size();
+    }
+  }
+  std::size_t size() const { return size_; }  // distinct ids
+  bool count(std::int64_t id) const {
+    if (!sparse_.empty()) return sparse_.count(id) > 0;
+    return id >= 0 && static_cast<std::size_t>(id) < bits_.size() && bits_[static_cast<std::size_t>(id)];
+  }
+
+ private:
+  std::vector<bool> bits_;
+  std::unordered_set<std::int64_t> sparse_;
+  std::size_t size_ = 0;
+};
+
 struct NumberScan {
   PlacementValues values;
   std::map<std::size_t, std::pair<std::size_t, std::int64_t>> spans;  // by where the numbers begin: their end and id
@@ -372,7 +403,7 @@ struct NumberScan {
 };
 std::optional<NumberScan> scan_numbers(std::string_view text, std::span<const std::int64_t> ids,
                                        std::span<const std::int64_t> axes) {
-  const std::unordered_set<std::int64_t> wanted(ids.begin(), ids.end()), axis_set(axes.begin(), axes.end());
+  const IdSet wanted(ids), axis_set(axes);
   NumberScan out;
   std::unordered_set<std::int64_t> bound;  // values referenced by a statement other than an axis
   std::unordered_set<std::int64_t> fixed;  // axes referenced by a statement that uses them for more than placing occurrences
