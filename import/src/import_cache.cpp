@@ -32,7 +32,7 @@ namespace {
 
 // Bumped whenever the entry layout or what it stores (save_import, save_brep_source) changes; part
 // of every key, so entries of another version are never looked up.
-constexpr std::uint64_t kCacheFormat = 5;
+constexpr std::uint64_t kCacheFormat = 6;
 constexpr std::string_view kMagic = "CCIMPORT";
 constexpr std::size_t kDigestBytes = 32;
 using Digest = std::array<unsigned char, kDigestBytes>;

@@ -15,6 +15,7 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <Interface_Static.hxx>
 #include <STEPCAFControl_Reader.hxx>
+#include <ShapeFix.hxx>
 #include <STEPConstruct_Styles.hxx>
 #include <StepVisual_Colour.hxx>
 #include <StepVisual_StyledItem.hxx>
@@ -231,8 +232,14 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
     result.parallel_workers = parallel.used ? parallel.workers : 1;
   }
 
+  // The edges' regularity (XSControl_TransferReader::ShapeResult encodes it on the whole result) was
+  // encoded by the workers on each piece's items, the same edges between the same faces, and came
+  // back with their shapes: not computed again for every edge of the file here.
+  const Standard_Real regularity = Interface_Static::RVal("read.encoderegularity.angle");
+  if (pieces != nullptr) Interface_Static::SetRVal("read.encoderegularity.angle", 0.0);
   const std::optional<Handle(Transfer_TransientProcess)> process =
       transfer_document(reader, ws, model, label, path, "STEP", result);
+  if (pieces != nullptr) Interface_Static::SetRVal("read.encoderegularity.angle", regularity);
   run.mark(kTransferred);
   if (!process) return;
   colour_styled_faces(result.doc, bound.styles);
@@ -296,6 +303,13 @@ std::string read_step_piece(const std::string& path, const StepPiece& piece) {
     }
     const Handle(Transfer_TransientProcess) process = transfer->TransientProcess();
     if (process.IsNull() || !process->CheckList(Standard_True).IsEmpty(Standard_True)) return {};
+    // The edges' regularity, as the main reader's ShapeResult encodes it on the whole file's result
+    // (it then leaves it to the pieces: transfer_products).
+    const Standard_Real regularity = Interface_Static::RVal("read.encoderegularity.angle");
+    if (regularity > 0)
+      for (const std::int64_t id : piece.reps)
+        if (const TopoDS_Shape shape = TransferBRep::ShapeResult(process, wanted[id]); !shape.IsNull())
+          ShapeFix::EncodeRegularity(shape, regularity);
     ShapeBindings out;
     for (const std::int64_t id : piece.bind) {
       const TopoDS_Shape shape = TransferBRep::ShapeResult(process, wanted[id]);

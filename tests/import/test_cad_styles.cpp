@@ -1,7 +1,9 @@
-// Face colours of a STEP file read in pieces (step_split_text.h): a face's only styled item goes into
-// the face's piece, its worker reads the colours with OCCT's own code and the main reader sets them
-// where STEPCAFControl_Reader::ReadColors would. The model must be the one the reader alone makes
-// from the whole file, with the styles moved, and with each case that keeps a style in the main text.
+// What a STEP file read in pieces (step_split_text.h) carries besides its shapes, as the reader alone
+// makes it from the whole file. Face colours: a face's only styled item goes into the face's piece,
+// its worker reads the colours with OCCT's own code and the main reader sets them where
+// STEPCAFControl_Reader::ReadColors would (with the styles moved, and with each case that keeps a
+// style in the main text). Edge regularity: encoded by the workers on their items, not again by the
+// main reader.
 #include "cadclash/import.h"
 #include "import_cache.h"
 #include "import_compare.h"
@@ -10,8 +12,14 @@
 
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <Quantity_Color.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <gp_Trsf.hxx>
@@ -19,6 +27,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -176,6 +185,46 @@ TEST(CadStyles, StylesTheMainTextStillNeedsStayThere) {
              "PRESENTATION_STYLE_ASSIGNMENT((@5))", "STYLED_ITEM('',(@6)," + face + ")"});
   EXPECT_EQ(styled_items(twice).main, 3u);
   expect_same_when_split(write_text("styled_twice.step", twice), 4);
+}
+
+// Per part, the continuity OCCT recorded between the two faces of each edge (a seam: the face with
+// itself), sorted: what XSControl_TransferReader::ShapeResult's EncodeRegularity leaves on the shapes.
+std::vector<std::vector<int>> edge_regularity(const ImportResult& r) {
+  std::vector<std::vector<int>> out;
+  for (const Part& part : r.model.parts) {
+    const auto* brep = dynamic_cast<const BrepSource*>(part.source.get());
+    out.emplace_back();
+    if (brep == nullptr) continue;
+    TopoDS_Compound faces;
+    BRep_Builder builder;
+    builder.MakeCompound(faces);
+    for (std::uint32_t f = 0; f < brep->face_count(); ++f) builder.Add(faces, brep->face(f));
+    TopTools_IndexedDataMapOfShapeListOfShape edges;
+    TopExp::MapShapesAndAncestors(faces, TopAbs_EDGE, TopAbs_FACE, edges);
+    for (int e = 1; e <= edges.Extent(); ++e) {
+      const TopoDS_Edge& edge = TopoDS::Edge(edges.FindKey(e));
+      const TopTools_ListOfShape& around = edges.FindFromIndex(e);
+      const TopoDS_Face& first = TopoDS::Face(around.First());
+      const TopoDS_Face& last = TopoDS::Face(around.Last());
+      out.back().push_back(static_cast<int>(BRep_Tool::Continuity(edge, first, last)));
+    }
+    std::sort(out.back().begin(), out.back().end());
+  }
+  return out;
+}
+
+TEST(CadSplit, EdgeRegularityIsTheWholeFilesOne) {
+  const std::string path = write_text("regularity_board.step", write_styled_board());
+  ImportOptions options;
+  options.transfer_workers = 1;
+  const auto alone = edge_regularity(import_file(path, options));
+  bool smooth = false;  // the pin's seam joins its side to itself smoothly
+  for (const auto& part : alone) smooth = smooth || std::any_of(part.begin(), part.end(), [](int c) { return c > GeomAbs_C0; });
+  EXPECT_TRUE(smooth);
+  options.transfer_workers = 2;
+  const ImportResult spread = import_file(path, options);
+  ASSERT_GT(spread.files.at(0).pieces, 1u);
+  EXPECT_EQ(edge_regularity(spread), alone);
 }
 
 }  // namespace
