@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <sstream>
 #include <system_error>
@@ -412,12 +413,16 @@ bool load_file_entry(std::string_view payload, const ImportOptions& options, Imp
   return true;
 }
 
-// The file at `path` when the cache holds an earlier version of it that differs only in its
-// placements' numbers: that version's model with each instance's pose computed from `bytes`.
-// A damaged placements entry adds a warning to `notes` (the file is then read, and the entry
-// rewritten).
-std::optional<ImportResult> placed_import(const std::string& path, const std::string& bytes, const ImportOptions& options,
-                                          std::vector<Diagnostic>& notes) {
+// The file at `path`, when the cache holds an earlier version of it that differs only in its
+// placements' numbers, is that version's model with each instance's pose computed from `bytes`:
+// first the plan (the entry holding the model and the poses), then the model loaded. A damaged
+// placements entry adds a warning to `notes` (the file is then read, and the entry rewritten).
+struct PlacedPlan {
+  std::string file_key;
+  std::vector<Pose> poses;
+};
+std::optional<PlacedPlan> placed_plan(const std::string& path, const std::string& bytes, const ImportOptions& options,
+                                      std::vector<Diagnostic>& notes) {
   const CacheRead index = read_cache_entry(options.cache_dir, placements_key(path, options));
   if (!index.damaged.empty())
     notes.push_back(cache_warning(path, std::string(kCacheNote) + index.file + " is damaged (" + index.damaged +
@@ -431,23 +436,27 @@ std::optional<ImportResult> placed_import(const std::string& path, const std::st
   if (!r.ok || r.at != index.payload->size() || !load_placements(recipe, p)) return std::nullopt;
   const std::optional<PlacementText> text = placement_text(bytes, p.value_ids(), free);
   if (!text || text->skeleton != skeleton) return std::nullopt;
-  const std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
+  std::optional<std::vector<Pose>> poses = placement_poses(p, text->values);
   if (!poses) return std::nullopt;  // read: the reader says what is wrong with the new poses
-  const CacheRead file = read_cache_entry(options.cache_dir, file_key);
+  return PlacedPlan{file_key, std::move(*poses)};
+}
+
+std::optional<ImportResult> placed_import(const std::string& path, const ImportOptions& options, const PlacedPlan& plan) {
+  const CacheRead file = read_cache_entry(options.cache_dir, plan.file_key);
   ImportResult placed;
   std::string why;
   auto record = std::make_shared<CacheRecord>();
   record->dir = options.cache_dir;
   record->max_bytes = options.cache_max_bytes;
   if (!file.payload || !load_file_entry(*file.payload, options, placed, why, record.get()) ||
-      placed.model.instances.size() != poses->size())
+      placed.model.instances.size() != plan.poses.size())
     return std::nullopt;
   placed.files.assign(1, FileImport{path, CacheUse::Placements, {}});
   if (options.lazy) {  // triangles a check makes go to the entries the parts came from
-    record->file = record_entry(file_key, placed);
+    record->file = record_entry(plan.file_key, placed);
     placed.files.back().cache_record = std::move(record);
   }
-  for (std::size_t k = 0; k < poses->size(); ++k) placed.model.instances[k].pose = (*poses)[k];
+  for (std::size_t k = 0; k < plan.poses.size(); ++k) placed.model.instances[k].pose = plan.poses[k];
   return placed;
 }
 
@@ -467,6 +476,13 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
                            const std::function<ImportResult()>& read) {
   const std::optional<std::string> bytes = file_bytes(path);
   if (!bytes) return read();  // the reader names the problem (no such file, a directory, ...)
+  // Whether the file differs from an earlier one only in its placements' numbers is worked out
+  // while its key is hashed and its entry looked for (a pass over the text each); asked only when
+  // the file has no entry of its own.
+  const auto placed_start = std::chrono::steady_clock::now();
+  std::vector<Diagnostic> placed_notes;
+  std::future<std::optional<PlacedPlan>> plan =
+      std::async(std::launch::async, [&] { return placed_plan(path, *bytes, options, placed_notes); });
   const std::string key = cache_key(path, *bytes, options);
   const std::filesystem::path dir(options.cache_dir);
   const std::filesystem::path entry = dir / entry_name(key);
@@ -496,10 +512,10 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
                                         "); the file was read again and the entry rewritten");
   }
 
-  std::vector<Diagnostic> placed_notes;
-  if (!damaged) {
-    const auto placed_start = std::chrono::steady_clock::now();
-    if (std::optional<ImportResult> placed = placed_import(path, *bytes, options, placed_notes)) {
+  const std::optional<PlacedPlan> placed_as = plan.get();
+  if (damaged) placed_notes.clear();  // the file is read: its placements entry was not asked
+  if (!damaged && placed_as) {
+    if (std::optional<ImportResult> placed = placed_import(path, options, *placed_as)) {
       placed->files.back().timings.read = seconds_since(placed_start);
       prune_cache(options.cache_dir, options.cache_max_bytes);
       return std::move(*placed);
