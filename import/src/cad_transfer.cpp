@@ -125,6 +125,18 @@ std::string pack_transfer(const Transfer& t) {
       w.i64(entity->id);
       w.str(entity->name);
     }
+    std::unordered_map<const void*, Standard_Integer> index_of;  // by TShape, as the tags
+    if (!t.side_colours.empty())
+      for (Standard_Integer f = 1; f <= faces.Extent(); ++f) index_of.try_emplace(faces(f).TShape().get(), f);
+    std::vector<std::pair<Standard_Integer, const SideColour*>> sides;
+    for (const SideColour& c : t.side_colours)
+      if (const auto it = index_of.find(c.face.TShape().get()); it != index_of.end()) sides.emplace_back(it->second, &c);
+    w.u64(sides.size());
+    for (const auto& [f, c] : sides) {
+      w.i64(f);
+      w.str(c->part);
+      for (const float v : c->rgb) w.f64(v);
+    }
     std::ostringstream stored;
     const std::lock_guard<std::mutex> lock(application_mutex());
     if (application()->SaveAs(t.doc, stored) != PCDM_SS_OK) return {};
@@ -166,11 +178,17 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
-      std::vector<std::pair<std::int64_t, FaceEntity>> tagged(r.u64());
+      std::vector<std::pair<std::int64_t, FaceEntity>> tagged(r.count(24));
       for (auto& [f, entity] : tagged) {
         f = r.i64();
         entity.id = r.i64();
         entity.name = r.str();
+      }
+      std::vector<std::pair<std::int64_t, SideColour>> sides(r.count(40));
+      for (auto& [f, c] : sides) {
+        f = r.i64();
+        c.part = r.str();
+        for (float& v : c.rgb) v = static_cast<float>(r.f64());
       }
       std::istringstream stored(r.str());
       if (!r.ok) {
@@ -185,6 +203,14 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
       const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
       for (const auto& [f, entity] : tagged)
         if (f >= 1 && f <= faces.Extent()) t.faces.emplace(faces(static_cast<Standard_Integer>(f)).TShape().get(), entity);
+      for (auto& [f, c] : sides) {
+        if (f < 1 || f > faces.Extent()) {
+          why = "the reader's output is not whole";
+          return false;
+        }
+        c.face = faces(static_cast<Standard_Integer>(f));
+        t.side_colours.push_back(std::move(c));
+      }
     } else if (r.ok && what == 2) {
       t.loose_ids.resize(r.u64());
       for (std::int64_t& id : t.loose_ids) id = r.i64();
@@ -242,7 +268,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   const char* format = t.kind == SourceKind::IgesFace ? "IGES" : "STEP";
   if (!t.doc.IsNull()) {
     std::vector<std::vector<std::string>> chains;
-    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings, &chains);
+    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings, &chains, t.side_colours);
     if (t.placements)
       if (std::optional<Placements> p = file_placements(*t.placements, chains)) {
         p->stored = t.unpacked;

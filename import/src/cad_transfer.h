@@ -40,6 +40,7 @@ struct Transfer {
   // Products: an XCAF document (closed by the destructor) and the entities of its faces.
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;
+  std::vector<SideColour> side_colours;  // face colours kept beside the document (add_xcaf_document)
   // STEP products: every occurrence's component and placement (step_placements.h); nullopt when
   // one is placed otherwise, or not STEP.
   std::optional<std::vector<ComponentPlacement>> placements;

@@ -184,10 +184,13 @@ struct Walker {
   }
 };
 
-// Face colours of a part: a face's own colour, else the colour of the nearest enclosing shape
-// (shell, solid, compound) that has one.
-std::unordered_map<const void*, std::array<float, 3>> part_face_colours(const TDF_Label& label) {
+// Face colours of a part: a face's own colour (`side`'s first), else the colour of the nearest
+// enclosing shape (shell, solid, compound) that has one.
+std::unordered_map<const void*, std::array<float, 3>> part_face_colours(
+    const TDF_Label& label, const std::vector<std::pair<const void*, std::array<float, 3>>>* side) {
   std::unordered_map<const void*, std::array<float, 3>> out;
+  if (side != nullptr)
+    for (const auto& [face, rgb] : *side) out.try_emplace(face, rgb);
   XCAFPrs_IndexedDataMapOfShapeStyle styles;
   try {
     XCAFPrs::CollectStyleSettings(label, TopLoc_Location(), styles);
@@ -273,7 +276,10 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
                        const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings, std::vector<std::vector<std::string>>* chains) {
+                       BrepPartTimings* timings, std::vector<std::vector<std::string>>* chains,
+                       const std::vector<SideColour>& side) {
+  std::unordered_map<std::string, std::vector<std::pair<const void*, std::array<float, 3>>>> side_of;  // by part
+  for (const SideColour& c : side) side_of[c.part].emplace_back(c.face.TShape().get(), c.rgb);
   Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, {}, result.diagnostics};
   TDF_LabelSequence roots;
   walker.shapes->GetFreeShapes(roots);
@@ -294,7 +300,13 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
     if (in.name.empty()) in.name = "part" + std::to_string(p);
     in.source_file = file;
     in.kind = kind;
-    const auto colours = part_face_colours(label);
+    const std::unordered_map<const void*, std::array<float, 3>> colours = [&] {
+      if (side_of.empty()) return part_face_colours(label, nullptr);
+      TCollection_AsciiString entry;
+      TDF_Tool::Entry(label, entry);
+      const auto it = side_of.find(entry.ToCString());
+      return part_face_colours(label, it == side_of.end() ? nullptr : &it->second);
+    }();
     TopTools_IndexedMapOfShape face_map;
     if (!shapes[p].IsNull()) TopExp::MapShapes(shapes[p], TopAbs_FACE, face_map);
     in.tags.resize(static_cast<std::size_t>(face_map.Extent()));

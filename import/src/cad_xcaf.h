@@ -12,6 +12,7 @@
 #include <gp_Trsf.hxx>
 #include <Transfer_TransientProcess.hxx>
 
+#include <array>
 #include <functional>
 #include <string>
 #include <unordered_map>
@@ -58,9 +59,17 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
 // `timings`, when given, gets add_brep_parts' seconds added.
 // `chains`, when given, gets per instance added (in order) the entries of the component labels
 // from the root down to it.
+// `side`: colours of faces the document would hold as sub-shape colours of a part, kept beside it
+// (a STEP piece's styled faces, step_attempt.cpp): they come first, as the most specific.
+struct SideColour {
+  std::string part;   // the part's label entry ("0:1:1:5")
+  TopoDS_Shape face;  // a face of the part's shape
+  std::array<float, 3> rgb{};  // sRGB, as the document's surface colour reads
+};
 void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
                        const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings = nullptr, std::vector<std::vector<std::string>>* chains = nullptr);
+                       BrepPartTimings* timings = nullptr, std::vector<std::vector<std::string>>* chains = nullptr,
+                       const std::vector<SideColour>& side = {});
 
 // An instance's pose from its location's transformation, as add_xcaf_document makes it (the scale
 // divided out of the rotation part: the walk warns about a scale).

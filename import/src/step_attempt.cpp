@@ -24,6 +24,7 @@
 #include <StepShape_Face.hxx>
 #include <TCollection_HAsciiString.hxx>
 #include <TDF_LabelSequence.hxx>
+#include <TDF_Tool.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS_Iterator.hxx>
@@ -151,10 +152,13 @@ std::string read_step_pieces(const std::string& path, const std::vector<StepPiec
   return std::move(w.out);
 }
 
-// The styled faces of the pieces coloured in the document as STEPCAFControl_Reader::ReadColors
-// colours a face it finds styled in the file: on the face's sub-shape label of the part holding it,
-// else on the labels of the face's wires.
-void colour_styled_faces(const Handle(TDocStd_Document)& doc, const std::vector<FaceStyle>& styles) {
+// The styled faces of the pieces coloured as STEPCAFControl_Reader::ReadColors colours a face it
+// finds styled in the file: on the face's sub-shape label of the part holding it, else on the
+// labels of the face's wires. A surface colour that would go to a new sub-shape label of a part
+// is kept beside the document instead (`side`: the walk reads it as that label's colour), which
+// spares the document a label per face on its way out of the reader and back.
+void colour_styled_faces(const Handle(TDocStd_Document)& doc, const std::vector<FaceStyle>& styles,
+                         std::vector<SideColour>& side) {
   if (styles.empty() || doc.IsNull()) return;
   const Handle(XCAFDoc_ColorTool) colours = XCAFDoc_DocumentTool::ColorTool(doc->Main());
   const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
@@ -165,6 +169,21 @@ void colour_styled_faces(const Handle(TDocStd_Document)& doc, const std::vector<
   };
   for (const FaceStyle& style : styles) {
     TDF_Label label;
+    if (style.surface && !style.boundary && !style.curve && !shapes->SearchUsingMap(style.face, label, Standard_False, Standard_False)) {
+      // Where SearchUsingMap would add the face as a sub-shape (XCAFDoc_ShapeTool::AddSubShape's
+      // conditions), unless a label for it is there already.
+      const TDF_Label part = shapes->FindMainShapeUsingMap(style.face);
+      TDF_Label existing;
+      if (!part.IsNull() && shapes->IsSimpleShape(part) && shapes->IsTopLevel(part) && shapes->IsSubShape(part, style.face) &&
+          !shapes->FindSubShape(part, style.face, existing)) {
+        TCollection_AsciiString entry;
+        TDF_Tool::Entry(part, entry);
+        Standard_Real r = 0, g = 0, b = 0;
+        style.surface->GetRGB().Values(r, g, b, Quantity_TOC_sRGB);
+        side.push_back({entry.ToCString(), style.face, {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)}});
+        continue;
+      }
+    }
     if (shapes->SearchUsingMap(style.face, label, Standard_False, Standard_True)) {
       set(label, style);
       continue;
@@ -242,7 +261,7 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
   if (pieces != nullptr) Interface_Static::SetRVal("read.encoderegularity.angle", regularity);
   run.mark(kTransferred);
   if (!process) return;
-  colour_styled_faces(result.doc, bound.styles);
+  colour_styled_faces(result.doc, bound.styles, result.side_colours);
   if (has_faces(result.doc)) run.mark(kShapes);
   result.faces = map_face_entities(
       *process, [&](const Handle(Standard_Transient)& entity, FaceEntity& out) { return describe_face(entity, label, out); },
