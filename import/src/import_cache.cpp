@@ -477,12 +477,12 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
   const std::optional<std::string> bytes = file_bytes(path);
   if (!bytes) return read();  // the reader names the problem (no such file, a directory, ...)
   // Whether the file differs from an earlier one only in its placements' numbers is worked out
-  // while its key is hashed and its entry looked for (a pass over the text each); asked only when
-  // the file has no entry of its own.
+  // while its key is hashed and its entry looked for (a pass over the text each; here when no
+  // thread can be started); asked only when the file has no entry of its own.
   const auto placed_start = std::chrono::steady_clock::now();
   std::vector<Diagnostic> placed_notes;
   std::future<std::optional<PlacedPlan>> plan =
-      std::async(std::launch::async, [&] { return placed_plan(path, *bytes, options, placed_notes); });
+      std::async(std::launch::async | std::launch::deferred, [&] { return placed_plan(path, *bytes, options, placed_notes); });
   const std::string key = cache_key(path, *bytes, options);
   const std::filesystem::path dir(options.cache_dir);
   const std::filesystem::path entry = dir / entry_name(key);
@@ -539,8 +539,20 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
   // out; it reads only the placements, the poses and the text, which nothing here changes.
   std::optional<std::string> placements;
   std::thread recorder;
-  if (placements_recordable(result))
-    recorder = std::thread([&] { placements = placements_record(*bytes, key, *result.files.front().placements, result.model.instances); });
+  auto record_placements = [&] {
+    try {
+      placements = placements_record(*bytes, key, *result.files.front().placements, result.model.instances);
+    } catch (...) {  // (bad_alloc) not recorded: the next edit of the file is read as any other
+      placements.reset();
+    }
+  };
+  if (placements_recordable(result)) {
+    try {
+      recorder = std::thread(record_placements);
+    } catch (const std::system_error&) {  // no thread to spare: recorded here
+      record_placements();
+    }
+  }
   const std::shared_ptr<CacheRecord>& made = result.files.front().cache_record;
   const std::optional<std::string> payload = save_import(result, true, made ? &made->part_keys : nullptr);
   if (recorder.joinable()) recorder.join();

@@ -406,12 +406,13 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     }
     if (text.size() < run.parallel_min_bytes) run.workers = 1;
     // The text's own checks (its unit contexts, its declared uncertainty) run on a thread of their
-    // own while the text is cut and parsed; it is done before this process forks any worker.
+    // own while the text is cut and parsed (here, when no thread can be started); it is done before
+    // this process forks any worker.
     struct TextChecks {
       std::vector<Diagnostic> units, uncertainty;
       double declared = 0.0;
     };
-    std::future<TextChecks> text_checks = std::async(std::launch::async, [&text, &path] {
+    std::future<TextChecks> text_checks = std::async(std::launch::async | std::launch::deferred, [&text, &path] {
       TextChecks c;
       c.units = unit_context_problems(text, path);
       c.declared = declared_length_uncertainty(text, path, c.uncertainty);

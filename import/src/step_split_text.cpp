@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cassert>
 #include <cctype>
+#include <exception>
 #include <numeric>
 #include <span>
 #include <string_view>
@@ -611,14 +612,28 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
     for (std::uint32_t w; (w = next.fetch_add(1)) < used;) write_piece(w, number);
   };
   std::optional<std::thread> helper;
+  std::exception_ptr failed;  // the helper's exception (bad_alloc), thrown here after the join
   if (used > 1 && text.size() >= (std::size_t{1} << 20)) {
     try {
-      helper.emplace(write_pieces);
+      helper.emplace([&] {
+        try {
+          write_pieces();
+        } catch (...) {
+          failed = std::current_exception();
+          next = static_cast<std::uint32_t>(used);  // this thread stops taking pieces too
+        }
+      });
     } catch (const std::system_error&) {  // no thread to spare: this one writes them all
     }
   }
-  write_pieces();
+  try {
+    write_pieces();
+  } catch (...) {
+    if (helper) helper->join();
+    throw;
+  }
   if (helper) helper->join();
+  if (failed) std::rethrow_exception(failed);
   return out;
 }
 
