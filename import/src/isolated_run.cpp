@@ -10,8 +10,6 @@
 #include <mutex>
 #include <shared_mutex>
 #include <sstream>
-#include <system_error>
-#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -76,23 +74,41 @@ bool whole(const std::string& bytes) {
   return bytes.size() - end - 9 >= size;
 }
 
-// A finished child is reaped by a thread of its own: its exit, after it gave back its memory, is
-// not waited for.
-void reap_later(pid_t pid) {
-  auto reap = [pid] {
+// Finished children not yet reaped: each is reaped when it has ended, at the latest when the next
+// child is started or finished (a zombie until then: no thread waits for it, so a caller that asked
+// for one thread keeps one).
+std::mutex& unreaped_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::vector<pid_t>& unreaped() {
+  static std::vector<pid_t> pids;
+  return pids;
+}
+void reap_ended() {
+  const std::lock_guard<std::mutex> lock(unreaped_mutex());
+  std::erase_if(unreaped(), [](pid_t pid) {
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    pid_t waited = -1;
+    while ((waited = waitpid(pid, &status, WNOHANG)) < 0 && errno == EINTR) {
     }
-  };
-  try {
-    std::thread(reap).detach();
-  } catch (const std::system_error&) {
-    reap();  // no thread to spare: wait here
-  }
+    return waited != 0;  // ended and reaped, or not ours any more
+  });
+}
+void reap_later(pid_t pid) {
+  // A host that ignores SIGCHLD has its children reaped by the system: its pid could come back as
+  // another of the host's children, which must not be reaped here.
+  struct sigaction current {};
+  if (sigaction(SIGCHLD, nullptr, &current) == 0 &&
+      (current.sa_handler == SIG_IGN || (current.sa_flags & SA_NOCLDWAIT) != 0))
+    return;
+  const std::lock_guard<std::mutex> lock(unreaped_mutex());
+  unreaped().push_back(pid);
 }
 
 // How a finished child's bytes and exit status read: the payload split off the marks, and what ended it.
 void finish_run(ChildRun& run, pid_t pid) {
+  reap_ended();
   const std::size_t end = run.marks.find(kFinished);
   const bool finished = !run.timed_out && whole(run.marks);
   if (end != std::string::npos) {
@@ -159,6 +175,7 @@ CadWork::~CadWork() {
 }
 
 ChildRun run_in_child(const std::function<std::string(const Mark& mark)>& work, double time_limit_seconds) {
+  reap_ended();
   const LetGo let_go;
   ChildRun run;
   // Held from the pipe to the parent's closing of its write end: a child forked by another thread
