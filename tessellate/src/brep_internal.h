@@ -84,11 +84,16 @@ struct MeshDeadline {
   std::string reason() const;  // "the tessellation time limit of 2 s ran out"
 };
 
+// How BRepMesh triangulates a face's parameter plane: planes by Delabella and the rest by Watson
+// (the default: Watson's cost grows with the square of a plane's holes), or all by Watson (a face
+// Delabella left without triangles is tried again so).
+enum class MeshAlgorithm { PlanesByDelabella, Watson };
+
 // Runs BRepMesh_IncrementalMesh on `shape` (a face or a compound of faces) with an absolute linear
 // deflection, asking it to stop at `deadline`. Returns false and fills `why` when OCCT throws or the
 // deadline stopped it (some faces may then have triangles).
 bool run_brepmesh(const TopoDS_Shape& shape, double deflection, double angular, bool parallel, std::string& why,
-                  const MeshDeadline& deadline = {});
+                  const MeshDeadline& deadline = {}, MeshAlgorithm algorithm = MeshAlgorithm::PlanesByDelabella);
 
 // Reads the face's triangulation into `out` (part-local, outward winding). When `measure` is set,
 // `achieved` is max(triangulation deflection, distance from each triangle centroid to the surface

@@ -3,7 +3,11 @@
 #include "built_parts.h"
 #include "cadclash/tessellate.h"
 
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepClass_FaceClassifier.hxx>
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepExtrema_ExtPF.hxx>
 #include <TopoDS_Vertex.hxx>
@@ -20,6 +24,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <optional>
+#include <string>
 #include <thread>
 
 namespace cadclash {
@@ -121,6 +128,74 @@ TEST(BrepTessellate, OneSurfacePerFaceInMapShapesOrder) {
   for (std::uint32_t i = 0; i < 6; ++i) all.extend(b.model.surfaces[i].aabb);
   EXPECT_NEAR(all.min().norm(), 0.0, 1e-6);
   EXPECT_NEAR((all.max() - Vec3(10, 20, 30)).norm(), 0.0, 1e-6);
+}
+
+// A board-like plate drilled with `side` x `side` holes of two radii (planar faces with many holes:
+// where BRepMesh's Watson triangulation is slow and planes are triangulated by Delabella).
+TopoDS_Shape drilled_plate(int side) {
+  TopTools_ListOfShape drills;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j)
+      drills.Append(BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2.0 + 4.0 * i, 2.0 + 4.0 * j, -3), gp_Dir(0, 0, 1)),
+                                             (i + j) % 2 ? 0.8 : 1.3, 5.0)
+                        .Shape());
+  TopTools_ListOfShape plate;
+  plate.Append(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, -1.6), gp_Pnt(4.0 * side, 4.0 * side, 0)).Shape());
+  BRepAlgoAPI_Cut cut;
+  cut.SetArguments(plate);
+  cut.SetTools(drills);
+  cut.Build();
+  EXPECT_TRUE(cut.IsDone());
+  return cut.Shape();
+}
+
+// The plate's faces are covered by their triangles and nothing else: every triangle lies inside its
+// face (none fills a hole) and the triangles' area is the face's less at most a chord's sagitta
+// along each boundary (the holes' outlines are polygons inscribed in their circles).
+TEST(BrepTessellate, DrilledPlatesFacesAreCoveredByTheirTriangles) {
+  const Built b = build({drilled_plate(8)}, {}, false);
+  ASSERT_TRUE(b.complete);
+  const auto* source = dynamic_cast<const BrepSource*>(b.model.parts[0].source.get());
+  ASSERT_NE(source, nullptr);
+  int drilled = 0;
+  for (std::uint32_t i = 0; i < b.model.parts[0].surface_count; ++i) {
+    const Surface& s = b.model.surfaces[i];
+    const TopoDS_Face& face = source->face(i);
+    GProp_GProps exact, boundary;
+    BRepGProp::SurfaceProperties(face, exact);
+    BRepGProp::LinearProperties(face, boundary);
+    double area = 0.0;
+    for (const auto& t : s.mesh.triangles) {
+      const Vec3 &p = s.mesh.vertices[t[0]], &q = s.mesh.vertices[t[1]], &r = s.mesh.vertices[t[2]];
+      area += 0.5 * (q - p).cross(r - p).norm();
+      const Vec3 c = (p + q + r) / 3.0;
+      BRepClass_FaceClassifier inside(face, gp_Pnt(c.x(), c.y(), c.z()), 1e-7);
+      ASSERT_EQ(inside.State(), TopAbs_IN) << "face " << i << " triangle centroid " << c.transpose();
+    }
+    // Between the exact face and its triangles: at most the deflection along the whole boundary.
+    EXPECT_NEAR(area, exact.Mass(), boundary.Mass() * TessellationOptions{}.linear_deflection) << "face " << i;
+    drilled += s.mesh.triangles.size() > 500;
+  }
+  EXPECT_EQ(drilled, 2);  // the top and the bottom
+}
+
+// OCCT picks its default triangulation from the CSF_MeshAlgo environment variable; cadclash names
+// its own, so the same file gives the same triangles (and reports) in any environment.
+TEST(BrepTessellate, MeshesDoNotDependOnOcctsMeshAlgorithmVariable) {
+  const char* before = std::getenv("CSF_MeshAlgo");
+  const std::optional<std::string> saved = before ? std::optional<std::string>(before) : std::nullopt;
+  std::vector<Model> models;
+  for (const char* algorithm : {"watson", "delabella"}) {
+    setenv("CSF_MeshAlgo", algorithm, 1);
+    models.push_back(build({drilled_plate(6)}, {}, false).model);  // a new shape: BRepMesh keeps its triangles
+  }
+  if (saved) setenv("CSF_MeshAlgo", saved->c_str(), 1);
+  else unsetenv("CSF_MeshAlgo");
+  ASSERT_EQ(models[0].surfaces.size(), models[1].surfaces.size());
+  for (std::size_t i = 0; i < models[0].surfaces.size(); ++i) {
+    EXPECT_EQ(models[0].surfaces[i].mesh.triangles, models[1].surfaces[i].mesh.triangles) << "face " << i;
+    EXPECT_EQ(models[0].surfaces[i].mesh.vertices, models[1].surfaces[i].mesh.vertices) << "face " << i;
+  }
 }
 
 TEST(BrepTessellate, WindingIsOutwardIncludingReversedFaces) {
