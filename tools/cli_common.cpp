@@ -35,6 +35,10 @@ void add_input_options(CLI::App& cmd, InputOptions& in) {
   cmd.add_flag("--lazy", in.lazy, "Tessellate B-rep faces only when a query needs them");
   cmd.add_flag("--no-isolation", in.no_isolation,
                "Read STEP/IGES/BREP in this process, not in a child (faster import; a file that crashes OCCT then ends the program)");
+  cmd.add_flag("--no-transfer-healing", in.no_transfer_healing,
+               "Skip OCCT's shape healing of every STEP/IGES shape at transfer (faster import, docs/import.md "
+               "\"Healing at transfer\"); faces BRepCheck finds invalid are still healed one by one, each named "
+               "in a warning");
   cmd.add_option("--import-time-limit", in.import_time_limit,
                  "Seconds the isolated reader of one STEP/IGES/BREP file may take, and again its tessellation; what is not done by then is reported as not read or not tessellated (0: no limit)")
       ->check(CLI::NonNegativeNumber);
@@ -119,6 +123,7 @@ ImportOptions import_options(const InputOptions& in) {
   options.tessellation = effective_tessellation(in);
   options.lazy = in.lazy;
   options.isolate_cad_readers = !in.no_isolation;
+  options.transfer_healing = !in.no_transfer_healing;
   options.reader_time_limit_seconds = in.import_time_limit;
   options.model_tolerance = in.model_tolerance;
   if (in.uncertainty == "occt") options.uncertainty = UncertaintyChoice::OcctTolerance;

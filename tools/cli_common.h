@@ -25,6 +25,7 @@ struct InputOptions {
   std::string preset;  // coarse | normal | fine | very-fine; overrides deflection/angular when set
   bool lazy = false;
   bool no_isolation = false;
+  bool no_transfer_healing = false;  // ImportOptions::transfer_healing = false
   double model_tolerance = 0.0;    // mm, meshes; 0 = derived from the coordinates
   std::string uncertainty = "auto";  // auto | occt | a value in mm (ImportOptions::uncertainty)
   double import_time_limit = 0.0;  // seconds per CAD file's isolated reader, and again for its tessellation; 0 = none

@@ -24,6 +24,8 @@
 #include <XCAFPrs.hxx>
 #include <XCAFPrs_IndexedDataMapOfShapeStyle.hxx>
 #include <XCAFPrs_Style.hxx>
+#include <XSAlgo.hxx>
+#include <XSAlgo_AlgoContainer.hxx>
 
 #include <algorithm>
 #include <cstdio>
@@ -364,12 +366,40 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
 
 std::string cad_file_stem(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
+namespace {
+
+thread_local bool t_transfer_healing = true;
+
+// OCCT's STEP and IGES actors heal each transferred shape through the global algorithm container's
+// ProcessShape; this one runs it only when the reading thread asks for it. A container, not a
+// resource file: Interface_Static's sequence names are global to the process, and the resource
+// manager ShapeProcess loads is a static shared by every thread.
+class SwitchedHealing final : public XSAlgo_AlgoContainer {
+ public:
+  TopoDS_Shape ProcessShape(const TopoDS_Shape& shape, const Standard_Real precision, const Standard_Real max_tolerance,
+                            const Standard_CString resource, const Standard_CString sequence,
+                            Handle(Standard_Transient)& info, const Message_ProgressRange& progress,
+                            const Standard_Boolean non_manifold) const override {
+    if (!t_transfer_healing) return shape;
+    return XSAlgo_AlgoContainer::ProcessShape(shape, precision, max_tolerance, resource, sequence, info, progress,
+                                              non_manifold);
+  }
+};
+
+}  // namespace
+
 void prepare_occt_exchange() {
   static std::once_flag once;
   std::call_once(once, [] {
     const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
     if (!messenger.IsNull()) messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+    XSAlgo::Init();
+    XSAlgo::SetAlgoContainer(new SwitchedHealing);
   });
 }
+
+TransferHealing::TransferHealing(bool on) : before_(t_transfer_healing) { t_transfer_healing = on; }
+TransferHealing::~TransferHealing() { t_transfer_healing = before_; }
+bool transfer_healing_on() { return t_transfer_healing; }
 
 }  // namespace cadclash::detail

@@ -79,7 +79,25 @@ Pose pose_of_transformation(const gp_Trsf& trsf);
 std::string cad_file_stem(const std::string& path);
 
 // Silences OCCT's default message printers: library code never prints, and every OCCT message that
-// matters reaches the caller through the check lists. Idempotent; call before reading.
+// matters reaches the caller through the check lists. Installs the shape processing that
+// TransferHealing switches. Idempotent; call before reading.
 void prepare_occt_exchange();
+
+// While one lives, STEP and IGES transfers on this thread (and in processes forked from it) run
+// OCCT's shape healing or not (ImportOptions::transfer_healing); the previous setting comes back
+// when it ends. Without one: healing, as OCCT does.
+class TransferHealing {
+ public:
+  explicit TransferHealing(bool on);
+  ~TransferHealing();
+  TransferHealing(const TransferHealing&) = delete;
+  TransferHealing& operator=(const TransferHealing&) = delete;
+
+ private:
+  bool before_;
+};
+
+// This thread's setting (TransferHealing).
+bool transfer_healing_on();
 
 }  // namespace cadclash::detail

@@ -118,7 +118,7 @@ std::string options_key(const std::string& path, const ImportOptions& o) {
     << o.tessellation.relative << " angular " << o.tessellation.angular_deflection << " verify "
     << o.tessellation.verify_deflection << " time limit " << o.tessellation.time_limit_seconds << "\nlazy " << o.lazy
     << " isolated " << o.isolate_cad_readers << " reader time limit " << o.reader_time_limit_seconds
-    << " model tolerance " << o.model_tolerance << " uncertainty " << static_cast<int>(o.uncertainty) << " "
+    << " transfer healing " << o.transfer_healing << " model tolerance " << o.model_tolerance << " uncertainty " << static_cast<int>(o.uncertainty) << " "
     << o.uncertainty_value << '\n';
   return k.str();
 }

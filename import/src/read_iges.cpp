@@ -118,6 +118,7 @@ Transfer read_iges_transfer(const std::string& path, bool one_by_one, const std:
 // child process, which sends the document back.
 ImportResult read_iges(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
+  const TransferHealing healing(options.transfer_healing);
   std::vector<Diagnostic> notes;
   std::set<std::int64_t> skip;  // root entities a child crashed on
   constexpr std::size_t kMaxSkips = 20;

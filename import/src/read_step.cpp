@@ -24,6 +24,7 @@ namespace cadclash::detail {
 // and this process never runs OCCT's STEP code on the file.
 ImportResult read_step(const std::string& path, const ImportOptions& options) {
   prepare_occt_exchange();
+  const TransferHealing healing(options.transfer_healing);
   std::vector<Diagnostic> notes;  // how the attempts went, first in the result
   std::optional<Transfer> faceless;  // the first attempt that finished without a face
   double read_seconds = 0.0;         // parsing, over every attempt that finished

@@ -2,6 +2,7 @@
 // keyed by the SHA-256 of a piece's canonical text; ids stored canonical, mapped to each file's.
 #include "step_piece_cache.h"
 
+#include "cad_xcaf.h"
 #include "import_cache.h"
 #include "step_parallel_transfer.h"
 
@@ -11,7 +12,9 @@ namespace cadclash::detail {
 namespace {
 
 std::string piece_key(const StepPiece& piece) {
-  return cache_versions() + "step piece sha256 " + sha256_hex(piece.canonical) + '\n';
+  // The piece's shapes are transferred with this thread's healing setting (cad_xcaf.h).
+  return cache_versions() + "step piece sha256 " + sha256_hex(piece.canonical) +
+         (transfer_healing_on() ? "\n" : "\nno transfer healing\n");
 }
 
 Diagnostic note(const std::string& path, std::string message) {

@@ -246,7 +246,7 @@ def _path_under(path: str, prefix: str) -> bool:
 def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1, angular: float = 0.5,
          relative: bool = False, preset: Optional[str] = None, lazy: bool = False, repair: bool = False,
          fill_holes: bool = False, segment: bool = False, sharp_angle: float = 60.0, planar: bool = False,
-         isolate: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
+         isolate: bool = True, transfer_healing: bool = True, time_limit: float = 0.0, model_tolerance: float = 0.0,
          uncertainty: Union[str, float] = "auto", cache: Optional[PathLike] = None, threads: int = 0, strict: bool = False) -> Model:
     """Reads one or more files (STEP, IGES, BREP, OBJ, OFF, STL, PLY, glTF) into one ``Model``.
 
@@ -256,7 +256,10 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     when a query or an array access needs them), ``repair`` / ``fill_holes`` and ``segment`` /
     ``sharp_angle`` / ``planar`` for mesh parts. ``isolate`` reads STEP/IGES/BREP in a forked child
     process, so a file that crashes OCCT gives an error diagnostic (and the faces that could still be
-    read) instead of ending Python; ``isolate=False`` is the CLI's ``--no-isolation``. ``time_limit``
+    read) instead of ending Python; ``isolate=False`` is the CLI's ``--no-isolation``.
+    ``transfer_healing=False`` (the CLI's ``--no-transfer-healing``) skips OCCT's shape healing of
+    every STEP/IGES shape at transfer: a faster import, faces BRepCheck rejects healed one by one
+    (docs/import.md, "Healing at transfer"). ``time_limit``
     (seconds, 0 = none; the CLI's ``--import-time-limit``) stops an isolated reader that takes longer
     on one file, and then the file's tessellation, with error diagnostics naming what was not done.
     ``model_tolerance`` (mm; the CLI's ``--model-tolerance``) is the uncertainty of mesh coordinates
@@ -284,7 +287,8 @@ def load(paths: Union[PathLike, Sequence[PathLike]], *, deflection: float = 0.1,
     model = Model()
     raw, complete = model._load(files, float(deflection), bool(relative), float(angular), preset or "",
                                 bool(lazy), bool(repair), bool(fill_holes), bool(segment), float(sharp_angle),
-                                bool(planar), bool(isolate), float(time_limit), float(model_tolerance),
+                                bool(planar), bool(isolate), bool(transfer_healing), float(time_limit),
+                                float(model_tolerance),
                                 uncertainty if isinstance(uncertainty, str) else "value",
                                 0.0 if isinstance(uncertainty, str) else float(uncertainty),
                                 os.fspath(cache) if cache is not None else "", int(threads))

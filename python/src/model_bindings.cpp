@@ -60,6 +60,7 @@ struct LoadArgs {
   double sharp_angle = 60.0;
   bool planar = false;
   bool isolate = true;
+  bool transfer_healing = true;
   double time_limit = 0.0;
   double model_tolerance = 0.0;
   std::string uncertainty = "auto";  // auto | occt | value (then uncertainty_value)
@@ -85,6 +86,7 @@ pyb::tuple load(ModelCore& core, const LoadArgs& a) {
   }
   options.lazy = a.lazy;
   options.isolate_cad_readers = a.isolate;
+  options.transfer_healing = a.transfer_healing;
   if (!(a.time_limit >= 0.0)) throw pyb::value_error("time_limit must be >= 0 seconds (0: no limit)");
   options.reader_time_limit_seconds = a.time_limit;
   options.tessellation.time_limit_seconds = a.time_limit;
@@ -193,15 +195,16 @@ void bind_model(pyb::module_& m) {
           "_load",
           [](ModelCore& core, std::vector<std::string> paths, double deflection, bool relative, double angular,
              std::string preset, bool lazy, bool repair, bool fill_holes, bool segment, double sharp_angle,
-             bool planar, bool isolate, double time_limit, double model_tolerance, std::string uncertainty,
-             double uncertainty_value, std::string cache, int threads) {
+             bool planar, bool isolate, bool transfer_healing, double time_limit, double model_tolerance,
+             std::string uncertainty, double uncertainty_value, std::string cache, int threads) {
             return load(core, {std::move(paths), deflection, relative, angular, std::move(preset), lazy, repair,
-                               fill_holes, segment, sharp_angle, planar, isolate, time_limit, model_tolerance,
+                               fill_holes, segment, sharp_angle, planar, isolate, transfer_healing, time_limit,
+                               model_tolerance,
                                std::move(uncertainty), uncertainty_value, std::move(cache), threads});
           },
           pyb::arg("paths"), pyb::arg("deflection"), pyb::arg("relative"), pyb::arg("angular"), pyb::arg("preset"),
           pyb::arg("lazy"), pyb::arg("repair"), pyb::arg("fill_holes"), pyb::arg("segment"), pyb::arg("sharp_angle"),
-          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("time_limit"), pyb::arg("model_tolerance"),
+          pyb::arg("planar"), pyb::arg("isolate"), pyb::arg("transfer_healing"), pyb::arg("time_limit"), pyb::arg("model_tolerance"),
           pyb::arg("uncertainty"), pyb::arg("uncertainty_value"), pyb::arg("cache"), pyb::arg("threads"))
       .def("_counts",
            [](const ModelCore& c) {

@@ -2,6 +2,7 @@
 // kept and reported, and STEP face colours match the COLOUR_RGB values written in the file.
 // data/cad/heal_unshared_vertices.brep, mesh_fail_bowtie.brep and mesh_fail_degenerate.step were
 // written with OCCT 7.6 (BRepTools::Write, STEPControl_Writer) from the shapes the comments below describe.
+#include "cadclash/collide.h"
 #include "cadclash/import.h"
 
 #include <BRepCheck_Analyzer.hxx>
@@ -14,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -58,6 +60,49 @@ std::string describe(const std::vector<Diagnostic>& ds) {
   std::string s;
   for (const Diagnostic& d : ds) s += format_diagnostic(d) + "\n";
   return s;
+}
+
+// The clashes of an assembly's faces as translated without OCCT's healing at transfer
+// (ImportOptions::transfer_healing = false) are those of the healed ones: on as1 the faces BRepCheck
+// then rejects are healed one by one, each named by its STEP #id in a warning; with healing none is.
+TEST(CadHeal, WithoutHealingAtTransferAs1sClashesStayAndHealedFacesAreNamed) {
+  const std::string path = kExternal + "as1-tu-203.stp";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "run scripts/setup.sh";
+  std::vector<std::vector<std::string>> pairs;
+  std::vector<std::size_t> healed_faces;
+  for (const bool healing : {true, false}) {
+    SCOPED_TRACE(healing ? "healing at transfer" : "no healing at transfer");
+    ImportOptions options;
+    options.transfer_healing = healing;
+    ImportResult r = import_file(path, options);
+    EXPECT_TRUE(r.complete) << describe(r.diagnostics);
+    std::size_t healed = 0;
+    for (const Diagnostic& d : r.diagnostics) {
+      EXPECT_NE(d.severity, Severity::Error) << format_diagnostic(d);
+      if (d.message.find("failed BRepCheck; healed with ShapeFix_Face") == std::string::npos) continue;
+      EXPECT_GT(d.step_id, 0) << format_diagnostic(d);
+      ++healed;
+    }
+    std::size_t flagged = 0;
+    for (const Surface& s : r.model.surfaces) flagged += s.provenance.healed;
+    EXPECT_EQ(flagged, healed);
+    healed_faces.push_back(healed);
+    Scene scene(r.model, SceneSelection{});
+    CollideOptions o;
+    o.tolerance = 0.01;
+    const auto result = scene.check(o);
+    EXPECT_TRUE(result.complete);
+    std::vector<std::string> names;
+    for (const SurfacePairResult& p : result.pairs)
+      names.push_back(std::to_string(p.instance_a) + "/" + std::to_string(p.surface_a) + " " +
+                      std::to_string(p.instance_b) + "/" + std::to_string(p.surface_b) + " " + std::to_string(static_cast<int>(p.contact)));
+    std::sort(names.begin(), names.end());
+    pairs.push_back(std::move(names));
+  }
+  EXPECT_EQ(healed_faces[0], 0u);
+  EXPECT_GT(healed_faces[1], 0u);
+  EXPECT_FALSE(pairs[0].empty());
+  EXPECT_EQ(pairs[0], pairs[1]);
 }
 
 // Face 0: a valid 10 x 10 square at x in [20, 30]. Face 1: a 10 x 10 square at the origin whose four

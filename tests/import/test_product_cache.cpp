@@ -194,6 +194,35 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
   }
 }
 
+// ImportOptions::transfer_healing changes the shapes: the file's entry and every product's are kept
+// apart per setting, and each read is what reading the file afresh with its setting gives.
+TEST(ProductCache, TransferHealingIsPartOfTheFilesAndTheProductsKeys) {
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  auto [path, original, options] = cached_board("transfer_healing", false);
+  const ImportResult healed = import_file(path, options);
+  ASSERT_EQ(healed.files.size(), 1u);
+  const std::size_t pieces = healed.files[0].pieces;
+  ASSERT_GT(pieces, 10u);
+
+  options.transfer_healing = false;
+  const ImportResult as_translated = import_file(path, options);
+  ASSERT_EQ(as_translated.files.size(), 1u);
+  EXPECT_EQ(as_translated.files[0].cache, CacheUse::Miss);
+  EXPECT_EQ(as_translated.files[0].pieces, pieces);
+  EXPECT_EQ(as_translated.files[0].pieces_cached, 0u);
+  EXPECT_NE(messages(as_translated), messages(healed));  // faces BRepCheck rejects, healed one by one
+  expect_as_read_afresh(path, as_translated, &options);
+
+  for (const bool healing : {false, true}) {
+    SCOPED_TRACE(healing ? "healing again" : "no healing again");
+    options.transfer_healing = healing;
+    const ImportResult again = import_file(path, options);
+    ASSERT_EQ(again.files.size(), 1u);
+    EXPECT_EQ(again.files[0].cache, CacheUse::Hit);
+    EXPECT_EQ(messages(again), messages(healing ? healed : as_translated));
+  }
+}
+
 // Every product entry damaged (a byte flipped, cut short, emptied): each is found before it is
 // used, named in a warning, made again from the file and rewritten; the next read trusts them again.
 TEST(ProductCache, DamagedProductEntriesAreRebuilt) {

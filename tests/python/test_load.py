@@ -133,6 +133,17 @@ def test_cache_gives_back_the_same_model(data_dir, tmp_path):
     assert len(again.surfaces) == len(cold.surfaces)
 
 
+def test_without_healing_at_transfer_healed_faces_are_named(as1_path):
+    # OCCT's healing at transfer skipped (the CLI's --no-transfer-healing): the faces BRepCheck then
+    # rejects are healed one by one, each named with its STEP #id; the same faces as with it.
+    healed = cadclash.load(as1_path, lazy=True)
+    as_translated = cadclash.load(as1_path, lazy=True, transfer_healing=False)
+    named = [d for d in as_translated.diagnostics if "failed BRepCheck; healed with ShapeFix_Face" in d.message]
+    assert named and all(d.step_id > 0 for d in named)
+    assert not any("failed BRepCheck" in d.message for d in healed.diagnostics)
+    assert [s.step_id for s in as_translated.surfaces] == [s.step_id for s in healed.surfaces]
+
+
 def test_bad_arguments(boxes):
     with pytest.raises(ValueError, match="preset"):
         cadclash.load(boxes, preset="ultra")

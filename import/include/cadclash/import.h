@@ -82,6 +82,13 @@ struct ImportOptions {
   // Turn it off only for trusted files, or in a host that must not fork (fork copies only the
   // calling thread; a thread of the host holding a lock OCCT needs would hang the child).
   bool isolate_cad_readers = true;
+  // STEP/IGES: OCCT's shape healing of every transferred shape (ShapeFix_Shape, what STEPControl_Reader
+  // and IGESControl_Reader run after translating: wires, edges' pcurves and tolerances, shells'
+  // orientation). false skips it: the faces are the file's as translated, and the per-part check
+  // (BRepCheck, ShapeFix_Face on each invalid face, a warning per face) still runs. A speed knob,
+  // measured in docs/import.md ("Healing at transfer"): on the 40 MB KiCad board 19 % less time, 445
+  // faces then healed one by one, the same clashes; on as1-tu-203.stp the same pairs.
+  bool transfer_healing = true;
   // STEP with isolate_cad_readers: processes that transfer one file's shapes into B-rep at once, forked
   // from its isolated reader after parsing (they share the parsed file; shapes whose topology meets
   // go to one process). 0 = one per OpenMP thread (omp_get_max_threads) for files of 20,000 entities
