@@ -144,7 +144,7 @@ with open(os.path.join(out, "results.md"), "w") as md:
     md.write(f"cadclash at {commit}; {cores} cores (load average before the runs: {load}), median of {repeats} run(s) per tool, alternating. "
              "cadclash: `cadclash check FILE` (import, healing, tessellation at 0.1 mm, certified collision query); "
              "peer: `occt_pipeline_peer FILE` (STEPCAFControl_Reader ReadFile and Transfer, BRepMesh_IncrementalMesh "
-             "0.1 mm / 0.5 rad in parallel on each distinct leaf shape; no healing, no query). Wall time of the whole "
+             "0.1 mm / 0.5 rad in parallel on each distinct leaf shape; OCCT's own healing at transfer but no BRepCheck pass, no query). Wall time of the whole "
              "process; stages of the median run in ms (a build that tessellates lazily meshes inside query, "
              "`timings.tessellation` in results.json, and shows tessellate 0); MB/s is file size over wall time; peer/cadclash > 1: cadclash "
              "is faster (wall: whole runs; import: the peer's total against cadclash's import, query left out); "
