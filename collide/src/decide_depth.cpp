@@ -120,23 +120,37 @@ std::optional<double> witness(const Side& own, const Side& other, const Vec3& x,
 }
 
 // A general face: its vertices farthest on that side of `other` (by their heights), moved onto the
-// exact surface (their foot points), tried until one witnesses.
+// exact surface (their foot points), tried until one witnesses. A foot not high enough (the chords
+// of the face's triangles cut below a bulge of it, and no vertex lies at its top) climbs along the
+// face a few times: a step along its tangent plane toward the height, moved onto the surface again.
+// Only witness() proves anything: how the candidates are found cannot make an answer wrong.
 std::optional<double> vertex_witness(const Side& own, const Side& other, double sign, double h, const Vec3& up,
                                      const Tolerances& tol, Asked& asked) {
   const TriangleMesh& mesh = own.f.surface.mesh;
+  auto over = [&](const Vec3& x) { return sign * other.n.dot(x - other.o); };  // other is a plane here
   std::vector<std::pair<double, std::uint32_t>> far;
   for (std::uint32_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec3 v = *own.to_a * mesh.vertices[i];
-    const Foot f{v - other.n.dot(v - other.o) * other.n, other.n, 0.0};  // other is a plane here
-    const double hv = sign * height(other, v, f, up);
-    if (hv >= h) far.emplace_back(-hv, i);
+    const double hv = over(*own.to_a * mesh.vertices[i]);
+    if (hv > 0.0) far.emplace_back(-hv, i);
   }
   const std::size_t keep = std::min(far.size(), kVertexTrials);
   std::partial_sort(far.begin(), far.begin() + static_cast<std::ptrdiff_t>(keep), far.end());
   for (std::size_t k = 0; k < keep; ++k) {
-    const std::optional<Foot> on_own = foot(own, *own.to_a * mesh.vertices[far[k].second], asked);
-    if (!on_own) continue;
-    if (auto d = witness(own, other, on_own->point, on_own->rounding, sign, h, up, tol, asked)) return d;
+    std::optional<Foot> on_own = foot(own, *own.to_a * mesh.vertices[far[k].second], asked);
+    for (int step = 0; on_own && step <= kStepTrials; ++step) {
+      const double hx = over(on_own->point);
+      if (hx - on_own->rounding >= h) {
+        if (auto d = witness(own, other, on_own->point, on_own->rounding, sign, h, up, tol, asked)) return d;
+        break;  // high enough, but not inside the faces
+      }
+      if (!(hx > 0.0) || step == kStepTrials) break;
+      // Along the face toward the bulge's top: the rise per unit length there is the tangent part
+      // of the plane's normal; a step that would rise to twice h if the face were flat.
+      const Vec3 rise = sign * other.n - (sign * other.n).dot(on_own->normal) * on_own->normal;
+      const double slope = rise.norm();
+      if (!(slope > kMinSine)) break;
+      on_own = foot(own, on_own->point + ((2.0 * h - hx) / (slope * slope)) * rise, asked);
+    }
   }
   return std::nullopt;
 }
@@ -235,6 +249,29 @@ std::vector<Vec3> crossings(const Side& q, const Side& p, const Aabb& region) {
   return out;
 }
 
+// Whether face q can reach above +threshold and below -threshold over plane p anywhere a proof
+// could look: the exact face lies within its deflection of its triangles (a plane: see below), whose
+// heights over p are at most their vertices', and a point the proof uses (its height at most
+// `reach` less q's deflection, its foot inside p's face) lies within `reach` of `region`. False: no
+// crossing deeper than the threshold can be proved, and no exact query is made.
+bool may_cross_deeper(const Side& q, const Side& p, const Aabb& region, double reach, double threshold, double r) {
+  const TriangleMesh& mesh = q.f.surface.mesh;
+  std::vector<std::uint32_t> near;
+  std::uint64_t tests = 0;
+  query_surface_bvh(q.f.bvh, mesh, transform_box(pad_box(region, reach), *q.to_own), near, tests);
+  double up = 0.0, down = 0.0;
+  for (const std::uint32_t k : near)
+    for (const std::uint32_t v : mesh.triangles[k]) {
+      const double h = p.n.dot(*q.to_a * mesh.vertices[v] - p.o);
+      up = std::max(up, h);
+      down = std::max(down, -h);
+    }
+  // A plane's interior is exact (its triangles lie on it); its deflection is its outline's, which
+  // reaches past the triangles within the plane, rising over p by at most the planes' sine.
+  const double off = q.kind == Kind::Plane ? q.n.cross(p.n).norm() * q.f.surface.deflection : q.f.surface.deflection;
+  return std::min(up, down) + off + 4.0 * r > threshold;
+}
+
 // A crossing point x of q's triangles with plane p moved onto both exact surfaces: a plane's point
 // is on it already; a cylinder's goes to the cylinder and back onto p along its generator; another
 // surface's by Newton on the curve where it meets p. Returns the point and what it may be off q
@@ -283,7 +320,7 @@ Side side_of(const Model& m, FaceView f, SurfaceId s, const Pose& to_a, const Po
 
 bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p) {
   if (!p.settled || p.cut || p.cls != ContactClass::Touching || t.outcome == nullptr) return false;
-  if (!t.outcome->intersecting || !t.outcome->crosses_threshold) return false;
+  if (!t.outcome->intersecting || !t.outcome->may_cross_threshold) return false;
   const Surface& a = m.surfaces[t.sa];
   const Surface& b = m.surfaces[t.sb];
   if (!a.has_triangles || !b.has_triangles) return false;
@@ -317,9 +354,10 @@ bool depth_step(const Model& m, const DecideTask& t, FaceView fa, FaceView fb, P
     Vec3 x;
   };
   std::vector<Start> starts;
-  if (a.kind == Kind::Plane)
+  const double reach = high + std::max(a.f.surface.deflection, b.f.surface.deflection);
+  if (a.kind == Kind::Plane && may_cross_deeper(b, a, region, reach, p.threshold, r))
     for (const Vec3& x : crossings(b, a, region)) starts.push_back({&b, &a, x});
-  if (b.kind == Kind::Plane)
+  if (b.kind == Kind::Plane && may_cross_deeper(a, b, region, reach, p.threshold, r))
     for (const Vec3& x : crossings(a, b, region)) starts.push_back({&a, &b, x});
   if (starts.empty()) return false;
   const std::size_t stride = (starts.size() + kMaxCrossingTrials - 1) / kMaxCrossingTrials;

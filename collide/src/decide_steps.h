@@ -92,7 +92,8 @@ inline std::optional<std::array<Vec3, 2>> plane_cut(const Vec3* const (&v)[3], c
 }
 
 // After a contact is proved: a planar face and a planar, cylindrical or other exact face whose
-// triangles cross deeper than T (the band hides whether the faces do) are proved penetrating on
+// triangles cross deeper than T less their band and than the rounding (PairOutcome::
+// may_cross_threshold: the band hides whether the faces cross deeper than T) are proved penetrating on
 // their exact surfaces (decide_depth.cpp): a point c of both surfaces where the triangles cross,
 // inside both faces, and points of each face at height above +H and below -H over the other's
 // exact surface (H > T; along a plane or a cylinder's generator from c, or a general face's
@@ -102,7 +103,7 @@ inline std::optional<std::array<Vec3, 2>> plane_cut(const Vec3* const (&v)[3], c
 // leaves p as it was. Precondition: p settled in contact.
 bool depth_step(const Model& m, const DecideTask& t, FaceView a, FaceView b, Pending& p, CollideCounters& c);
 // Whether depth_step can apply to task t (a plane against a plane, a cylinder or a face with exact
-// geometry, triangles crossing deeper than T, the pair settled touching): the outlines are then needed.
+// geometry, triangles that may cross deeper than T, the pair settled touching): the outlines are then needed.
 bool depth_step_applies(const Model& m, const DecideTask& t, const Pending& p);
 
 // Step 2d: a cylinder, cone or sphere tangent to the other face's plane: the point of its surface

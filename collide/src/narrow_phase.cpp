@@ -161,6 +161,7 @@ void prepare_pair_reach(const Surface& sa, const SurfaceBvh& bvh_a, const Surfac
   out.margin = out.slack = 0.0;
   out.tau = tau;
   out.threshold = tau;
+  out.low = tau;
   const double search = std::max(out.tau, options.clearance);
   if (options.use_oaabb) {
     // Surface-pair OAABB in A's frame: where a triangle of one side can come within `search` of the
@@ -282,7 +283,11 @@ struct TriangleRun {
   CrossingBound bound;
 
   bool penetration_only() const { return out.intersecting && !all; }
-  double level() const { return out.crosses_threshold ? p.tau : p.threshold; }
+  // The next depth a crossing must pass to change the outcome: low, then threshold, then tau.
+  double level() const {
+    if (out.crosses_threshold) return p.tau;
+    return out.may_cross_threshold ? p.threshold : std::min(p.low, p.threshold);
+  }
 
   // Brings the bound to the current level; when no candidate left can cross deeper than it, the
   // outcome is settled and the run ends.
@@ -313,6 +318,7 @@ struct TriangleRun {
 
   // An intersecting pair's crossing depth: what the flag and the penetration keep of it.
   void note_crossing(double depth) {
+    if (depth > std::min(p.low, p.threshold)) out.may_cross_threshold = true;
     if (depth > p.threshold) out.crosses_threshold = true;
     if (depth > p.tau) {
       out.penetration = std::max(out.penetration, depth);
@@ -476,6 +482,7 @@ void merge_outcome(PairOutcome& into, PairOutcome&& later) {
   into.intersecting = into.intersecting || later.intersecting;
   into.cut = into.cut || later.cut;
   into.crosses_threshold = into.crosses_threshold || later.crosses_threshold;
+  into.may_cross_threshold = into.may_cross_threshold || later.may_cross_threshold;
   into.penetration = std::max(into.penetration, later.penetration);
   into.distance = std::min(into.distance, later.distance);
   into.triangle_pairs.insert(into.triangle_pairs.end(), later.triangle_pairs.begin(), later.triangle_pairs.end());

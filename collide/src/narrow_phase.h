@@ -21,6 +21,9 @@ struct PreparedPair {
   // Crossings deeper than this set PairOutcome::crosses_threshold (<= tau; certified, where one face
   // is a plane: T, where the decision's crossing step begins; else tau).
   double threshold = 0.0;
+  // Crossings deeper than min(low, threshold) set PairOutcome::may_cross_threshold (certified, where
+  // one face is a plane: where the exact faces may cross deeper than T; else tau, as threshold).
+  double low = 0.0;
   double margin = 0.0;  // search margin: max(tau, clearance) plus the rounding slack
   double slack = 0.0;   // that rounding slack: bounds any rounding of a height or box coordinate here
   std::vector<std::uint32_t> la, lb;           // surviving triangle indices of Sk and Sl, ascending
@@ -52,6 +55,7 @@ struct PairOutcome {
   // exact faces: they are not measured beyond what the two flags need.
   double penetration = 0.0;
   bool crosses_threshold = false;  // some intersecting pair crosses deeper than PreparedPair::threshold
+  bool may_cross_threshold = false;  // some intersecting pair crosses deeper than PreparedPair::low
   // The smallest triangle distance when no pair intersects (+inf when no candidate came within the
   // margin). When one does, pairs met before it are not all measured: the value means nothing then.
   double distance = std::numeric_limits<double>::infinity();

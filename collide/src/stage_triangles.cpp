@@ -77,9 +77,14 @@ bool prepare(const SceneData& s, QueryState& q, std::size_t k, std::uint64_t& by
   // only where one face is a plane (decide_crossing.cpp); elsewhere the run need not find out.
   const Surface& a = s.model.surfaces[t.sa];
   const Surface& b = s.model.surfaces[t.sb];
+  // The depth step asks whether the exact faces may cross deeper than T: triangles crossing deeper
+  // than T less their band (tau - T), and deeper than the rounding (faces lying on each other or
+  // meeting at an edge cross by round-off only).
   if (q.o.decision != DecisionMode::Fast &&
-      (a.analytic.shape == SurfaceShape::Plane || b.analytic.shape == SurfaceShape::Plane))
+      (a.analytic.shape == SurfaceShape::Plane || b.analytic.shape == SurfaceShape::Plane)) {
     out.threshold = touch_threshold(s.eps[t.sa], s.eps[t.sb], q.o.tolerance);
+    out.low = std::min(out.threshold, std::max(out.threshold - (out.tau - out.threshold), out.slack));
+  }
   bytes = prepared_bytes(out);
   return true;
 }

@@ -286,6 +286,50 @@ TEST(DepthWitness, FacesCrossingDeeperThanTheUncertaintyArePenetrating) {
     }
 }
 
+// A sphere sunk 0.03 mm into a disk's flat top (T = 0.02: ε 0.01 mm on every face) whose triangles
+// cross the top less deep than T: its nodes miss its lowest point, so the chord triangles there lie
+// up to their sagitta above the sphere. The exact surfaces cross deeper than T, and wherever the
+// triangles cross the top at all (deeper than the rounding), the pair is proved penetrating on them.
+// Turned about a horizontal axis through its centre by angles that move its nodes about; some
+// angles must leave its lowest node less than T below the top (else the test proves nothing new).
+// The same wherever the pair is placed.
+TEST(DepthWitness, CurvedFacesWhoseTrianglesCrossShallowerThanTArePenetrating) {
+  constexpr double kSunk = 0.03, kT = 0.02;
+  int shallow = 0;
+  for (const Pose& where : {Pose::Identity(), moved(Vec3(1e6, -3e5, 2e4), 0.7)})
+  for (int k = 0; k < 24; ++k) {
+    const double tilt = 0.011 + 0.0237 * k;
+    Model m = build({BRepPrimAPI_MakeCylinder(20, 2).Shape(), BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 3), 3).Shape()}, 0.1);
+    for (Surface& s : m.surfaces) s.uncertainty = 0.01;
+    // About the sphere's centre (0, 0, 3): its lowest point stays 0.03 below the disk's top (z = 2).
+    Pose pose = Pose::Identity();
+    pose.translate(Vec3(1, -2, 5 - kSunk));
+    pose.rotate(Eigen::AngleAxisd(tilt, Vec3(1, 2, 0).normalized()));
+    pose.translate(Vec3(0, 0, -3));
+    place(m, 0, "/disk", where);
+    place(m, 1, "/sphere", where * pose);
+    const Surface& sphere = m.surfaces[m.parts[1].first_surface];
+    double lowest = 1e300;
+    for (const Vec3& v : sphere.mesh.vertices) lowest = std::min(lowest, (pose * v).z());
+    const double below = 2.0 - lowest;  // how far its lowest node lies below the top
+    const Outcome r = check_pair(m, 0.0);
+    const std::string what = "tilt " + std::to_string(tilt) + ", lowest node " + std::to_string(below) + " below, at " +
+                             std::to_string(where.translation().x());
+    EXPECT_EQ(r.report.counters.undecided, 0u) << what;
+    ASSERT_EQ(r.report.pairs.size(), 1u) << what;
+    const SurfacePairResult& p = r.report.pairs[0];
+    if (below > 1e-6) {
+      EXPECT_EQ(p.contact, ContactClass::Penetrating) << what;
+      EXPECT_GT(p.penetration, kT) << what;
+      EXPECT_LE(p.penetration, kSunk + 1e-9) << what;
+      shallow += below < kT;
+    } else {
+      EXPECT_NE(p.contact, ContactClass::Clearance) << what;
+    }
+  }
+  EXPECT_GT(shallow, 0);
+}
+
 // The contact band's ε and how far a face's own points may lie off it are two things: a KiCad file
 // declares 0.01 mm (ε, so T = 0.02 at tolerance 0) while its faces' OCCT tolerances are 1e-7. A box
 // sunk 0.025 mm into a disk: its bottom lies 0.025 below the disk's top, parallel, farther than T,
