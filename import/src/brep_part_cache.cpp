@@ -17,7 +17,8 @@ namespace cadclash::detail {
 namespace {
 
 // Everything add_brep_parts' result for one part depends on, as text (doubles in hexadecimal);
-// nullopt when OCCT cannot write the shape.
+// nullopt when OCCT cannot write the shape. Not the file it came from, which only names it
+// (load_part names the file reading it): a product in several files, or a file renamed, is one entry.
 std::optional<std::string> part_key(const BrepPartInput& in, const ImportOptions& options) {
   std::ostringstream shape;
   try {
@@ -29,8 +30,7 @@ std::optional<std::string> part_key(const BrepPartInput& in, const ImportOptions
   std::ostringstream k;
   k << std::hexfloat;
   k << cache_versions() << "brep part\nshape sha256 " << sha256_hex(shape.str()) << "\nkind "
-    << static_cast<int>(in.kind) << "\nname " << in.name.size() << ' ' << in.name << "\nfile " << in.source_file.size()
-    << ' ' << in.source_file << "\ndeflection " << t.linear_deflection << " relative " << t.relative << " angular "
+    << static_cast<int>(in.kind) << "\nname " << in.name.size() << ' ' << in.name << "\ndeflection " << t.linear_deflection << " relative " << t.relative << " angular "
     << t.angular_deflection << " verify " << t.verify_deflection << "\nlazy " << options.lazy << "\ntags "
     << in.tags.size() << '\n';
   // Entity ids by their pattern (canonical: 1, 2, ... in order of first use), so another export
@@ -87,8 +87,14 @@ bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, st
     }
     p.step_id = ids[f] = now;
   }
-  relabel_brep_faces(*source, ids);
-  for (Diagnostic& d : r.diagnostics)
+  // Stored under the file that made it (the same product in another file, or this file renamed, finds
+  // it): named after this one.
+  relabel_brep_faces(*source, ids, in.source_file);
+  const std::string stored_file = r.model.parts[0].source_file;
+  r.model.parts[0].source_file = in.source_file;
+  for (Surface& s : r.model.surfaces) s.provenance.source_file = in.source_file;
+  for (Diagnostic& d : r.diagnostics) {
+    if (d.file == stored_file) d.file = in.source_file;
     if (d.step_id >= 0) {
       const auto it = id_of.find(d.step_id);
       if (it == id_of.end()) {
@@ -97,6 +103,7 @@ bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, st
       }
       d.step_id = it->second;
     }
+  }
   out.part = std::move(r.model.parts[0]);
   out.surfaces = std::move(r.model.surfaces);
   out.diagnostics = std::move(r.diagnostics);

@@ -395,7 +395,7 @@ bool load_file_entry(std::string_view payload, const ImportOptions& options, Imp
     }
     std::vector<std::int64_t> ids(part.surface_count);
     for (std::uint32_t f = 0; f < part.surface_count; ++f) ids[f] = out.model.surfaces[part.first_surface + f].provenance.step_id;
-    relabel_brep_faces(*source, ids);
+    relabel_brep_faces(*source, ids, part.source_file);
     loaded[k] = std::move(one);
   }
   for (std::size_t k = 0; k < n; ++k)

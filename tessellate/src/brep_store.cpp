@@ -108,11 +108,12 @@ std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string
   return std::make_shared<BrepSource>(std::move(impl));
 }
 
-void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids) {
+void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids, const std::string& source_file) {
   BrepSource::Impl& impl = *source.impl_;
   assert(entity_ids.size() == impl.faces.size());
   const std::lock_guard<std::shared_mutex> lock(impl.mutex);
   impl.entity_ids.assign(entity_ids.begin(), entity_ids.end());
+  impl.source_file = source_file;
 }
 
 }  // namespace cadclash

@@ -194,6 +194,30 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
   }
 }
 
+// A part's entry is not the file's: the same bytes at another path (a renamed or copied board, or
+// another board holding the same component models) take every product and part from the first
+// file's entries, named after the file read (its surfaces, parts and diagnostics), as reading it
+// afresh gives.
+TEST(ProductCache, AnotherFileHoldingTheSameProductsFindsTheirEntries) {
+  if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
+  for (const bool lazy : {false, true}) {
+    SCOPED_TRACE(lazy ? "lazy" : "eager");
+    auto [path, original, options] = cached_board(lazy ? "same_products_lazy" : "same_products_eager", lazy);
+    const ImportResult first = import_file(path, options);
+    ASSERT_EQ(first.files.size(), 1u);
+    const std::string copy = path + "-copy.step";
+    write_bytes(copy, original);
+    const ImportResult again = import_file(copy, options);
+    ASSERT_EQ(again.files.size(), 1u);
+    EXPECT_EQ(again.files[0].cache, CacheUse::Miss);  // the file's own entry is its path's
+    EXPECT_EQ(again.files[0].pieces_cached, first.files[0].pieces);
+    EXPECT_EQ(again.files[0].parts_cached, first.model.parts.size());
+    for (const Part& part : again.model.parts) EXPECT_EQ(part.source_file, copy);
+    for (const Surface& s : again.model.surfaces) EXPECT_EQ(s.provenance.source_file, copy);
+    expect_as_read_afresh(copy, again, &options);
+  }
+}
+
 // ImportOptions::transfer_healing changes the shapes: the file's entry and every product's are kept
 // apart per setting, and each read is what reading the file afresh with its setting gives.
 TEST(ProductCache, TransferHealingIsPartOfTheFilesAndTheProductsKeys) {

@@ -122,7 +122,8 @@ struct ImportOptions {
   // Besides the file's entry, a STEP file that can be cut (docs/import.md) keeps one entry per piece
   // (a product's shapes, keyed by the piece's text with its ids renumbered canonically) and every
   // CAD file one per checked and healed B-rep part (keyed by its transferred shape, names, tags and
-  // the tessellation options): a changed file reads and heals only the products that changed.
+  // the tessellation options, not by its file: another file holding the same product, or the file
+  // renamed, finds it): a changed file reads and heals only the products that changed.
   std::string cache_dir;
   // With cache_dir: after a file is read (and after store_triangles_in_cache), the least recently
   // used entries are removed until the directory's entries take at most this many bytes (an entry

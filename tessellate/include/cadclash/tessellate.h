@@ -213,10 +213,11 @@ class BrepSource final : public SurfaceSource {
   // Back from save_brep_source's bytes; nullptr and `why` when they are not whole. The bytes must be
   // ones save_brep_source wrote (check a cache entry's checksum first): OCCT's shape reader trusts them.
   friend std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
-  // The file's entity id of each face (what a part stored under one file's ids is in another
-  // export of the same product). Precondition: entity_ids.size() == face_count(); no other thread
-  // uses the part meanwhile.
-  friend void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids);
+  // The file's entity id of each face and the file its diagnostics name (what a part stored under
+  // one file's ids and name is in another export of the same product, or another file holding it).
+  // Precondition: entity_ids.size() == face_count(); no other thread uses the part meanwhile.
+  friend void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids,
+                                 const std::string& source_file);
   friend std::size_t tessellate_parts(Model& model, std::span<const PartId> parts,
                                       std::vector<Diagnostic>& diagnostics, bool& complete);
   friend void release_part_triangles(Model& model, std::span<const PartId> parts);
@@ -228,7 +229,7 @@ class BrepSource final : public SurfaceSource {
 
 std::string save_brep_source(const BrepSource& source);
 std::shared_ptr<BrepSource> load_brep_source(std::string_view bytes, std::string& why);
-void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids);
+void relabel_brep_faces(BrepSource& source, std::span<const std::int64_t> entity_ids, const std::string& source_file);
 
 // Whole parts meshed later (distributed checks: a rank meshes only the parts its share of the work
 // reaches, and must get the triangles one process's eager import gets).
