@@ -122,9 +122,9 @@ std::vector<SurfaceSource::CircularHole> face_circular_holes(const TopoDS_Face& 
     if (state != TopAbs_OUT) continue;
     const bool nested = std::any_of(wires.begin(), wires.end(), [&](const TopoDS_Wire& other) {
       if (other.IsSame(w)) return false;
-      TopExp_Explorer v(other, TopAbs_VERTEX);
-      if (!v.More()) return false;
-      const Vec3 p = vec(BRep_Tool::Pnt(TopoDS::Vertex(v.Current())).XYZ()) - centre;
+      TopExp_Explorer first(other, TopAbs_VERTEX);
+      if (!first.More()) return false;
+      const Vec3 p = vec(BRep_Tool::Pnt(TopoDS::Vertex(first.Current())).XYZ()) - centre;
       return (p - n.dot(p) * n).norm() < c->radius + c->tolerance;
     });
     if (nested) continue;
