@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cadclash::detail {
 namespace {
@@ -198,16 +199,6 @@ std::optional<double> straddle(const Side& own, const Side& other, const Vec3& c
   return reached;
 }
 
-// The depth both faces reach through each other at c (a point of both), at least h.
-std::optional<double> crossing_at(const Side& a, const Side& b, const Vec3& c, const Vec3& up_a, const Vec3& up_b,
-                                  double h, const Tolerances& tol, Asked& asked) {
-  const auto da = straddle(a, b, c, up_b, h, tol, asked);
-  if (!da) return std::nullopt;
-  const auto db = straddle(b, a, c, up_a, h, tol, asked);
-  if (!db) return std::nullopt;
-  return std::min(*da, *db) - 2.0 * tol.r;
-}
-
 // The part of segment [e0, e1] inside `box` (slab clipping), or nothing.
 std::optional<std::pair<Vec3, Vec3>> clip(const Vec3& e0, const Vec3& e1, const Aabb& box) {
   double s0 = 0.0, s1 = 1.0;
@@ -376,13 +367,29 @@ bool depth_step(const Model& m, const DecideTask& t, FaceView fa, FaceView fb, P
     if (!fa_x || !fb_x) continue;
     const Vec3 up_a = fa_x->normal, up_b = fb_x->normal;
     const double first = low + 8.0 * tol.within + on->second;
-    std::optional<double> proved = crossing_at(a, b, x, up_a, up_b, first, tol, asked);
+    // The depth both faces reach through each other at x, at least h: each side's straddle made only
+    // when h is above what its points already reached (they witness every lower height too).
+    double reached_a = -std::numeric_limits<double>::infinity(), reached_b = reached_a;
+    auto crossing_here = [&](double h) -> std::optional<double> {
+      if (!(reached_a >= h)) {
+        const auto d = straddle(a, b, x, up_b, h, tol, asked);
+        if (!d) return std::nullopt;
+        reached_a = *d;
+      }
+      if (!(reached_b >= h)) {
+        const auto d = straddle(b, a, x, up_a, h, tol, asked);
+        if (!d) return std::nullopt;
+        reached_b = *d;
+      }
+      return std::min(reached_a, reached_b) - 2.0 * tol.r;
+    };
+    std::optional<double> proved = crossing_here(first);
     if (!proved || !(*proved > p.threshold)) continue;
     // The deepest height this crossing holds, up to the band's top (what a depth estimate says).
     double lo = first, hi = high;
     for (int i = 0; i < kBisections; ++i) {
       const double mid = 0.5 * (lo + hi);
-      if (const auto d = crossing_at(a, b, x, up_a, up_b, mid, tol, asked); d && *d > p.threshold) {
+      if (const auto d = crossing_here(mid); d && *d > p.threshold) {
         lo = mid;
         proved = std::max(*proved, *d);
       } else {
