@@ -22,7 +22,8 @@ struct PreparedPair {
   // is a plane: T, where the decision's crossing step begins; else tau).
   double threshold = 0.0;
   // Crossings deeper than min(low, threshold) set PairOutcome::may_cross_threshold (certified, where
-  // one face is a plane: where the exact faces may cross deeper than T; else tau, as threshold).
+  // one face is a plane: where the exact faces may cross deeper than T; else tau, as threshold). The
+  // min, not an invariant: a caller that lowers threshold alone (tests of the early exit) gets it.
   double low = 0.0;
   double margin = 0.0;  // search margin: max(tau, clearance) plus the rounding slack
   double slack = 0.0;   // that rounding slack: bounds any rounding of a height or box coordinate here
