@@ -1,6 +1,6 @@
 // Issue 40 (Goals): continuous motion checked against the discrete check of the same steps, a dense
 // exact-B-rep reference and FCL's continuous collision, on real parts of as1-tu-203.stp.
-//   continuous_bench [--data DIR] [--samples N] [--as1-samples N] [--repeats R] [--only PATH] [--list]
+//   continuous_bench [--data DIR] [--samples N] [--as1-samples N] [--repeats R] [--only PATH] [--list] [--write-paths DIR]
 // Paths (each a few steps, so that the motion between steps matters):
 // - tunnel-nut: a nut dropped through the plate and back up along the plate's normal; every step is
 //   clear (the discrete check sees nothing), the motion between them passes through the plate;
@@ -448,7 +448,7 @@ Row run_path(Model& m, const cb::GeneratedPath& path, const cb::ContinuousRefere
 }
 
 int usage() {
-  std::fprintf(stderr, "usage: continuous_bench [--data DIR] [--samples N] [--as1-samples N] [--repeats R] [--only PATH] [--list]\n");
+  std::fprintf(stderr, "usage: continuous_bench [--data DIR] [--samples N] [--as1-samples N] [--repeats R] [--only PATH] [--list] [--write-paths DIR]\n");
   return 2;
 }
 
@@ -468,6 +468,7 @@ int main(int argc, char** argv) {
   int repeats = env_int("CONTINUOUS_BENCH_REPEATS", 3);
   bool list = false;
   std::string only;  // --only NAME: that path alone
+  std::string write_dir;  // --write-paths DIR: each path as DIR/NAME.csv, for `cadclash check --path`
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--list") {
@@ -481,6 +482,7 @@ int main(int argc, char** argv) {
     else if (a == "--as1-samples") as1_samples = std::max(1, std::stoi(v));
     else if (a == "--repeats") repeats = std::max(1, std::stoi(v));
     else if (a == "--only") only = v;
+    else if (a == "--write-paths") write_dir = v;
     else return usage();
   }
   const std::string file = data + "/as1-tu-203.stp";
@@ -604,6 +606,8 @@ int main(int argc, char** argv) {
   bool missed = false;
   for (const cb::GeneratedPath& p : paths) {
     if (!only.empty() && p.name != only) continue;
+    if (!write_dir.empty() && !cb::write_path_csv(m, p, write_dir + "/" + p.name + ".csv"))
+      std::fprintf(stderr, "continuous_bench: cannot write %s/%s.csv\n", write_dir.c_str(), p.name.c_str());
     std::fprintf(stderr, "%s: %s\n", p.name.c_str(), p.description.c_str());
     const bool as1_path = p.name == "withdraw-8" || p.name == "unscrew-10";
     rows.push_back(run_path(m, p, ref, fcl_models, as1_path ? as1_samples : samples, repeats));
