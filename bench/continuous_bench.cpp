@@ -6,7 +6,8 @@
 //   clear (the discrete check sees nothing), the motion between them passes through the plate;
 // - tunnel-bolt: a bolt falling through the plate while it turns a quarter turn about a horizontal axis;
 // - swing-nut: a nut swung about an axis far from it (in the plate's mid-plane) from above the plate to
-//   below it and back, its steps on the circle, the motion between them cadclash's (chord and slerp);
+//   below it and back, its steps on the circle (cadclash's motion between them, the screw of each
+//   displacement, follows the circle);
 // - withdraw-8 / unscrew-10: bench_compare's as1 withdraw and unscrew paths with 8 and 10 steps.
 // For each: the discrete check of the steps (replay_trajectory) and the continuous check
 // (replay_continuous, default MotionOptions), tolerance 0.01 mm, 2 threads, each the median of R runs
@@ -14,8 +15,8 @@
 // (continuous_reference.h) at N + 1 poses per stretch (env CONTINUOUS_BENCH_SAMPLES, default 1000; the
 // issue's 10^5 is an opt-in; withdraw and unscrew CONTINUOUS_BENCH_AS1_SAMPLES, default 25: they slide in
 // contact, so every sample measures many face pairs exactly) for every pair of a moving and a non-moving instance; FCL 0.7's
-// continuousCollide (conservative advancement, CCDM_LINEAR = cadclash's motion: translation linear,
-// constant angular velocity about the part-local origin; RSS trees) on the model's surfaces' triangles, per
+// continuousCollide (conservative advancement, CCDM_SCREW = cadclash's motion: the screw of each
+// displacement, FCL's ScrewMotion; RSS trees) on the model's surfaces' triangles, per
 // part, for every stretch and pair that cadclash or the reference finds in contact.
 // Prints a Markdown table and notes on stdout, progress on stderr. Timings are printed, never judged;
 // exit 1 only when the reference finds a contact outside cadclash's spans (a missed contact), 77
@@ -403,7 +404,7 @@ Row run_path(Model& m, const cb::GeneratedPath& path, const cb::ContinuousRefere
         const auto* ma = fcl_models.get(m.instances[a].part);
         const auto* mb = fcl_models.get(m.instances[b].part);
         if (ma == nullptr || mb == nullptr) continue;
-        fcl::ContinuousCollisionRequestd request(1000, 1e-4, fcl::CCDM_LINEAR, fcl::GST_LIBCCD,
+        fcl::ContinuousCollisionRequestd request(1000, 1e-4, fcl::CCDM_SCREW, fcl::GST_LIBCCD,
                                                  fcl::CCDC_CONSERVATIVE_ADVANCEMENT);
         fcl::ContinuousCollisionResultd result;
         const auto f0 = std::chrono::steady_clock::now();
@@ -420,7 +421,7 @@ Row run_path(Model& m, const cb::GeneratedPath& path, const cb::ContinuousRefere
           } else {
             // A control, not timed: FCL's naive continuous collision (discrete collide at 1000 poses of the
             // same motion) on the same trees. Finding the contact says the miss is conservative advancement's.
-            fcl::ContinuousCollisionRequestd naive(1000, 1e-3, fcl::CCDM_LINEAR, fcl::GST_LIBCCD, fcl::CCDC_NAIVE);
+            fcl::ContinuousCollisionRequestd naive(1000, 1e-3, fcl::CCDM_SCREW, fcl::GST_LIBCCD, fcl::CCDC_NAIVE);
             fcl::ContinuousCollisionResultd control;
             fcl::continuousCollide(ma, to_fcl(poses[a]), to_fcl(next[a]), mb, to_fcl(poses[b]), to_fcl(next[b]), naive,
                                    control);
@@ -652,7 +653,7 @@ int main(int argc, char** argv) {
               "pair (must be 0).\n");
   std::printf("- transitions bracketed: reference changes between contact and free (between two samples) that meet a "
               "cadclash span at most the resolution wide or one proved in contact at both ends / all such changes.\n");
-  std::printf("- FCL: continuousCollide, conservative advancement, CCDM_LINEAR (cadclash's motion), BVHModel<RSS> "
+  std::printf("- FCL: continuousCollide, conservative advancement, CCDM_SCREW (cadclash's motion: the screw of each displacement), BVHModel<RSS> "
               "(FCL's mesh conservative advancement is reported to work with RSS only: fcl issues 120, 555) of the parts' "
               "surfaces' triangles, on each stretch and pair that cadclash or the reference finds in "
               "contact; found / expected: stretches where the reference has contact and FCL reports it; extra: FCL "

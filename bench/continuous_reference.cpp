@@ -117,8 +117,14 @@ ReferenceSamples ContinuousReference::sample(InstanceId a, const Pose& a0, const
     la[j] = TopLoc_Location(to_trsf(pa[j]));
     lb[j] = TopLoc_Location(to_trsf(pb[j]));
   }
-  const double move_a = (a1.translation() - a0.translation()).norm(), turn_a = turn_angle(a0, a1);
-  const double move_b = (b1.translation() - b0.translation()).norm(), turn_b = turn_angle(b0, b1);
+  // The arc each origin runs (a helix about the screw's axis) is at most its chord times
+  // (angle / 2) / sin(angle / 2).
+  auto arc = [](const Pose& p0, const Pose& p1, double turn) {
+    const double chord = (p1.translation() - p0.translation()).norm();
+    return turn > 1e-8 ? chord * (0.5 * turn) / std::sin(0.5 * turn) : chord * (1.0 + turn * turn);
+  };
+  const double turn_a = turn_angle(a0, a1), turn_b = turn_angle(b0, b1);
+  const double move_a = arc(a0, a1, turn_a), move_b = arc(b0, b1, turn_b);
   const std::size_t pairs = fa.size() * fb.size();
 #pragma omp parallel num_threads(std::max(1, threads))
   {

@@ -4,15 +4,16 @@
 //
 // Contact of faces fa, fb at a pose: their exact distance <= tolerance + ε_a + ε_b, ε the faces'
 // model uncertainty (Surface::uncertainty; as a static check defines contact). Between two poses a
-// part moves along interpolate_pose (cadclash's motion: translation linear, rotation slerp about the
-// part-local origin).
+// part moves along interpolate_pose (cadclash's motion: the screw of the displacement, each point on
+// a helix about its axis).
 //
 // Samples are s_j = j / N, j = 0..N, of one stretch. A face pair is measured exactly at a sample
 // unless a lower bound already proves it out of contact there: the distance of the faces' placed
 // OCCT bounding boxes (BRepBndLib::AddOptimal, part-local, corners mapped), or a lower bound carried
 // from the last sample where the pair was measured: d(s) >= d(s') - v |s - s'| with v the pair's
-// largest point speed, |t_b - t_a| + angle * (largest |p| over the face's box), per side, taken 5 %
-// larger plus 1e-9 mm. Containment (one part inside another without faces in contact) is not seen.
+// largest point speed, per side the arc its origin runs, |t_b - t_a| * (angle / 2) / sin(angle / 2) (a
+// helix is at most that much longer than its chord), + angle * (largest |p| over the face's box),
+// taken 5 % larger plus 1e-9 mm. Containment (one part inside another without faces in contact) is not seen.
 #pragma once
 
 #include "cadclash/collide.h"

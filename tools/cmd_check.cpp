@@ -498,8 +498,8 @@ void register_check(CLI::App& app) {
   add_threads_option(*cmd, o->threads, "files read at once, meshing and the query");
   cmd->add_option("--path", o->path_csv, "Trajectory CSV: step,instance_path,tx,ty,tz,qw,qx,qy,qz");
   cmd->add_flag("--continuous", o->continuous,
-                "With --path: check the motion between the steps too (each instance moves along the screw-like "
-                "motion between its poses); a contact that begins and ends between two steps is found, and the "
+                "With --path: check the motion between the steps too (each instance moves along the screw of "
+                "the displacement between its poses); a contact that begins and ends between two steps is found, and the "
                 "report gets a timeline per pair (docs/cli.md)");
   cmd->add_option("--time-resolution", o->time_resolution,
                   "With --continuous: how narrow the spans where a contact begins or ends are, as a fraction of "

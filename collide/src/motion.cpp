@@ -38,17 +38,58 @@ Turn turn(const Eigen::Quaterniond& qa, const Eigen::Quaterniond& qb) {
   return t;
 }
 
+// The screw of the displacement from a to b (Chasles): b = M a with M the turn by `angle` about a
+// world line along `axis`, then the shift `along` along it. Computed once from a and b, and used as
+// it is by interpolate_pose and travel_bound, so that the bound is about the motion the poses follow.
+// `drift` is the velocity (per unit of s) of the point of a's origin across the axis at s = 0,
+// angle * (P t_a - c) for the axis through c (P: across the axis); it stays finite as the angle
+// goes to 0 (the axis then lies far off and the motion becomes the shift t_b - t_a).
+struct Screw {
+  Eigen::Quaterniond qa;
+  Turn local;          // the turn in a's frame (slerp's)
+  Vec3 axis;           // the same axis in the world: q_a * local.axis
+  double along = 0.0;  // d: M's shift along the axis
+  Vec3 drift = Vec3::Zero();
+};
+Screw screw_of(const Pose& a, const Pose& b) {
+  Screw w;
+  w.qa = rotation_of(a);
+  w.local = turn(w.qa, rotation_of(b));
+  w.axis = w.qa * w.local.axis;
+  const double angle = w.local.angle;
+  // M = b a^-1: its rotation turns by angle about axis, its translation is t = t_b - R t_a.
+  const Vec3 t = b.translation() - Eigen::AngleAxisd(angle, w.axis) * a.translation();
+  w.along = w.axis.dot(t);
+  const Vec3 across = t - w.along * w.axis;
+  // The axis point c (across the axis) solves (I - R) c = across: c = across / 2 + cot(angle / 2)
+  // axis x across / 2; angle * c, with g = angle cot(angle / 2) (2 at angle 0).
+  const double half = 0.5 * angle;
+  const double g = half == 0.0 ? 2.0 : angle * std::cos(half) / std::sin(half);
+  const Vec3 ta = a.translation() - w.axis.dot(a.translation()) * w.axis;
+  w.drift = angle * ta - 0.5 * angle * across - 0.5 * g * w.axis.cross(across);
+  return w;
+}
+
 }  // namespace
 
 Pose interpolate_pose(const Pose& a, const Pose& b, double s) {
   assert(s >= 0.0 && s <= 1.0);
-  const Eigen::Quaterniond qa = rotation_of(a);
-  const Turn t = turn(qa, rotation_of(b));
-  const Eigen::Quaterniond step(Eigen::AngleAxisd(s * t.angle, t.axis));  // constant angular speed
+  const Screw w = screw_of(a, b);
+  const double angle = w.local.angle;
+  const Eigen::Quaterniond step(Eigen::AngleAxisd(s * angle, w.local.axis));  // constant angular speed
   Pose out = Pose::Identity();
-  out.linear() = (qa * step).normalized().toRotationMatrix();
-  // Exact at both ends: (1 - s) t_a + s t_b is t_a at s = 0 and t_b at s = 1.
-  out.translation() = (1.0 - s) * a.translation() + s * b.translation();
+  out.linear() = (w.qa * step).normalized().toRotationMatrix();
+  // Exact at both ends. In between a's origin turns about the axis through c and shifts along it:
+  // (R_s - I)(P t_a - c) + s d axis, with (R_s - I) v = 2 sin(s angle / 2) (cos(s angle / 2)
+  // axis x v - sin(s angle / 2) v) for v across the axis, and P t_a - c = drift / angle.
+  if (s == 0.0 || s == 1.0) {
+    out.translation() = s == 0.0 ? a.translation() : b.translation();
+    return out;
+  }
+  const double h = 0.5 * s * angle;
+  const double chord = angle == 0.0 ? s : 2.0 * std::sin(h) / angle;  // 2 sin(h) / angle, s at angle 0
+  out.translation() = a.translation() + chord * (std::cos(h) * w.axis.cross(w.drift) - std::sin(h) * w.drift) +
+                      (s * w.along) * w.axis;
   return out;
 }
 
@@ -56,17 +97,27 @@ double motion_angle(const Pose& a, const Pose& b) { return turn(rotation_of(a), 
 
 double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, double s1) {
   assert(s0 >= 0.0 && s0 <= s1 && s1 <= 1.0 && !box.isEmpty());
-  double reach = 0.0;  // the largest |p| over the box: at a corner
-  for (int k = 0; k < 8; ++k) reach = std::max(reach, box.corner(static_cast<Aabb::CornerType>(k)).norm());
-  const double shift = (b.translation() - a.translation()).norm();
-  // The angle within a few ulps, and an absolute 1e-15 for the quaternions' own rounding.
-  const double angle = motion_angle(a, b) * (1.0 + 16.0 * kUnit) + 64.0 * kUnit;
-  const double speed = shift + angle * reach;
-  // What the computed poses may be off the exact motion (their quaternions and rotation matrices,
-  // the blend of the translations): far above it, for both ends.
+  const Screw w = screw_of(a, b);
+  const double angle = w.local.angle;
+  // A point x of the part moves along a helix about the axis: speed hypot(|angle P(x - c)|, d) (the
+  // turn's velocity is across the axis, the shift's along it), with
+  // angle P(x - c) = angle P(R_a p) + drift for the part-local point p. Its largest over the box is
+  // at a corner (the norm of an affine map is convex).
+  double reach = 0.0, across = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 p = box.corner(static_cast<Aabb::CornerType>(k));
+    reach = std::max(reach, p.norm());
+    const Vec3 r = a.linear() * p;
+    across = std::max(across, (angle * (r - w.axis.dot(r) * w.axis) + w.drift).norm());
+  }
+  const double speed = std::hypot(across, w.along);
+  // The speed's own rounding (a few ulps of its terms), and what the computed poses may be off the
+  // motion (quaternions, rotation matrices, the turned and shifted origin): far above it, for both
+  // ends.
   const double t = std::max(a.translation().norm(), b.translation().norm());
-  const double poses = 2.0 * 64.0 * kUnit * (reach + t);
-  return (s1 - s0) * speed * (1.0 + 16.0 * kUnit) + poses;
+  const double slack = 64.0 * kUnit * (angle * reach + w.drift.norm() + std::abs(w.along)) + 64.0 * kUnit;
+  const double poses = 2.0 * 256.0 * kUnit * (reach + t);
+  return (s1 - s0) * (speed * (1.0 + 16.0 * kUnit) + slack) + poses;
 }
 
 }  // namespace cadclash

@@ -105,8 +105,11 @@ TEST(ContinuousMotion, APartPassingThroughAThinPlateBetweenTwoStepsIsFound) {
     expect_spans(r, 0.4, 0.7, 0.4 - 2 * mo.resolution, 0.7 + 2 * mo.resolution);
     // The spans where the contact begins and ends are at most the resolution wide; the rest of the
     // contact is proved at the ends of its spans.
-    for (const MotionSpan& s : r.pairs[0].spans)
-      if (!s.contact_at_ends) EXPECT_LE(s.s1 - s.s0, mo.resolution + 1e-15);
+    for (const MotionSpan& s : r.pairs[0].spans) {
+      if (!s.contact_at_ends) {
+        EXPECT_LE(s.s1 - s.s0, mo.resolution + 1e-15);
+      }
+    }
     // The scene is left at the stretch's end.
     EXPECT_TRUE(scene.pose(f.cube).isApprox(to));
     // Beside the plate, the same fall touches nothing: no pair, proved on a handful of checks.
@@ -151,6 +154,44 @@ TEST(ContinuousMotion, RotationAboutAFarAxisSweepsThroughThePlate) {
   bool mid = false;  // at s = 0.5 the low cube lies across the plate (z in [-1, 1])
   for (const MotionSpan& s : r.pairs[0].spans) mid |= s.s0 <= 0.5 && 0.5 <= s.s1;
   EXPECT_TRUE(mid);
+}
+
+// A square frame unscrewed off a square rod: each step turns it 120 degrees about the rod's axis and
+// lifts it 1 mm, and its part frame's origin lies 30 mm off that axis (as a CAD part's often does).
+// The motion between the steps is the screw about the rod's axis, whatever the part's origin: the
+// frame stays around the rod, 0.5 mm clear of it everywhere, and no span is listed. (A translation
+// blended linearly between the steps' origins would swing the frame 15 mm off the axis and through
+// the rod.)
+TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
+  Model m;
+  const InstanceId rod = add_instance(m, "/rod", add_part(m, "rod", box_surfaces(Vec3(-1, -1, -10), Vec3(1, 1, 10), 2)));
+  std::vector<Surface> bars;
+  // Around (30, 0, 0) of its own frame: the hole |x - 30|, |y| < 2.5, the bars out to 4.
+  for (const auto& [lo, hi] : {std::pair{Vec3(26, -4, -1), Vec3(34, -2.5, 1)}, std::pair{Vec3(26, 2.5, -1), Vec3(34, 4, 1)},
+                               std::pair{Vec3(26, -2.5, -1), Vec3(27.5, 2.5, 1)}, std::pair{Vec3(32.5, -2.5, -1), Vec3(34, 2.5, 1)}})
+    for (Surface& f : box_surfaces(lo, hi, 2)) bars.push_back(std::move(f));
+  const InstanceId frame = add_instance(m, "/frame", add_part(m, "frame", std::move(bars)));
+  auto step = [](int k) {  // turned k times 120 degrees about z, lifted k mm
+    Pose p = Pose::Identity();
+    p.translate(Vec3(0, 0, k));
+    p.rotate(Eigen::AngleAxisd(k * 2.0 * std::numbers::pi / 3.0, Vec3::UnitZ()));
+    p.translate(Vec3(-30, 0, 0));
+    return p;
+  };
+  Scene scene(m);
+  for (int k = 0; k < 3; ++k) {
+    scene.set_pose(frame, step(k));
+    EXPECT_TRUE(scene.check().pairs.empty()) << k;
+    const InstanceId moving[] = {frame};
+    const Pose from[] = {step(k)}, to[] = {step(k + 1)};
+    const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
+    EXPECT_TRUE(r.pairs.empty()) << k;
+    EXPECT_TRUE(r.complete);
+  }
+  // Half way through a stretch the frame is turned 60 degrees and lifted 0.5 mm, centred on the rod.
+  const Pose mid = interpolate_pose(step(0), step(1), 0.5);
+  EXPECT_LT((mid * Vec3(30, 0, 0) - Vec3(0, 0, 0.5)).norm(), 1e-12);
+  (void)rod;
 }
 
 // Two cubes fly at each other and through each other within one stretch: each moves 20 mm, so a

@@ -44,6 +44,50 @@ TEST(Motion, EndsShorterArcAndConstantSpeed) {
   EXPECT_NEAR(motion_angle(id, tiny), 3e-9, 1e-22);
 }
 
+// The motion is the screw of the displacement from a to b (Chasles): a point's path does not depend
+// on where the part's own frame has its origin, nor on where the world's has; parts moved by one
+// displacement move together all the way; a turn about a fixed axis with a shift along it (a nut
+// unscrewed) keeps each point at its distance from that axis.
+TEST(Motion, TheScrewFollowsThePointsNotTheFrames) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);
+  auto random_pose = [&](double spread) {
+    return pose(Vec3(u(rng), u(rng), u(rng)), 3.0 * u(rng), spread * Vec3(u(rng), u(rng), u(rng)));
+  };
+  for (int k = 0; k < 200; ++k) {
+    const Pose a = random_pose(100.0), b = random_pose(100.0);
+    const Pose frame = random_pose(50.0), world = random_pose(1e3);  // a part frame moved; the world moved
+    const Vec3 p(10.0 * u(rng), 10.0 * u(rng), 10.0 * u(rng));
+    for (double s : {0.1, 0.37, 0.5, 0.93}) {
+      const Vec3 x = interpolate_pose(a, b, s) * p;
+      // The same part described in another frame: its points p' = frame^-1 p, its poses a frame.
+      EXPECT_LT((interpolate_pose(a * frame, b * frame, s) * (frame.inverse() * p) - x).norm(), 1e-9) << k << ' ' << s;
+      EXPECT_LT((interpolate_pose(world * a, world * b, s) * p - world * x).norm(), 1e-9) << k << ' ' << s;
+      // Another part moved by the same displacement b a^-1 moves with it.
+      const Pose c = random_pose(100.0), d = b * a.inverse() * c;
+      const Pose together = interpolate_pose(c, d, s) * c.inverse();
+      EXPECT_LT((together * (a * p) - x).norm(), 1e-9) << k << ' ' << s;
+    }
+  }
+  // Turned 108 degrees about the line x = 20, y = -5 (along z) and shifted 0.45 mm along it: every
+  // point keeps its distance from the line and rises by s 0.45, turning by s 108 degrees.
+  const Vec3 c(20, -5, 0);
+  Pose a = pose(Vec3(1, 1, 0), 0.3, Vec3(3, 4, 5));
+  Pose screw = Pose::Identity();
+  screw.translate(c + Vec3(0, 0, 0.45));
+  screw.rotate(Eigen::AngleAxisd(0.6 * std::numbers::pi, Vec3::UnitZ()));
+  screw.translate(-c);
+  const Pose b = screw * a;
+  const Vec3 p(1, 2, 3), x0 = a * p;
+  for (double s : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    Pose part = Pose::Identity();
+    part.translate(c + Vec3(0, 0, s * 0.45));
+    part.rotate(Eigen::AngleAxisd(s * 0.6 * std::numbers::pi, Vec3::UnitZ()));
+    part.translate(-c);
+    EXPECT_LT((interpolate_pose(a, b, s) * p - part * x0).norm(), 1e-12) << s;
+  }
+}
+
 // The bound holds for every point of the box over every stretch, with random motions near the
 // origin and a million millimetres out, rotations about far axes included; and it is not loose: a
 // pure translation travels it all, a pure turn its arc.

@@ -12,8 +12,9 @@
 //   drawn where the CSV's poses, interpolated here, put it.
 // - turn: a path written here that turns the near box about z by 170 degrees, then by 80 more
 //   (its last quaternion given with the opposite sign: the shorter arc must be taken), with step
-//   numbers 0, 1, 3: the box is drawn at a slerp computed here (the textbook formula, not the
-//   page's), at several times; it never comes near box_a, so nothing is coloured.
+//   numbers 0, 1, 3, and moves it as it turns: the box is drawn at the screw computed here (the
+//   textbook formulas: slerp, and FCL's axis point of the displacement; not the page's), at several
+//   times; it never comes near box_a, so nothing is coloured.
 // - plain: path_ok.csv without --continuous: no slider, the page as before (last step, class
 //   colours); and the JSON report is the same bytes with and without --html.
 //
@@ -68,7 +69,10 @@ function slerp(a, b, s) {
   return a.map((c, k) => wa * c + wb * b[k]);
 }
 
-// Where the CSV puts instance `path` at time t: translation linear, rotation slerped.
+// Where the CSV puts instance `path` at time t: the screw of the displacement between the two steps
+// (a turn about an axis and a shift along it): its rotation slerped, its axis through the point FCL's
+// ScrewMotion takes, (t_a + t_b + axis x (t_b - t_a) cot(angle / 2)) / 2, a's origin turned about
+// it and shifted along it.
 function expectedPose(path, { steps, poses }, t) {
   const at = poses.get(path);
   if (t <= steps[0]) return at[0];
@@ -76,7 +80,24 @@ function expectedPose(path, { steps, poses }, t) {
   let k = 0;
   while (steps[k + 1] <= t) ++k;
   const s = (t - steps[k]) / (steps[k + 1] - steps[k]);
-  return { t: at[k].t.map((c, i) => (1 - s) * c + s * at[k + 1].t[i]), q: slerp(at[k].q, at[k + 1].q, s) };
+  const a = at[k], b = at[k + 1];
+  const q = slerp(a.q, b.q, s);
+  // The world turn b.q a.q^-1 on the shorter arc.
+  const [aw, ax, ay, az] = a.q, [bw, bx, by, bz] = b.q;
+  let r = [bw * aw + bx * ax + by * ay + bz * az, -bw * ax + bx * aw - by * az + bz * ay,
+    -bw * ay + bx * az + by * aw - bz * ax, -bw * az - bx * ay + by * ax + bz * aw];
+  if (r[0] < 0) r = r.map((c) => -c);
+  const v = Math.hypot(r[1], r[2], r[3]);
+  const o = b.t.map((c, i) => c - a.t[i]);
+  if (v < 1e-12) return { t: a.t.map((c, i) => c + s * o[i]), q };
+  const angle = 2 * Math.atan2(v, r[0]), axis = [r[1] / v, r[2] / v, r[3] / v];
+  const x = [axis[1] * o[2] - axis[2] * o[1], axis[2] * o[0] - axis[0] * o[2], axis[0] * o[1] - axis[1] * o[0]];
+  const cot = 1 / Math.tan(angle / 2);
+  const p = [0, 1, 2].map((i) => (a.t[i] + b.t[i] + x[i] * cot) / 2);
+  const along = axis.reduce((sum, c, i) => sum + c * o[i], 0);
+  const turn = { t: [0, 0, 0], q: [Math.cos(s * angle / 2), ...axis.map((c) => c * Math.sin(s * angle / 2))] };
+  const moved = place(turn, a.t.map((c, i) => c - p[i]));
+  return { t: moved.map((c, i) => p[i] + c + s * along * axis[i]), q };
 }
 
 // p rotated by unit quaternion q = [w, x, y, z], then moved by t.
@@ -251,7 +272,7 @@ async function turnCase(browser, a, out) {
       checkPoses(state, path, t, `turning, t = ${t}`);
       check(state.coloured.length === 0, `turning, t = ${t}: ${state.coloured.length} surfaces coloured`);
     }
-    console.log('turn: the box is drawn at the slerped pose at t = 0.37, 1, 1.5, 2.9');
+    console.log('turn: the box is drawn at the screw pose at t = 0.37, 1, 1.5, 2.9');
     await page.screenshot({ path: join(out, 'viewer.png') });
   } finally {
     await page.close();

@@ -4,9 +4,11 @@
 //
 // Times are the path's step numbers. Between steps k and k + 1 the fraction s = (t - step_k) /
 // (step_{k+1} - step_k) of the motion is done, and the pose is cadclash's interpolate_pose
-// (collide/src/motion.cpp, trajectory.h "Motion between steps"): translation linear, rotation
-// slerp along the shorter arc at constant angular speed. It is written here with the same steps
-// (angle from atan2, not acos) so that the page shows the pose the check placed, not a look-alike.
+// (collide/src/motion.cpp, trajectory.h "Motion between steps"): the screw of the displacement
+// from a to b, its rotation a slerp along the shorter arc at constant angular speed, each point on
+// a helix about the screw's axis. It is written here with the same steps (angle from atan2, not
+// acos; the origin's drift across the axis) so that the page shows the pose the check placed, not
+// a look-alike.
 
 // Quaternions are [w, x, y, z].
 function multiply(a, b) {
@@ -24,6 +26,16 @@ function normalized(q) {
   return q.map((c) => c / n);
 }
 
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+
+// v turned by the unit quaternion q.
+function rotate(q, v) {
+  const u = [q[1], q[2], q[3]];
+  const c1 = cross(u, v), c2 = cross(u, c1);
+  return [0, 1, 2].map((k) => v[k] + 2 * q[0] * c1[k] + 2 * c2[k]);
+}
+
 // The pose at fraction s of the motion from a to b, each [tx, ty, tz, qw, qx, qy, qz].
 export function interpolatePose(a, b, s) {
   const qa = a.slice(3, 7), qb = b.slice(3, 7);
@@ -32,12 +44,29 @@ export function interpolatePose(a, b, s) {
   if (r[0] < 0) r = r.map((c) => -c);
   const v = Math.hypot(r[1], r[2], r[3]);
   const angle = 2 * Math.atan2(v, r[0]);
-  const axis = v > 0 ? [r[1] / v, r[2] / v, r[3] / v] : [1, 0, 0];
+  const local = v > 0 ? [r[1] / v, r[2] / v, r[3] / v] : [1, 0, 0];
   const half = (s * angle) / 2;  // constant angular speed
-  const step = [Math.cos(half), axis[0] * Math.sin(half), axis[1] * Math.sin(half), axis[2] * Math.sin(half)];
+  const step = [Math.cos(half), local[0] * Math.sin(half), local[1] * Math.sin(half), local[2] * Math.sin(half)];
   const q = normalized(multiply(qa, step));
-  const t = [0, 1, 2].map((k) => (1 - s) * a[k] + s * b[k]);
-  return [...t, ...q];
+  if (s === 0 || s === 1) return [...(s === 0 ? a : b).slice(0, 3), ...q];
+  // The screw (motion.cpp, screw_of): its world axis, M's translation t = t_b - R t_a split along
+  // and across it, and the drift of a's origin across it.
+  const ta = a.slice(0, 3);
+  const axis = rotate(qa, local);
+  const whole = [Math.cos(angle / 2), ...axis.map((c) => c * Math.sin(angle / 2))];
+  const turned = rotate(whole, ta);
+  const t = [0, 1, 2].map((k) => b[k] - turned[k]);
+  const along = dot(axis, t);
+  const across = t.map((c, k) => c - along * axis[k]);
+  const g = angle === 0 ? 2 : (angle * Math.cos(angle / 2)) / Math.sin(angle / 2);
+  const ia = dot(axis, ta);
+  const ac = cross(axis, across);
+  const drift = [0, 1, 2].map((k) => angle * (ta[k] - ia * axis[k]) - 0.5 * angle * across[k] - 0.5 * g * ac[k]);
+  const h = 0.5 * s * angle;
+  const chord = angle === 0 ? s : (2 * Math.sin(h)) / angle;
+  const ad = cross(axis, drift);
+  const out = [0, 1, 2].map((k) => ta[k] + chord * (Math.cos(h) * ad[k] - Math.sin(h) * drift[k]) + s * along * axis[k]);
+  return [...out, ...q];
 }
 
 // Column-major 4x4 matrix (three.js's Matrix4.elements order) of a pose [t, q].

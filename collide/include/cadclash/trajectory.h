@@ -45,10 +45,16 @@ Diagnostic steps_not_checked(std::span<const TrajectoryRow> rows, std::size_t k,
 // ---------------------------------------------------------------------------------------------
 // Motion between steps
 // ---------------------------------------------------------------------------------------------
-// Between two consecutive poses a and b of an instance, its motion for s in [0, 1] is the rigid
-// motion with translation (1 - s) t_a + s t_b (linear) and rotation slerp(q_a, q_b, s): along the
-// shorter arc (q and -q are one rotation), at constant angular speed, about an axis fixed relative to
-// a: a screw-like motion. A point p of the part (part-local) is at R(s) p + t(s).
+// Between two consecutive poses a and b of an instance, its motion for s in [0, 1] is the screw of
+// the displacement M = b a^-1 (Chasles: every rigid displacement is a turn about a line and a shift
+// along it): at s the part is turned by s times M's angle about M's axis and shifted by s times M's
+// shift along it, so its rotation is slerp(q_a, q_b, s) (along the shorter arc, q and -q being one
+// rotation, at constant angular speed) and each point moves along a helix about that axis. A point's
+// path depends on the two placements of the part only, not on where its own frame (a CAD model's
+// origin, often far off the part) or the world's has its origin: a nut turned about its bolt between
+// two steps stays on the bolt, parts moved by one displacement move together. Without a turn it is
+// the straight shift t_a -> t_b. (FCL's CCDM_SCREW is the same motion; its CCDM_LINEAR, a
+// translation blended linearly with the slerp, depends on the part's origin.)
 
 // The pose at fraction s of the motion from a to b (s = 0: a's rotation and translation, s = 1:
 // b's, each up to its quaternion's rounding). Preconditions: a and b are rigid (orthonormal linear
@@ -59,8 +65,9 @@ Pose interpolate_pose(const Pose& a, const Pose& b, double s);
 double motion_angle(const Pose& a, const Pose& b);
 
 // An upper bound on how far any point of `box` (part-local) moves while s runs over [s0, s1] of
-// the motion from a to b: (s1 - s0) (|t_b - t_a| + angle * the largest |p| over the box), since a
-// point moves at speed |t_b - t_a| + angle |p| at most. Computed with its rounding: it also covers
+// the motion from a to b: (s1 - s0) times the largest speed of a box corner along its helix,
+// hypot(angle * its distance from the screw's axis, the shift along it) (for a pure shift,
+// |t_b - t_a|; for a turn about the part's origin, angle * |p|). Computed with its rounding: it also covers
 // the rounding of the poses interpolate_pose computes (a few units in the last place of |p| + |t|),
 // so a point of the box placed by interpolate_pose(a, b, s) for s in [s0, s1] lies within it of the
 // same point placed by interpolate_pose(a, b, s0). Preconditions: 0 <= s0 <= s1 <= 1; box not empty.
