@@ -114,12 +114,7 @@ std::vector<SurfaceSource::CircularHole> face_circular_holes(const TopoDS_Face& 
     // are the same for the face's location applied to both.)
     double u = 0.0, v = 0.0;
     ElSLib::Parameters(plane, gp_Pnt(centre.x(), centre.y(), centre.z()), u, v);
-    TopAbs_State state = TopAbs_UNKNOWN;
-    {
-      std::lock_guard<std::mutex> lock(where.domain_mutex);
-      state = where.domain->Perform(gp_Pnt2d(u, v));
-    }
-    if (state != TopAbs_OUT) continue;
+    if (where.classify(u, v) != TopAbs_OUT) continue;
     const bool nested = std::any_of(wires.begin(), wires.end(), [&](const TopoDS_Wire& other) {
       if (other.IsSame(w)) return false;
       TopExp_Explorer first(other, TopAbs_VERTEX);

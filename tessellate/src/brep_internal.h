@@ -8,6 +8,7 @@
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
+#include <TopAbs_State.hxx>
 #include <TopoDS_Edge.hxx>
 
 #include <chrono>
@@ -30,15 +31,23 @@ std::uint64_t next_source_id();  // brep_face_cache.h
 // parameter domain (a polygon of the boundary's pcurves, points nearer than the polygon's measured
 // deviation counting as on it) and its edges with their boxes.
 struct FaceLocator {
-  // Perform() is const but not thread-safe: the classifier keeps its wires in NCollection_Sequence,
-  // whose Value() moves a cached cursor. Every call holds domain_mutex.
-  std::unique_ptr<BRepTopAdaptor_FClass2d> domain;
-  mutable std::mutex domain_mutex;
   std::vector<std::pair<TopoDS_Edge, Aabb>> edges;  // edges with a 3D curve, each with its box
   // Per edge: points of its curve at evenly spaced parameters (t, point), where Newton starts.
   std::vector<std::vector<std::pair<double, gp_Pnt>>> samples;
   explicit FaceLocator(const TopoDS_Face& face);
   ~FaceLocator();
+  // The classifier's state of the face's parameters (u, v) (BRepTopAdaptor_FClass2d::Perform, the
+  // same answer from any thread). Thread-safe.
+  TopAbs_State classify(double u, double v) const;
+
+ private:
+  TopoDS_Face face_;
+  // Perform() is const but not thread-safe: the classifier keeps its wires in NCollection_Sequence,
+  // whose Value() moves a cached cursor. So each call takes a classifier no other call is using,
+  // made on first need (most faces' calls never overlap: one; the witness steps of a check on two
+  // threads often ask the same face at once, and waited for each other's OCCT face classifier).
+  mutable std::mutex idle_mutex_;
+  mutable std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> idle_;
 };
 }  // namespace detail
 

@@ -159,8 +159,8 @@ std::optional<double> edge_pair_witness(const FaceLocator& a, const gp_Trsf& pla
   return d + kEvaluationRounding * magnitude;
 }
 
-FaceLocator::FaceLocator(const TopoDS_Face& face)
-    : domain(std::make_unique<BRepTopAdaptor_FClass2d>(face, Precision::PConfusion())) {
+FaceLocator::FaceLocator(const TopoDS_Face& face) : face_(face) {
+  idle_.push_back(std::make_unique<BRepTopAdaptor_FClass2d>(face, Precision::PConfusion()));
   for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) {
     const TopoDS_Edge& edge = TopoDS::Edge(e.Current());
     if (BRep_Tool::Degenerated(edge) || !BRep_Tool::IsGeometric(edge)) continue;
@@ -188,6 +188,22 @@ FaceLocator::FaceLocator(const TopoDS_Face& face)
 }
 
 FaceLocator::~FaceLocator() = default;
+
+TopAbs_State FaceLocator::classify(double u, double v) const {
+  std::unique_ptr<BRepTopAdaptor_FClass2d> mine;
+  {
+    std::lock_guard<std::mutex> lock(idle_mutex_);
+    if (!idle_.empty()) {
+      mine = std::move(idle_.back());
+      idle_.pop_back();
+    }
+  }
+  if (!mine) mine = std::make_unique<BRepTopAdaptor_FClass2d>(face_, Precision::PConfusion());
+  const TopAbs_State state = mine->Perform(gp_Pnt2d(u, v));
+  std::lock_guard<std::mutex> lock(idle_mutex_);
+  idle_.push_back(std::move(mine));
+  return state;
+}
 
 namespace {
 
@@ -253,11 +269,7 @@ std::optional<double> face_point_witness(const BRepAdaptor_Surface& surface, con
   if (!f) return std::nullopt;
   // Parameters the classifier puts inside name a point of the face. A foot on or past the boundary
   // means the face's nearest points are on its edges.
-  TopAbs_State state = TopAbs_UNKNOWN;
-  {
-    std::lock_guard<std::mutex> lock(where.domain_mutex);
-    state = where.domain->Perform(gp_Pnt2d(f->u, f->v));
-  }
+  const TopAbs_State state = where.classify(f->u, f->v);
   if (state != TopAbs_IN) return edge_witness(where, p, f->magnitude);
   return p.Distance(surface.Value(f->u, f->v)) + kEvaluationRounding * f->magnitude;
 }
