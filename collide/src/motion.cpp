@@ -70,6 +70,12 @@ Screw screw_of(const Pose& a, const Pose& b) {
   return w;
 }
 
+// The velocity (per unit of s) of the world point x under the screw w of a motion from pose a: the
+// turn's angle * axis x (x - t_a) plus the velocity of a's origin, axis x drift + d axis.
+Vec3 velocity_at(const Screw& w, const Pose& a, const Vec3& x) {
+  return (w.local.angle * w.axis).cross(x - a.translation()) + w.axis.cross(w.drift) + w.along * w.axis;
+}
+
 }  // namespace
 
 Pose interpolate_pose(const Pose& a, const Pose& b, double s) {
@@ -120,9 +126,30 @@ double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, do
   return (s1 - s0) * (speed * (1.0 + 16.0 * kUnit) + slack) + poses;
 }
 
-}  // namespace cadclash
+// Each part moves along its screw, a constant twist (the velocity field x -> omega x (x - x0) +
+// v(x0)), so in a's frame b's point at z moves at |v_b(z) - v_a(z)| <= |omega_b - omega_a| |z - p| +
+// |v_b(p) - v_a(p)|, p the centre of b's box at s = 0, |z - p| at most its half diagonal plus b's
+// travel over the motion. Parts moved by one displacement (a sub-assembly turned or pulled out) keep
+// their gap: the two twists then differ by rounding only. Each side's rounding of its poses is
+// travel_bound's over no motion.
+double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, const Pose& b0, const Pose& b1,
+                             const Aabb& box_b, double s0, double s1) {
+  assert(s0 >= 0.0 && s0 <= s1 && s1 <= 1.0 && !box_a.isEmpty() && !box_b.isEmpty());
+  const Screw wa = screw_of(a0, a1), wb = screw_of(b0, b1);
+  const Vec3 p = b0 * box_b.center();
+  const Vec3 va = velocity_at(wa, a0, p), vb = velocity_at(wb, b0, p);
+  const Vec3 oa = wa.local.angle * wa.axis, ob = wb.local.angle * wb.axis;
+  const double spread = 0.5 * box_b.sizes().norm() + travel_bound(b0, b1, box_b, 0.0, 1.0);
+  const double speed = (ob - oa).norm() * spread + (vb - va).norm();
+  // The rounding of the velocities and of their differences: a few ulps of their terms.
+  const double terms = oa.norm() * ((p - a0.translation()).norm() + spread) +
+                       ob.norm() * ((p - b0.translation()).norm() + spread) + wa.drift.norm() + wb.drift.norm() +
+                       std::abs(wa.along) + std::abs(wb.along);
+  const double slack = 64.0 * kUnit * terms + 64.0 * kUnit;
+  const double poses = travel_bound(a0, a1, box_a, s0, s0) + travel_bound(b0, b1, box_b, s0, s0);
+  return (s1 - s0) * (speed * (1.0 + 16.0 * kUnit) + slack) + poses;
+}
 
-namespace cadclash {
 namespace {
 
 // An instance pair (surfaces kInvalidId: any of its surface pairs, or containment) or one surface
@@ -188,30 +215,20 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       boxes[i].extend(model.surfaces[s].aabb.isEmpty() ? mesh_aabb(model.surfaces[s].mesh) : model.surfaces[s].aabb);
   }
   // A pair moves apart or together over [s0, s1] by at most its two sides' travel (a side that does
-  // not move: none). When neither side turns, the translation they share does not move them
-  // relative to each other: their travel is what their shifts differ by, plus each side's travel
-  // with its shift left out (the rotation interpolate_pose computes for no turn, and the rounding of
-  // the poses). So parts moved together keep their gap, wherever the assembly is placed.
+  // not move: none), and, when both move, by at most how far one moves relative to the other
+  // (relative_travel_bound: parts moved together keep their gap, wherever the assembly is placed).
   std::map<InstanceId, std::size_t> index;
   for (std::size_t i = 0; i < moving.size(); ++i) index.emplace(moving[i], i);
-  auto shift_only = [&](std::size_t i) { return from[i].linear() == to[i].linear(); };
   auto pair_travel = [&](InstanceId a, InstanceId b, double s0, double s1) {
     const auto ia = index.find(a), ib = index.find(b);
-    const bool together = ia != index.end() && ib != index.end() && shift_only(ia->second) && shift_only(ib->second);
     auto own = [&](const auto& it) {
       if (it == index.end() || boxes[it->second].isEmpty()) return 0.0;
-      const std::size_t i = it->second;
-      if (!together) return travel_bound(from[i], to[i], boxes[i], s0, s1);
-      Pose unshifted = to[i];
-      unshifted.translation() = from[i].translation();
-      return travel_bound(from[i], unshifted, boxes[i], s0, s1);
+      return travel_bound(from[it->second], to[it->second], boxes[it->second], s0, s1);
     };
-    if (!together) return own(ia) + own(ib);
-    const Vec3 da = to[ia->second].translation() - from[ia->second].translation();
-    const Vec3 db = to[ib->second].translation() - from[ib->second].translation();
-    // The difference with its rounding (each shift's, and the subtraction's).
-    const double apart = (da - db).norm() * (1.0 + 16.0 * kUnit) + 8.0 * kUnit * (da.norm() + db.norm());
-    return (s1 - s0) * apart * (1.0 + 16.0 * kUnit) + own(ia) + own(ib);
+    const double apart = own(ia) + own(ib);
+    if (ia == index.end() || ib == index.end() || boxes[ia->second].isEmpty() || boxes[ib->second].isEmpty()) return apart;
+    const std::size_t i = ia->second, j = ib->second;
+    return std::min(apart, relative_travel_bound(from[i], to[i], boxes[i], from[j], to[j], boxes[j], s0, s1));
   };
   // Any pair's: at most the two largest.
   auto travel_over = [&](double s0, double s1) {

@@ -39,17 +39,23 @@ void expect_spans(const MotionResult& r, double lo, double hi, double before, do
   EXPECT_GE(covered, hi);
 }
 
-// Two cubes 0.05 apart moved 30 mm by the same translation (a sub-assembly pulled out): their gap
-// stays, so they are never listed, and the stretch is proved on a few checks (each side's travel
-// would be 30 mm; theirs relative to each other is the poses' rounding). Touching, they are in
-// contact over the whole stretch: one span, proved at its ends.
+// Two cubes 0.05 apart moved by one displacement (a sub-assembly pulled out 30 mm, or swung 90
+// degrees about an axis 50 mm off it): their gap stays, so they are never listed, and the stretch is
+// proved on a few checks (each side's travel would be 30 mm or more; theirs relative to each other
+// is the poses' rounding). Touching, they are in contact over the whole stretch: one span, proved
+// at its ends.
 TEST(ContinuousMotion, PartsMovedTogetherKeepTheirGap) {
   // The same wherever the whole scene is placed: as built, and turned and moved 10^6 mm away (the
-  // two shifts then differ in their last bits).
+  // two displacements then differ in their last bits).
   Pose far = Pose::Identity();
   far.translate(Vec3(1e6, -4e5, 3e5));
   far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  Pose swing = Pose::Identity();
+  swing.translate(Vec3(0, 50, 0));
+  swing.rotate(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3(1, 0, 1).normalized()));
+  swing.translate(Vec3(0, -50, 0));
   for (const Pose& where : {Pose::Identity(), far})
+  for (const Pose& moved : {translation(0, 0, -30), swing})
   for (const double gap : {0.05, 0.0}) {
     SCOPED_TRACE(gap);
     Model m;
@@ -57,7 +63,7 @@ TEST(ContinuousMotion, PartsMovedTogetherKeepTheirGap) {
     const InstanceId b = add_instance(m, "/b", add_part(m, "b", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2)));
     Scene scene(m);
     const Pose from_a = where * translation(0, 0, 0), from_b = where * translation(2 + gap, 0, 0);
-    const Pose to_a = where * translation(0, 0, -30), to_b = where * translation(2 + gap, 0, -30);
+    const Pose to_a = where * moved * translation(0, 0, 0), to_b = where * moved * translation(2 + gap, 0, 0);
     scene.set_pose(a, from_a);
     scene.set_pose(b, from_b);
     CollideOptions o;

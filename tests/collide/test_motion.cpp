@@ -143,5 +143,64 @@ TEST(Motion, TravelBoundHoldsAndIsTight) {
               0.5 * std::numbers::pi / 2 * std::sqrt(32.0), 1e-12);
 }
 
+// The relative bound holds for every pair of points of the two boxes over every stretch: random
+// motions of both parts, and the same displacement applied to both (then slightly perturbed), near
+// the origin and a million millimetres out; and it is tight where it should be: two parts moved by
+// one displacement get the rounding only, a part against a still one its own travel or less.
+TEST(Motion, RelativeTravelBoundHolds) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);
+  auto random_pose = [&](const Vec3& c, double spread) {
+    return pose(Vec3(u(rng), u(rng), u(rng)), 3.0 * u(rng), c + spread * Vec3(u(rng), u(rng), u(rng)));
+  };
+  int checked = 0;
+  for (double offset : {0.0, 1e3, 1e6})
+    for (int k = 0; k < 300; ++k) {
+      const Vec3 c(offset * u(rng), offset * u(rng), offset * u(rng));
+      const Pose a0 = random_pose(c, 20.0), b0 = random_pose(c, 20.0);
+      Pose a1, b1;
+      if (k % 3 == 0) {  // independent motions
+        a1 = random_pose(c, 20.0);
+        b1 = random_pose(c, 20.0);
+      } else {  // one displacement (a turn about an axis up to 50 mm off), b's perturbed on every third
+        Pose m = Pose::Identity();
+        const Vec3 pivot = c + 50.0 * Vec3(u(rng), u(rng), u(rng));
+        m.translate(pivot);
+        m.rotate(Eigen::AngleAxisd(std::numbers::pi * unit(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
+        m.translate(-pivot + Vec3(u(rng), u(rng), u(rng)));
+        a1 = m * a0;
+        b1 = m * b0;
+        if (k % 3 == 2) b1 = Pose(b1 * pose(Vec3(u(rng), u(rng), u(rng)), 1e-3 * u(rng), 1e-3 * Vec3(u(rng), u(rng), u(rng))));
+      }
+      const Aabb box_a(Vec3(-5, -3, -1), Vec3(4, 6, 2) + Vec3(unit(rng), unit(rng), unit(rng)));
+      const Aabb box_b(Vec3(-2, -2, -2) + Vec3(u(rng), u(rng), u(rng)), Vec3(3, 1, 5));
+      double s0 = unit(rng), s1 = unit(rng);
+      if (s0 > s1) std::swap(s0, s1);
+      const double bound = relative_travel_bound(a0, a1, box_a, b0, b1, box_b, s0, s1);
+      if (k % 3 == 1) {
+        EXPECT_LT(bound, 1e-9 * (1.0 + offset)) << offset << ' ' << k;
+      }
+      const Pose pa0 = interpolate_pose(a0, a1, s0), pb0 = interpolate_pose(b0, b1, s0);
+      for (int i = 0; i < 10; ++i) {
+        const double s = s0 + (s1 - s0) * unit(rng);
+        const Pose pa = interpolate_pose(a0, a1, s), pb = interpolate_pose(b0, b1, s);
+        for (int j = 0; j < 16; ++j) {
+          const Vec3 p = j < 8 ? box_a.corner(static_cast<Aabb::CornerType>(j))
+                               : Vec3(box_a.min() + box_a.sizes().cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+          const Vec3 q = j < 8 ? box_b.corner(static_cast<Aabb::CornerType>((j + 3) % 8))
+                               : Vec3(box_b.min() + box_b.sizes().cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+          const double now = (pb * q - pa * p).norm(), then = (pb0 * q - pa0 * p).norm();
+          EXPECT_LE(std::abs(now - then), bound) << offset << ' ' << k;
+          ++checked;
+        }
+      }
+    }
+  EXPECT_GT(checked, 100000);
+  // A part moving against a still one: no more than its own travel (plus the still side's rounding).
+  const Pose id = Pose::Identity(), moved = pose(Vec3::UnitZ(), 0.0, Vec3(3, 4, 0));
+  const Aabb box(Vec3(-1, -1, -1), Vec3(1, 1, 1));
+  EXPECT_NEAR(relative_travel_bound(id, id, box, id, moved, box, 0.0, 1.0), 5.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace cadclash

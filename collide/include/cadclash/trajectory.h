@@ -73,6 +73,16 @@ double motion_angle(const Pose& a, const Pose& b);
 // same point placed by interpolate_pose(a, b, s0). Preconditions: 0 <= s0 <= s1 <= 1; box not empty.
 double travel_bound(const Pose& a, const Pose& b, const Aabb& box, double s0, double s1);
 
+// An upper bound on how much the distance between a point of `box_a` (a part-local box of a part
+// moving from pose a0 to a1) and a point of `box_b` (another's, from b0 to b1) changes while s runs
+// over [s0, s1] of both motions: how fast b's points move relative to a's, from the difference of
+// the two screws' velocity fields over b's reach. Parts moved by one displacement (a sub-assembly
+// pulled out or turned as a whole) get their poses' rounding only, where each travel_bound is the
+// whole motion's. Computed with its rounding, as travel_bound. Preconditions: 0 <= s0 <= s1 <= 1;
+// boxes not empty.
+double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, const Pose& b0, const Pose& b1,
+                             const Aabb& box_b, double s0, double s1);
+
 // One stretch of motion checked continuously: the instances `moving` go from poses `from` to `to`
 // (interpolate_pose; the others stay where the scene has them), and every instance pair the scene
 // checks is proved out of contact over the whole stretch or listed with the parts of it where it
