@@ -267,15 +267,45 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       }
     return contacts_of(detail::restricted_check(scene, o, keys ? &only : nullptr), certified, keys);
   };
-  // The static checks at T, by s and the pairs they are about (empty: all).
-  std::map<std::pair<double, std::set<PairKey>>, Contacts> at;
-  if (motion.at_start) at.emplace(std::pair{0.0, std::set<PairKey>{}}, contacts_of(*motion.at_start, certified, nullptr));
-  if (motion.at_end) at.emplace(std::pair{1.0, std::set<PairKey>{}}, contacts_of(*motion.at_end, certified, nullptr));
-  auto contacts_at = [&](double s, const std::set<PairKey>* keys) -> const Contacts& {
-    std::pair<double, std::set<PairKey>> key{s, keys ? *keys : std::set<PairKey>{}};
-    auto it = at.find(key);
-    if (it == at.end()) it = at.emplace(std::move(key), check(s, options.tolerance, keys)).first;
-    return it->second;
+  // What the static checks at T found, by s: the pairs examined there (all, or some), those of them
+  // in contact, and those open. A pair's answer depends on that pair alone (restricted_check.h),
+  // and an instance pair's on its surface pairs that may be in contact there, all of which the
+  // stretch asking has (the others were proved apart, or settled with it, over a stretch holding
+  // s): so a pair examined at s by one stretch is known there for every later one.
+  struct AtS {
+    bool all = false;
+    std::set<PairKey> examined, contact, open;
+  };
+  std::map<double, AtS> at;
+  auto merge = [](AtS& into, const Contacts& c) {
+    into.contact.insert(c.contact.begin(), c.contact.end());
+    into.open.insert(c.open.begin(), c.open.end());
+  };
+  if (motion.at_start) at[0.0].all = true, merge(at[0.0], contacts_of(*motion.at_start, certified, nullptr));
+  if (motion.at_end) at[1.0].all = true, merge(at[1.0], contacts_of(*motion.at_end, certified, nullptr));
+  // The contacts at s of the pairs `keys` (null: all), checking those not examined there yet (an
+  // instance pair with all of its surface pairs the keys have, as a check of the keys would).
+  auto contacts_at = [&](double s, const std::set<PairKey>* keys) -> const AtS& {
+    AtS& known = at[s];
+    if (known.all) return known;
+    if (!keys) {
+      merge(known, check(s, options.tolerance, nullptr));
+      known.all = true;
+      return known;
+    }
+    std::set<PairKey> missing;
+    std::set<std::pair<InstanceId, InstanceId>> whole;
+    for (const PairKey& k : *keys)
+      if (!known.examined.count(k)) {
+        missing.insert(k);
+        if (std::get<2>(k) == kInvalidId) whole.insert({std::get<0>(k), std::get<1>(k)});
+      }
+    if (missing.empty()) return known;
+    for (const PairKey& k : *keys)
+      if (whole.count({std::get<0>(k), std::get<1>(k)})) missing.insert(k);
+    merge(known, check(s, options.tolerance, &missing));
+    known.examined.insert(missing.begin(), missing.end());
+    return known;
   };
   std::map<PairKey, std::vector<MotionSpan>> spans;
   // Depth first, the earlier half first: spans come out in ascending order. Each stretch carries
@@ -325,7 +355,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     std::set<PairKey> halve;
     // Only a pair that may touch in the middle can be in contact over the whole stretch: the checks
     // at its ends (at T) are run, once for the stretch, when such a pair is there.
-    const Contacts* ends[2] = {nullptr, nullptr};
+    const AtS* ends[2] = {nullptr, nullptr};
     auto in_contact_at = [&](int end, const PairKey& k) {
       if (!ends[end]) ends[end] = &contacts_at(end == 0 ? st.s0 : st.s1, st.all ? nullptr : &st.pairs);
       return ends[end]->contact.count(k) > 0;
