@@ -149,14 +149,17 @@ Report MpiCheck::check(Scene& scene, Model& model, const CollideOptions& options
 
 Report MpiCheck::check_everywhere(Scene& scene, Model& model, const CollideOptions& options) {
   Report r = check(scene, model, options);
-  // Seven numbers per pair (instances, surfaces, class, distance bounds' bits) and `complete` last,
-  // broadcast from rank 0.
+  // Nine numbers per pair (instances, surfaces, class, the bits of the distance bounds and of the
+  // surfaces' uncertainties: check_motion's margins are the bounds less the uncertainties) and
+  // `complete` last, broadcast from rank 0.
+  constexpr std::size_t kPer = 9;
   std::vector<std::uint64_t> packed;
   if (rank_ == 0) {
     for (const SurfacePairResult& p : r.pairs)
       packed.insert(packed.end(), {p.instance_a, p.instance_b, p.surface_a, p.surface_b,
                                    static_cast<std::uint64_t>(p.contact), std::bit_cast<std::uint64_t>(p.distance_lo),
-                                   std::bit_cast<std::uint64_t>(p.distance_hi)});
+                                   std::bit_cast<std::uint64_t>(p.distance_hi), std::bit_cast<std::uint64_t>(p.uncertainty_a),
+                                   std::bit_cast<std::uint64_t>(p.uncertainty_b)});
     packed.push_back(r.complete ? 1 : 0);
   }
   unsigned long long n = packed.size();
@@ -165,7 +168,7 @@ Report MpiCheck::check_everywhere(Scene& scene, Model& model, const CollideOptio
   MPI_Bcast(packed.data(), static_cast<int>(n), MPI_UINT64_T, 0, MPI_COMM_WORLD);
   if (rank_ == 0) return r;
   Report thin;
-  for (std::size_t k = 0; k + 7 <= packed.size(); k += 7) {
+  for (std::size_t k = 0; k + kPer <= packed.size(); k += kPer) {
     SurfacePairResult p;
     p.instance_a = static_cast<InstanceId>(packed[k]);
     p.instance_b = static_cast<InstanceId>(packed[k + 1]);
@@ -174,6 +177,8 @@ Report MpiCheck::check_everywhere(Scene& scene, Model& model, const CollideOptio
     p.contact = static_cast<ContactClass>(packed[k + 4]);
     p.distance_lo = std::bit_cast<double>(packed[k + 5]);
     p.distance_hi = std::bit_cast<double>(packed[k + 6]);
+    p.uncertainty_a = std::bit_cast<double>(packed[k + 7]);
+    p.uncertainty_b = std::bit_cast<double>(packed[k + 8]);
     thin.pairs.push_back(p);
   }
   thin.complete = !packed.empty() && packed.back() == 1;

@@ -89,7 +89,8 @@ class MpiCheck {
   void note_files_read(std::size_t read_here, std::size_t files, double seconds);
   // Scene::check split over the ranks; the merged report on rank 0 (empty elsewhere).
   Report check(Scene& scene, Model& model, const CollideOptions& options);
-  // check() whose pairs (ids and classes) and `complete` reach every rank: the merged report on rank 0,
+  // check() whose pairs (ids, classes, distance bounds and uncertainties) and `complete` reach every
+  // rank: the merged report on rank 0,
   // a report of those pairs alone elsewhere. Collective. For searches every rank must take alike
   // (check --continuous: MotionOptions::check).
   Report check_everywhere(Scene& scene, Model& model, const CollideOptions& options);

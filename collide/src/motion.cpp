@@ -250,22 +250,28 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       scene.set_pose(moving[i], s == 0.0 ? from[i] : s == 1.0 ? to[i] : interpolate_pose(from[i], to[i], s));
   };
   const bool certified = options.decision != DecisionMode::Fast;
-  // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
-  // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
-  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys) {
+  const std::set<InstanceId> movers(moving.begin(), moving.end());
+  auto moves = [&](const PairKey& k) { return movers.count(std::get<0>(k)) > 0 || movers.count(std::get<1>(k)) > 0; };
+  // A check at s about the pairs `keys` (null: all; with `with_movers`, also every pair of a moving
+  // instance). Here it examines those pairs only; a distributed run's own check
+  // (MotionOptions::check) examines all, and the others are left out of its answer (those of a
+  // moving instance by the caller).
+  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys, bool with_movers = false) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    if (motion.check) return contacts_of(motion.check(scene, o), certified, keys);
+    if (motion.check) return contacts_of(motion.check(scene, o), certified, with_movers ? nullptr : keys);
     detail::CheckRestriction only;
+    if (with_movers) only.with = movers;
     if (keys)
       for (const auto& [a, b, sa, sb] : *keys) {
         auto& surfaces = only.pairs[{a, b}];
         if (sa != kInvalidId) surfaces.insert({sa, sb});
       }
-    return contacts_of(detail::restricted_check(scene, o, keys ? &only : nullptr), certified, keys);
+    return contacts_of(detail::restricted_check(scene, o, keys || with_movers ? &only : nullptr), certified,
+                       with_movers ? nullptr : keys);
   };
   // What the static checks at T found, by s: the pairs examined there (all, or some), those of them
   // in contact, and those open. A pair's answer depends on that pair alone (restricted_check.h),
@@ -308,8 +314,24 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     return known;
   };
   std::map<PairKey, std::vector<MotionSpan>> spans;
+  // Pairs of two instances that stay where they are keep their state over the stretch, the one at
+  // its ends: in contact at both, one span; else, when open at one, searched with the pairs of the
+  // moving instances (the search's first check is about those alone).
+  std::set<PairKey> still_open;
+  if (movers.size() < model.instances.size()) {
+    const AtS& start = contacts_at(0.0, nullptr);
+    const AtS& finish = contacts_at(1.0, nullptr);
+    std::set<PairKey> open = start.open;
+    open.insert(finish.open.begin(), finish.open.end());
+    for (const PairKey& k : open) {
+      if (moves(k)) continue;
+      if (start.contact.count(k) > 0 && finish.contact.count(k) > 0) spans[k].push_back({0.0, 1.0, true});
+      else still_open.insert(k);
+    }
+  }
   // Depth first, the earlier half first: spans come out in ascending order. Each stretch carries
-  // the pairs it still has to settle (all of them at the start: an empty set means all).
+  // the pairs it still has to settle (at the start, `all`: those of a moving instance and
+  // still_open).
   struct Stretch {
     double s0, s1;
     std::set<PairKey> pairs;
@@ -319,7 +341,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   while (!stack.empty()) {
     Stretch st = std::move(stack.back());
     stack.pop_back();
-    auto concerns = [&](const PairKey& k) { return st.all || st.pairs.count(k) > 0; };
+    auto concerns = [&](const PairKey& k) { return st.all ? moves(k) || still_open.count(k) > 0 : st.pairs.count(k) > 0; };
     const bool budget = out.checks + 3 <= motion.max_checks;
     std::set<PairKey> suspect;
     Contacts grown;
@@ -327,7 +349,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       // Checked in the middle of the stretch: every pose of it is within half its travel of there.
       const double mid = 0.5 * (st.s0 + st.s1);
       auto half = [&](const auto& travel) { return std::max(travel(st.s0, mid), travel(mid, st.s1)); };
-      grown = check(mid, options.tolerance + half(travel_over), st.all ? nullptr : &st.pairs);
+      grown = check(mid, options.tolerance + half(travel_over), st.all ? &still_open : &st.pairs, st.all);
       if (grown.complete) {
         // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound
@@ -348,7 +370,9 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       out.complete = false;
       std::set<PairKey> keep = st.pairs;
       if (st.all)
-        for (const auto& [s, c] : at) keep.insert(c.open.begin(), c.open.end());
+        for (const auto& [s, c] : at)
+          for (const PairKey& k : c.open)
+            if (concerns(k)) keep.insert(k);
       for (const PairKey& k : keep) spans[k].push_back({st.s0, st.s1, false});
       continue;
     }
@@ -367,9 +391,29 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       else halve.insert(k);
     }
     if (halve.empty()) continue;
+    // Conservative advancement around the middle: a pair proved apart there by more than T stays
+    // apart while its two sides travel less than that; when every pair halved is, the halves leave
+    // out the part of the stretch around the middle where all of them are (each half then has
+    // less travel, and a pair approaching or leaving contact gets there in fewer checks).
     const double mid = 0.5 * (st.s0 + st.s1);
-    stack.push_back({mid, st.s1, halve, false});
-    stack.push_back({st.s0, mid, std::move(halve), false});
+    double r = 0.5 * (st.s1 - st.s0);
+    for (const PairKey& k : halve) {
+      const double room = grown.margin.at(k) - options.tolerance;
+      if (!(room > 0.0)) {
+        r = 0.0;
+        break;
+      }
+      const InstanceId a = std::get<0>(k), b = std::get<1>(k);
+      // The travel is affine in the width of the stretch: its rate and what it is over none.
+      const double none = pair_travel(a, b, mid, mid), rate = pair_travel(a, b, 0.0, 1.0) - none;
+      double free = rate > 0.0 ? std::min(r, (1.0 - 1e-6) * (room - none) / rate) : r;
+      // Checked as the grown check clears a pair, halved where the rounding says otherwise.
+      for (int tries = 0; free > 0.0 && !(pair_travel(a, b, mid - free, mid) < room && pair_travel(a, b, mid, mid + free) < room); ++tries)
+        free = tries < 8 ? 0.5 * free : 0.0;
+      r = std::min(r, std::max(free, 0.0));
+    }
+    if (mid + r < st.s1) stack.push_back({mid + r, st.s1, halve, false});
+    if (st.s0 < mid - r) stack.push_back({st.s0, mid - r, std::move(halve), false});
   }
   std::map<std::pair<InstanceId, InstanceId>, PairMotion> by_pair;
   if (options.clearance > 0.0) {

@@ -200,6 +200,36 @@ TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
   (void)rod;
 }
 
+// A block resting on the plate stays while the cube falls through the plate beside it: the two
+// that stay are in contact over the whole stretch, one span proved at its ends (their state is the
+// one at the stretch's ends; the search is about the moving cube's pairs), and the cube's pair
+// with the plate is found as alone.
+TEST(ContinuousMotion, PairsThatStayKeepTheirContact) {
+  PlateAndCube f;
+  const InstanceId block = add_instance(f.m, "/block", add_part(f.m, "block", box_surfaces(Vec3(15, 15, 1), Vec3(18, 18, 3), 2)));
+  Scene scene(f.m);
+  const Pose from = translation(4, 4, 5), to = translation(4, 4, -5);
+  scene.set_pose(f.cube, from);
+  const InstanceId moving[] = {f.cube};
+  const Pose a[] = {from}, b[] = {to};
+  const MotionResult r = check_motion(scene, f.m, moving, a, b, {}, {});
+  EXPECT_TRUE(r.complete);
+  ASSERT_EQ(r.pairs.size(), 2u);
+  const PairMotion& resting = r.pairs[0].b == block ? r.pairs[0] : r.pairs[1];
+  const PairMotion& falling = r.pairs[0].b == block ? r.pairs[1] : r.pairs[0];
+  EXPECT_EQ(resting.a, f.plate);
+  EXPECT_EQ(resting.b, block);
+  ASSERT_EQ(resting.spans.size(), 1u);
+  EXPECT_EQ(resting.spans[0].s0, 0.0);
+  EXPECT_EQ(resting.spans[0].s1, 1.0);
+  EXPECT_TRUE(resting.spans[0].contact_at_ends);
+  EXPECT_FALSE(resting.surfaces.empty());
+  EXPECT_EQ(falling.b, f.cube);
+  bool mid = false;  // at s = 0.5 the cube (z in [0, 2]) lies across the plate
+  for (const MotionSpan& sp : falling.spans) mid |= sp.s0 <= 0.5 && 0.5 <= sp.s1;
+  EXPECT_TRUE(mid);
+}
+
 // Two cubes fly at each other and through each other within one stretch: each moves 20 mm, so a
 // stretch is cleared only when their distance exceeds both travels together. They overlap for s in
 // [0.45, 0.55] (faces meet at -8 + 20 s = 10 - 20 s); the spans must cover it.

@@ -211,7 +211,9 @@ async function contactCase(browser, a, out, csv) {
     const first = await page.evaluate(() => window.cadclashViewer.path.state());
     check(first.time === path.steps.at(-1), `the page opens at t = ${first.time}, expected the last step`);
     // Inside the contact span, between two steps (the box moves in x, y and z there).
-    const tContact = Math.max(contact.t0 + 0.4 * (contact.t1 - contact.t0), 1.2);
+    // Times with a few digits: a range input gives back its value in fewer digits than a double's.
+    const round6 = (t) => Math.round(t * 1e6) / 1e6;
+    const tContact = round6(Math.max(contact.t0 + 0.4 * (contact.t1 - contact.t0), 1.2));
     check(tContact < contact.t1 && !Number.isInteger(tContact), `no time inside ${JSON.stringify(contact)} between steps`);
     let state = await slideTo(page, tContact);
     await checkColoured(page, report, state, tContact, 'inside the contact span');
@@ -219,7 +221,8 @@ async function contactCase(browser, a, out, csv) {
     checkPoses(state, path, tContact, 'inside the contact span');
     await page.screenshot({ path: join(out, 'viewer.png') });
     // The middle of the narrow span where the contact begins: "may begin or end here".
-    const tNarrow = (narrow.t0 + narrow.t1) / 2;
+    const tNarrow = round6((narrow.t0 + narrow.t1) / 2);
+    check(narrow.t0 < tNarrow && tNarrow < narrow.t1, `no six-digit time inside ${JSON.stringify(narrow)}`);
     state = await slideTo(page, tNarrow);
     await checkColoured(page, report, state, tNarrow, 'inside the narrow span');
     check(state.coloured.some((c) => c.state === 'may'), 'inside the narrow span nothing is coloured "may begin or end"');

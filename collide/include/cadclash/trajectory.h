@@ -90,12 +90,17 @@ double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, 
 // on the exact faces within T = tolerance + the faces' uncertainties); no time between two checks
 // is called free unless proved.
 //
-// How: a stretch [s0, s1] is free for a pair when the certified check at s0 with the tolerance grown
-// by the two largest travel_bounds of the moving instances over it proves the pair apart (each side
-// moves at most its own). Pairs it cannot clear are halved, down to `resolution`; a part of the
-// stretch where the pair is proved in contact at both ends is not halved further (in between it is
-// not proved either way). Contact that begins and ends between two steps, a part passing through a
-// thin plate, is found: such a stretch is never cleared.
+// How: a stretch [s0, s1] is free for a pair when the certified check in its middle with the
+// tolerance grown by the two largest travel_bounds of the moving instances over its halves proves
+// the pair apart by more than T plus the pair's own travel (travel_bound of each side, or
+// relative_travel_bound when both move). Pairs it cannot clear are halved, down to `resolution`;
+// when every pair halved is proved apart in the middle, the part around it where their travel stays
+// below that margin is left out of both halves (conservative advancement). A part of the stretch
+// where the pair is proved in contact at both ends is not halved further (in between it is not
+// proved either way). Contact that begins and ends between two steps, a part passing through a thin
+// plate, is found: such a stretch is never cleared. A pair of two instances that stay keeps the
+// state it has at the stretch's ends (one span when in contact at both); the search is about the
+// moving instances' pairs.
 // With options.clearance > 0 the pairs that come within the clearance somewhere also get their
 // closest approach (PairMotion::closest): a branch and bound over the stretch, each part of it
 // bounded below by the check at its start (with the clearance grown by the travel) less the
@@ -105,8 +110,9 @@ struct MotionOptions {
   double resolution = 1e-3;      // width of the spans a contact may begin or end in, as a fraction of the stretch (> 0)
   std::size_t max_checks = 4096;  // static checks at most; past it the open spans are listed as they are
   // How each static check runs; empty: Scene::check. A distributed run (cadclash check under mpirun)
-  // passes its own: it must return, on every process, reports with the same pairs (ids, classes and
-  // distance bounds) and the same `complete`, so that every process takes the same stretches.
+  // passes its own: it must return, on every process, reports with the same pairs (ids, classes,
+  // distance bounds and uncertainties) and the same `complete`, so that every process takes the same
+  // stretches.
   std::function<Report(Scene&, const CollideOptions&)> check;
   // The static checks a caller has made already at the stretch's ends (the moving instances at
   // `from`, and at `to`; the others where the scene has them), with options.tolerance and no
