@@ -241,6 +241,25 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     }
     return first + second;
   };
+  // The largest travel of the pairs a check is about: `keys` (null: any pair of a moving instance,
+  // against one that stays or another that moves). With many moving instances, the two largest.
+  constexpr std::size_t kPairwise = 64;
+  auto travel_of = [&](const std::set<PairKey>* keys, double s0, double s1) {
+    double worst = 0.0;
+    if (keys) {
+      std::set<std::pair<InstanceId, InstanceId>> seen;
+      for (const PairKey& k : *keys)
+        if (seen.insert({std::get<0>(k), std::get<1>(k)}).second)
+          worst = std::max(worst, pair_travel(std::get<0>(k), std::get<1>(k), s0, s1));
+      return worst;
+    }
+    if (moving.size() > kPairwise) return travel_over(s0, s1);
+    for (std::size_t i = 0; i < moving.size(); ++i) {
+      worst = std::max(worst, pair_travel(moving[i], kInvalidId, s0, s1));
+      for (std::size_t j = i + 1; j < moving.size(); ++j) worst = std::max(worst, pair_travel(moving[i], moving[j], s0, s1));
+    }
+    return worst;
+  };
   MotionResult out;
   // At the ends, the poses given (the steps' own, whose checks a path has made already); between
   // them interpolate_pose's, which differ from those at the ends by its rounding only (travel_bound
@@ -349,7 +368,10 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       // Checked in the middle of the stretch: every pose of it is within half its travel of there.
       const double mid = 0.5 * (st.s0 + st.s1);
       auto half = [&](const auto& travel) { return std::max(travel(st.s0, mid), travel(mid, st.s1)); };
-      grown = check(mid, options.tolerance + half(travel_over), st.all ? &still_open : &st.pairs, st.all);
+      // Grown by the largest travel of its pairs: a pair it leaves out is apart by more than T plus
+      // its own travel.
+      grown = check(mid, options.tolerance + half([&](double u0, double u1) { return travel_of(st.all ? nullptr : &st.pairs, u0, u1); }),
+                    st.all ? &still_open : &st.pairs, st.all);
       if (grown.complete) {
         // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound

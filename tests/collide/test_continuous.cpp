@@ -247,6 +247,23 @@ TEST(ContinuousMotion, TwoMovingPartsPassingThroughEachOtherAreFound) {
   expect_spans(r, 0.45, 0.55, 0.45 - 2 * mo.resolution, 0.55 + 2 * mo.resolution);
 }
 
+// Two cubes moving at each other meet late in the stretch: their faces touch at s = 11/12 (gap
+// 22 - 24 s). In the middle they are 10 mm apart, less than both travels over a half (12 mm) but
+// more than either's (6 mm): the first check must be grown by the pair's travel, not one part's.
+TEST(ContinuousMotion, TwoMovingPartsMeetingLateAreFound) {
+  Model m;
+  const PartId cube = add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2));
+  const InstanceId left = add_instance(m, "/left", cube), right = add_instance(m, "/right", cube);
+  Scene scene(m);
+  const InstanceId moving[] = {left, right};
+  const Pose from[] = {translation(-12, 0, 0), translation(12, 0, 0)}, to[] = {translation(0, 0, 0), translation(0, 0, 0)};
+  MotionOptions mo;
+  mo.resolution = 1e-3;
+  const MotionResult r = check_motion(scene, m, moving, from, to, {}, mo);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  expect_spans(r, 11.0 / 12.0, 1.0, 11.0 / 12.0 - 2 * mo.resolution, 1.0);
+}
+
 // A cube resting on the plate and sliding along it stays in contact: the stretch is listed with
 // contact proved at its ends, not halved down to the resolution, for the instance pair and for each
 // surface pair in contact (the plate's top against the cube's bottom and its four sides). The
