@@ -230,38 +230,36 @@ TEST(ContinuousMotion, PairsThatStayKeepTheirContact) {
   EXPECT_TRUE(mid);
 }
 
-// Two cubes fly at each other and through each other within one stretch: each moves 20 mm, so a
-// stretch is cleared only when their distance exceeds both travels together. They overlap for s in
-// [0.45, 0.55] (faces meet at -8 + 20 s = 10 - 20 s); the spans must cover it.
-TEST(ContinuousMotion, TwoMovingPartsPassingThroughEachOtherAreFound) {
+// Two 2 mm cubes, both moving along x: from x = from_left and from_right to to_left and to_right.
+MotionResult two_cubes_moving(double from_left, double from_right, double to_left, double to_right) {
   Model m;
   const PartId cube = add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2));
   const InstanceId left = add_instance(m, "/left", cube), right = add_instance(m, "/right", cube);
   Scene scene(m);
   const InstanceId moving[] = {left, right};
-  const Pose from[] = {translation(-10, 0, 0), translation(10, 0, 0)}, to[] = {translation(10, 0, 0), translation(-10, 0, 0)};
+  const Pose from[] = {translation(from_left, 0, 0), translation(from_right, 0, 0)};
+  const Pose to[] = {translation(to_left, 0, 0), translation(to_right, 0, 0)};
   MotionOptions mo;
   mo.resolution = 1e-3;
-  const MotionResult r = check_motion(scene, m, moving, from, to, {}, mo);
+  return check_motion(scene, m, moving, from, to, {}, mo);
+}
+
+// Two cubes fly at each other and through each other within one stretch: each moves 20 mm, so a
+// stretch is cleared only when their distance exceeds both travels together. They overlap for s in
+// [0.45, 0.55] (faces meet at -8 + 20 s = 10 - 20 s); the spans must cover it.
+TEST(ContinuousMotion, TwoMovingPartsPassingThroughEachOtherAreFound) {
+  const MotionResult r = two_cubes_moving(-10, 10, 10, -10);
   ASSERT_EQ(r.pairs.size(), 1u);
-  expect_spans(r, 0.45, 0.55, 0.45 - 2 * mo.resolution, 0.55 + 2 * mo.resolution);
+  expect_spans(r, 0.45, 0.55, 0.45 - 2e-3, 0.55 + 2e-3);
 }
 
 // Two cubes moving at each other meet late in the stretch: their faces touch at s = 11/12 (gap
 // 22 - 24 s). In the middle they are 10 mm apart, less than both travels over a half (12 mm) but
 // more than either's (6 mm): the first check must be grown by the pair's travel, not one part's.
 TEST(ContinuousMotion, TwoMovingPartsMeetingLateAreFound) {
-  Model m;
-  const PartId cube = add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2));
-  const InstanceId left = add_instance(m, "/left", cube), right = add_instance(m, "/right", cube);
-  Scene scene(m);
-  const InstanceId moving[] = {left, right};
-  const Pose from[] = {translation(-12, 0, 0), translation(12, 0, 0)}, to[] = {translation(0, 0, 0), translation(0, 0, 0)};
-  MotionOptions mo;
-  mo.resolution = 1e-3;
-  const MotionResult r = check_motion(scene, m, moving, from, to, {}, mo);
+  const MotionResult r = two_cubes_moving(-12, 12, 0, 0);
   ASSERT_EQ(r.pairs.size(), 1u);
-  expect_spans(r, 11.0 / 12.0, 1.0, 11.0 / 12.0 - 2 * mo.resolution, 1.0);
+  expect_spans(r, 11.0 / 12.0, 1.0, 11.0 / 12.0 - 2e-3, 1.0);
 }
 
 // A cube resting on the plate and sliding along it stays in contact: the stretch is listed with
