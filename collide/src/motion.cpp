@@ -271,26 +271,22 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   const bool certified = options.decision != DecisionMode::Fast;
   const std::set<InstanceId> movers(moving.begin(), moving.end());
   auto moves = [&](const PairKey& k) { return movers.count(std::get<0>(k)) > 0 || movers.count(std::get<1>(k)) > 0; };
-  // A check at s about the pairs `keys` (null: all; with `with_movers`, also every pair of a moving
-  // instance). Here it examines those pairs only; a distributed run's own check
-  // (MotionOptions::check) examines all, and the others are left out of its answer (those of a
-  // moving instance by the caller).
-  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys, bool with_movers = false) {
+  // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
+  // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
+  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
     ++out.checks;
-    if (motion.check) return contacts_of(motion.check(scene, o), certified, with_movers ? nullptr : keys);
+    if (motion.check) return contacts_of(motion.check(scene, o), certified, keys);
     detail::CheckRestriction only;
-    if (with_movers) only.with = movers;
     if (keys)
       for (const auto& [a, b, sa, sb] : *keys) {
         auto& surfaces = only.pairs[{a, b}];
         if (sa != kInvalidId) surfaces.insert({sa, sb});
       }
-    return contacts_of(detail::restricted_check(scene, o, keys || with_movers ? &only : nullptr), certified,
-                       with_movers ? nullptr : keys);
+    return contacts_of(detail::restricted_check(scene, o, keys ? &only : nullptr), certified, keys);
   };
   // What the static checks at T found, by s: the pairs examined there (all, or some), those of them
   // in contact, and those open. A pair's answer depends on that pair alone (restricted_check.h),
@@ -335,7 +331,8 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   std::map<PairKey, std::vector<MotionSpan>> spans;
   // Pairs of two instances that stay where they are keep their state over the stretch, the one at
   // its ends: in contact at both, one span; else, when open at one, searched with the pairs of the
-  // moving instances (the search's first check is about those alone).
+  // moving instances. (The search's first check still examines every pair, as a distributed run's
+  // does: a lazy model then meshes the same faces either way, and the reports say so alike.)
   std::set<PairKey> still_open;
   if (movers.size() < model.instances.size()) {
     const AtS& start = contacts_at(0.0, nullptr);
@@ -371,7 +368,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       // Grown by the largest travel of its pairs: a pair it leaves out is apart by more than T plus
       // its own travel.
       grown = check(mid, options.tolerance + half([&](double u0, double u1) { return travel_of(st.all ? nullptr : &st.pairs, u0, u1); }),
-                    st.all ? &still_open : &st.pairs, st.all);
+                    st.all ? nullptr : &st.pairs);
       if (grown.complete) {
         // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound

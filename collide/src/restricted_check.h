@@ -9,8 +9,7 @@
 namespace cadclash::detail {
 
 // Scene::check(o) restricted to `only` (its instance pairs that the broad phase finds, and of each
-// the surface pairs it names that the surface level finds, all of them for a pair with an instance
-// of only->with; their containment as check() tests it),
+// the surface pairs it names that the surface level finds; their containment as check() tests it),
 // without the depth step: a contact it would prove penetrating is reported touching.
 // `only` null: every pair, as check() (but the depth step).
 Report restricted_check(Scene& scene, const CollideOptions& o, const CheckRestriction* only);

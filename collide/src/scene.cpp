@@ -122,7 +122,7 @@ Report restricted_check(Scene& scene, const CollideOptions& o, const CheckRestri
   set_schedule(o.schedule);
   broad_phase_stage(s, q);
   if (only) {
-    std::erase_if(q.pairs, [&](const InstancePair& ip) { return !only->whole(ip.a, ip.b) && !only->pairs.count({ip.a, ip.b}); });
+    std::erase_if(q.pairs, [&](const InstancePair& ip) { return !only->pairs.count({ip.a, ip.b}); });
     q.report.counters.instance_pairs = q.pairs.size();
   }
   q.report.timings.broad = seconds_since(q.t0);

@@ -135,9 +135,6 @@ struct CheckRestriction {
   // Per instance pair (a < b): the surface pairs (of a's part, of b's) examined; its containment is
   // tested as check() tests it.
   std::map<std::pair<InstanceId, InstanceId>, std::set<std::pair<SurfaceId, SurfaceId>>> pairs;
-  // And every instance pair with one of these instances, whole (all its surface pairs).
-  std::set<InstanceId> with;
-  bool whole(InstanceId a, InstanceId b) const { return with.count(a) > 0 || with.count(b) > 0; }
 };
 
 struct QueryState {

@@ -36,7 +36,7 @@ void surface_pairs(const SceneData& s, InstancePair& ip, const CollideOptions& o
 void surface_level(const SceneData& s, InstancePair& ip, const CollideOptions& o, const std::vector<double>& part_share,
                    const CheckRestriction* only) {
   surface_pairs(s, ip, o, part_share);
-  if (only == nullptr || only->whole(ip.a, ip.b)) return;
+  if (only == nullptr) return;
   const auto it = only->pairs.find({ip.a, ip.b});
   std::erase_if(ip.candidates, [&](const std::array<SurfaceId, 2>& c) {
     return it == only->pairs.end() || !it->second.count({c[0], c[1]});

@@ -143,14 +143,18 @@ TEST(MpiCli, As1EightRanksSameReportAndTable) {
   }
 }
 
-// The rod of as1 moved over eight steps (CSV written from the imported poses), at a coarse deflection.
-std::string as1_trajectory_csv() {
+// The rod of as1 and its first nut moved over eight steps, each turning a little more about x (CSV
+// written from the imported poses), at a coarse deflection. `by_step`: the first three steps, the
+// rows in step order (a continuous check's: every check of its motion is distributed), else
+// instance by instance.
+std::string as1_trajectory_csv(bool by_step = false) {
   const ImportResult as1 = import_file(as1_path());
   std::ostringstream csv;
   csv << "step,instance_path,tx,ty,tz,qw,qx,qy,qz\n";
+  for (int outer = 0; outer < (by_step ? 3 : 1); ++outer)
   for (const Instance& i : as1.model.instances) {
     if (i.path != "/as1/ROD-ASSEMBLY/ROD" && i.path != "/as1/ROD-ASSEMBLY/NUT::1") continue;
-    for (int step = 0; step < 8; ++step) {
+    for (int step = by_step ? outer : 0; step < (by_step ? outer + 1 : 8); ++step) {
       Pose p = i.pose;
       p.pretranslate(Vec3(0.0, 0.0, (i.path.back() == 'D' ? 3.0 : -2.0) * step));
       p.rotate(Eigen::AngleAxisd(0.04 * step, Vec3::UnitX()));
@@ -160,7 +164,7 @@ std::string as1_trajectory_csv() {
           << p.translation().z() << ',' << q.w() << ',' << q.x() << ',' << q.y() << ',' << q.z() << '\n';
     }
   }
-  return testing::write_scratch_file("as1_path.csv", csv.str());
+  return testing::write_scratch_file(by_step ? "as1_path_by_step.csv" : "as1_path.csv", csv.str());
 }
 
 // Lazily tessellated: steps reuse faces other ranks tessellated.
@@ -175,8 +179,20 @@ TEST(MpiCli, ContinuousPathSameReport) {
   const std::string boxes = std::string(CADCLASH_DATA_DIR) + "/collide/";
   expect_identical("check '" + boxes + "box_a.obj' '" + boxes + "box_near.obj' --path '" + boxes +
                        "path_ok.csv' --continuous --tolerance 0.01",
-                   false);
+                   true);
   EXPECT_NE(slurp(scratch("np4.json")).find("\"timeline\""), std::string::npos);
+}
+
+// --continuous on real parts that turn between steps (each stretch a screw about a far axis), the
+// HTML page with its time slider too: the same bytes for 1, 2 and 4 ranks as in one process.
+TEST(MpiCli, As1ContinuousTurningPathSameReportAndPage) {
+  REQUIRE_AS1();
+  expect_identical("check '" + as1_path() + "' --lazy --deflection 2 --path '" + as1_trajectory_csv(true) +
+                       "' --continuous --time-resolution 0.01",
+                   true);
+  const std::string json = slurp(scratch("np4.json"));
+  EXPECT_NE(json.find("\"timeline\""), std::string::npos);
+  EXPECT_NE(json.find("\"steps_not_checked\": 0"), std::string::npos);  // every step checked (ascending)
 }
 
 // Part meshing: steps reach parts the rank has not meshed yet; the plan uses the deflections other
