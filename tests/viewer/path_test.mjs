@@ -282,6 +282,39 @@ async function turnCase(browser, a, out) {
   }
 }
 
+// box_a and box_touch touch and stay; box_near moves beside them, touching nothing. The timeline holds
+// the pair that stays (in contact over the whole path): by default the page lists and colours only
+// pairs with a part the path moves, so nothing; unticking the choice lists it and colours its faces.
+async function stillCase(browser, a, out) {
+  const csv = join(out, 'path_still.csv');
+  writeFileSync(csv, ['step,instance_path,tx,ty,tz,qw,qx,qy,qz', '0,/box_near.obj/box_near,0,2,0,1,0,0,0',
+                      '1,/box_near.obj/box_near,-0.5,2,0,1,0,0,0'].join('\n') + '\n');
+  const json = join(out, 'report.json'), html = join(out, 'report.html');
+  cadclash(a.cadclash, ['check', join(a.data, 'box_a.obj'), join(a.data, 'box_touch.obj'), join(a.data, 'box_near.obj'),
+                        '--path', csv, '--continuous', '--tolerance', '0.01', '--no-timings', '--json', json, '--html', html]);
+  const report = JSON.parse(readFileSync(json, 'utf8'));
+  const pairs = report.timeline.pairs;
+  check(pairs.length === 1 && !pairs.some((p) => (p.a + p.b).includes('box_near')),
+        `expected the timeline to hold box_a x box_touch alone: ${pairs.map((p) => p.a + ' x ' + p.b)}`);
+  const page = await openPage(browser, html);
+  try {
+    const shown = () => page.$$eval('#timeline-pairs tr[data-pair]', (trs) => trs.filter((tr) => !tr.hidden).length);
+    check(await page.isChecked('#timeline-moving'), 'the choice of pairs with a moving part is missing or not ticked');
+    let state = await slideTo(page, 0.5);
+    check(await shown() === 0, `${await shown()} rows of the pair that stays are listed by default`);
+    check(state.coloured.length === 0, `the pair that stays is coloured by default: ${state.coloured.length} surfaces`);
+    check(await colouredPixels(page) === 0, 'coloured pixels with only the pair that stays in contact');
+    await page.uncheck('#timeline-moving');
+    state = await slideTo(page, 0.25);
+    check(await shown() === pairs[0].surfaces.length, `${await shown()} rows listed once unticked, expected ${pairs[0].surfaces.length}`);
+    await checkColoured(page, report, state, 0.25, 'the pair that stays, shown');
+    check(state.coloured.some((c) => c.state === 'contact'), 'the pair that stays is not coloured in contact once shown');
+    console.log(`still: the pair that stays is hidden by default, listed and coloured (${state.coloured.length} surfaces) once unticked`);
+  } finally {
+    await page.close();
+  }
+}
+
 async function plainCase(browser, a, out, csv) {
   const json = join(out, 'report.json'), html = join(out, 'report.html'), alone = join(out, 'alone.json');
   const common = ['check', join(a.data, 'box_a.obj'), join(a.data, 'box_near.obj'), '--path', csv, '--tolerance', '0.01', '--no-timings'];
@@ -307,7 +340,7 @@ async function plainCase(browser, a, out, csv) {
 async function main() {
   const a = args();
   const csv = join(a.data, 'path_ok.csv');
-  for (const f of ['box_a.obj', 'box_near.obj', 'path_ok.csv'])
+  for (const f of ['box_a.obj', 'box_near.obj', 'box_touch.obj', 'path_ok.csv'])
     if (!existsSync(join(a.data, f))) {
       console.log(`SKIP: ${join(a.data, f)} is missing`);
       return 77;
@@ -319,7 +352,7 @@ async function main() {
   const browser = await chromium.launch({ executablePath: CHROMIUM, headless: true, args: CHROMIUM_ARGS });
   try {
     for (const [name, run] of [['path_contact', (o) => contactCase(browser, a, o, csv)], ['path_turn', (o) => turnCase(browser, a, o)],
-                               ['path_plain', (o) => plainCase(browser, a, o, csv)]]) {
+                               ['path_still', (o) => stillCase(browser, a, o)], ['path_plain', (o) => plainCase(browser, a, o, csv)]]) {
       console.log(`--- ${name}`);
       const out = resolve(a.out, name);
       rmSync(out, { recursive: true, force: true });

@@ -104,6 +104,24 @@ export class PathPlayer {
     this.steps = path.steps.map((s) => s.step);
     this.first = this.steps[0];
     this.last = this.steps[this.steps.length - 1];
+    // The instances the path moves: those its rows place at poses that change from one step to the
+    // next (a row may place an instance where it already is).
+    this.moves = new Set(path.moving.filter((_, i) =>
+      path.steps.some((st, k) => k > 0 && st.poses[i].some((c, j) => c !== path.steps[k - 1].poses[i][j]))));
+    // Whether the pairs of two instances the path does not move are left out (timeline list and
+    // colours): their contact lasts the whole path, and a review of a motion is about what moves.
+    this.movingOnly = true;
+  }
+
+  // Whether timeline pair p has an instance the path moves.
+  pairMoves(p) {
+    const pair = this.path.pairs[p];
+    return this.moves.has(pair.instance_a) || this.moves.has(pair.instance_b);
+  }
+
+  // Whether timeline pair p is shown (listed and coloured).
+  shown(p) {
+    return !this.movingOnly || this.pairMoves(p);
   }
 
   // The stretch of time t: [k, s] with steps[k] <= t and s the fraction done towards step k + 1
@@ -128,13 +146,16 @@ export class PathPlayer {
     return this.path.moving.map((instance, i) => ({ instance, pose: s > 0 ? interpolatePose(at[i], next[i], s) : at[i] }));
   }
 
-  // Per timeline surface pair, its state at time t: [{pair, surface, state}] for those not free.
+  // Per timeline surface pair shown, its state at time t: [{pair, surface, state}] for those not free.
   pairsAt(t) {
     const out = [];
-    this.path.pairs.forEach((pair, p) => pair.surfaces.forEach((sp, k) => {
-      const state = spanState(sp.spans, t);
-      if (state) out.push({ pair: p, surface: k, state });
-    }));
+    this.path.pairs.forEach((pair, p) => {
+      if (!this.shown(p)) return;
+      pair.surfaces.forEach((sp, k) => {
+        const state = spanState(sp.spans, t);
+        if (state) out.push({ pair: p, surface: k, state });
+      });
+    });
     return out;
   }
 

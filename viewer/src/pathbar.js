@@ -53,24 +53,38 @@ export class PathBar {
     const rows = [];
     pairs.forEach((pair, p) => {
       const a = data.instances[pair.instance_a].path, b = data.instances[pair.instance_b].path;
-      rows.push(`<tr class="instance-pair"><td colspan="4" title="${escapeHtml(a + '\n' + b)}">` +
+      const moves = player.pairMoves(p) ? '1' : '0';
+      rows.push(`<tr class="instance-pair" data-moves="${moves}"><td colspan="4" title="${escapeHtml(a + '\n' + b)}">` +
                 `${escapeHtml(a)} × ${escapeHtml(b)}: ${this.spanLinks(pair.spans)}</td></tr>`);
       pair.surfaces.forEach((sp, k) => {
-        rows.push(`<tr data-pair="${p}" data-surface="${k}"><td class="state"><span class="chip"></span></td>` +
+        rows.push(`<tr data-pair="${p}" data-surface="${k}" data-moves="${moves}"><td class="state"><span class="chip"></span></td>` +
                   `<td>${sideText(data, pair.instance_a, sp.surface_a)}</td><td>${sideText(data, pair.instance_b, sp.surface_b)}</td>` +
                   `<td class="spans">${this.spanLinks(sp.spans)}</td></tr>`);
       });
     });
+    const moving = pairs.filter((_, p) => player.pairMoves(p)).length;
+    // A choice only when some pairs have no instance the path moves.
+    const movingOnly = moving === pairs.length ? '' :
+      ` <label><input id="timeline-moving" type="checkbox" checked> only the ${moving} of ${pairs.length} instance ` +
+      'pairs with a part the path moves</label> (the others keep their state over the whole path).';
     const partial = player.path.complete ? '' :
       ' <b>Partial:</b> a stretch ran out of its checks or the path was cut short; its open spans are listed whole.';
     list.innerHTML =
       `<div><b>Timeline</b>: ${count} surface pair${count === 1 ? '' : 's'} may touch between steps ${first} and ` +
       `${last}; at the shown time <span id="path-now"></span>. Spans in step numbers (~: where a contact may ` +
-      `begin or end, not proved); click one to go there, a row to frame its surfaces.${partial} ` +
+      `begin or end, not proved); click one to go there, a row to frame its surfaces.${movingOnly}${partial} ` +
       `The table below is the check at step ${last}.</div>` +
       `<div id="timeline-wrap"><table id="timeline-pairs"><tbody>${rows.join('')}</tbody></table></div>`;
     this.now = list.querySelector('#path-now');
     this.rows = [...list.querySelectorAll('tr[data-pair]')];
+    this.still = [...list.querySelectorAll('tr[data-moves="0"]')];
+    this.movingBox = list.querySelector('#timeline-moving');
+    const showMoving = () => {
+      player.movingOnly = !this.movingBox || this.movingBox.checked;
+      for (const tr of this.still) tr.hidden = player.movingOnly;
+    };
+    showMoving();
+    if (this.movingBox) this.movingBox.addEventListener('change', () => { showMoving(); this.setTime(this.time ?? last); });
     list.addEventListener('click', (e) => {
       const link = e.target.closest('a[data-t]');
       if (link) {
