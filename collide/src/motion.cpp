@@ -330,24 +330,20 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   };
   std::map<PairKey, std::vector<MotionSpan>> spans;
   // Pairs of two instances that stay where they are keep their state over the stretch, the one at
-  // its ends: in contact at both, one span; else, when open at one, searched with the pairs of the
-  // moving instances. (The search's first check still examines every pair, as a distributed run's
-  // does: a lazy model then meshes the same faces either way, and the reports say so alike.)
-  std::set<PairKey> still_open;
+  // its ends: in contact at both, one span proved at its ends; open but not so (undecided), one span
+  // not proved either way (halving cannot tell more). The search is about the moving instances'
+  // pairs. (Its first check still examines every pair, as a distributed run's does: a lazy model
+  // then meshes the same faces either way, and the reports say so alike.)
   if (movers.size() < model.instances.size()) {
     const AtS& start = contacts_at(0.0, nullptr);
     const AtS& finish = contacts_at(1.0, nullptr);
     std::set<PairKey> open = start.open;
     open.insert(finish.open.begin(), finish.open.end());
-    for (const PairKey& k : open) {
-      if (moves(k)) continue;
-      if (start.contact.count(k) > 0 && finish.contact.count(k) > 0) spans[k].push_back({0.0, 1.0, true});
-      else still_open.insert(k);
-    }
+    for (const PairKey& k : open)
+      if (!moves(k)) spans[k].push_back({0.0, 1.0, start.contact.count(k) > 0 && finish.contact.count(k) > 0});
   }
   // Depth first, the earlier half first: spans come out in ascending order. Each stretch carries
-  // the pairs it still has to settle (at the start, `all`: those of a moving instance and
-  // still_open).
+  // the pairs it still has to settle (at the start, `all`: those of a moving instance).
   struct Stretch {
     double s0, s1;
     std::set<PairKey> pairs;
@@ -357,7 +353,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   while (!stack.empty()) {
     Stretch st = std::move(stack.back());
     stack.pop_back();
-    auto concerns = [&](const PairKey& k) { return st.all ? moves(k) || still_open.count(k) > 0 : st.pairs.count(k) > 0; };
+    auto concerns = [&](const PairKey& k) { return st.all ? moves(k) : st.pairs.count(k) > 0; };
     const bool budget = out.checks + 3 <= motion.max_checks;
     std::set<PairKey> suspect;
     Contacts grown;

@@ -230,6 +230,44 @@ TEST(ContinuousMotion, PairsThatStayKeepTheirContact) {
   EXPECT_TRUE(mid);
 }
 
+// Two parts that stay and are undecided at the stretch's ends (a check hook reports them so, as a
+// budget or a face no certificate settles would): their state cannot change while they stay, so the
+// pair gets one span over the stretch, not proved either way, on a handful of checks (halving it
+// to the resolution would take thousands).
+TEST(ContinuousMotion, PairsThatStayUndecidedGetTheWholeStretch) {
+  PlateAndCube f;
+  const InstanceId block = add_instance(f.m, "/block", add_part(f.m, "block", box_surfaces(Vec3(15, 15, 1.5), Vec3(18, 18, 3), 2)));
+  Scene scene(f.m);
+  scene.set_pose(f.cube, translation(4, 4, 5));
+  MotionOptions mo;
+  mo.check = [&](Scene& sc, const CollideOptions& o) {
+    Report r = sc.check(o);
+    SurfacePairResult u;
+    u.instance_a = f.plate;
+    u.instance_b = block;
+    u.surface_a = f.m.parts[f.m.instances[f.plate].part].first_surface;
+    u.surface_b = f.m.parts[f.m.instances[block].part].first_surface;
+    u.contact = ContactClass::Undecided;
+    u.distance_lo = 0.0;
+    u.distance_hi = 0.5;
+    r.pairs.push_back(u);
+    return r;
+  };
+  const InstanceId moving[] = {f.cube};
+  const Pose a[] = {translation(4, 4, 5)}, b[] = {translation(4, 4, -5)};
+  const MotionResult r = check_motion(scene, f.m, moving, a, b, {}, mo);
+  EXPECT_TRUE(r.complete);
+  EXPECT_LT(r.checks, 200u);
+  const PairMotion* still = nullptr;
+  for (const PairMotion& p : r.pairs)
+    if (p.a == f.plate && p.b == block) still = &p;
+  ASSERT_NE(still, nullptr);
+  ASSERT_EQ(still->spans.size(), 1u);
+  EXPECT_EQ(still->spans[0].s0, 0.0);
+  EXPECT_EQ(still->spans[0].s1, 1.0);
+  EXPECT_FALSE(still->spans[0].contact_at_ends);
+}
+
 // Two 2 mm cubes, both moving along x: from x = from_left and from_right to to_left and to_right.
 MotionResult two_cubes_moving(double from_left, double from_right, double to_left, double to_right) {
   Model m;

@@ -99,8 +99,8 @@ double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, 
 // where the pair is proved in contact at both ends is not halved further (in between it is not
 // proved either way). Contact that begins and ends between two steps, a part passing through a thin
 // plate, is found: such a stretch is never cleared. A pair of two instances that stay keeps the
-// state it has at the stretch's ends (one span when in contact at both); the search is about the
-// moving instances' pairs.
+// state it has at the stretch's ends (one span, proved in contact at its ends or not); the search is
+// about the moving instances' pairs.
 // With options.clearance > 0 the pairs that come within the clearance somewhere also get their
 // closest approach (PairMotion::closest): a branch and bound over the stretch, each part of it
 // bounded below by the check at its start (with the clearance grown by the travel) less the
@@ -124,7 +124,8 @@ struct MotionOptions {
 struct MotionSpan {
   double s0 = 0.0, s1 = 0.0;
   // Proved in contact at s0 and at s1 (between: not proved either way); otherwise s1 - s0 <=
-  // resolution and a contact may begin, end or hold there (or the search stopped: MotionResult).
+  // resolution and a contact may begin, end or hold there (or the search stopped: MotionResult), or
+  // the pair's two instances do not move and it is undecided at the stretch's ends: the whole stretch.
   bool contact_at_ends = false;
 };
 struct SurfaceMotion {
