@@ -269,8 +269,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       scene.set_pose(moving[i], s == 0.0 ? from[i] : s == 1.0 ? to[i] : interpolate_pose(from[i], to[i], s));
   };
   const bool certified = options.decision != DecisionMode::Fast;
-  const std::set<InstanceId> movers(moving.begin(), moving.end());
-  auto moves = [&](const PairKey& k) { return movers.count(std::get<0>(k)) > 0 || movers.count(std::get<1>(k)) > 0; };
+  auto moves = [&](const PairKey& k) { return index.count(std::get<0>(k)) > 0 || index.count(std::get<1>(k)) > 0; };
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
   // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
   auto check = [&](double s, double tolerance, const std::set<PairKey>* keys) {
@@ -334,7 +333,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   // not proved either way (halving cannot tell more). The search is about the moving instances'
   // pairs. (Its first check still examines every pair, as a distributed run's does: a lazy model
   // then meshes the same faces either way, and the reports say so alike.)
-  if (movers.size() < model.instances.size()) {
+  if (index.size() < model.instances.size()) {
     const AtS& start = contacts_at(0.0, nullptr);
     const AtS& finish = contacts_at(1.0, nullptr);
     std::set<PairKey> open = start.open;
