@@ -105,6 +105,7 @@ def runs(file, tool):
             rows.append({"wall": float(w.read()), "rss_mb": int(r.read().split()[-1]) / 1024, "json": json.load(j),
                          "rc": int(open(f"{base}-{k}.rc").read()),
                          "tree_mb": int(open(f"{base}-{k}.pss").read()) / 1024})
+        rows[-1]["k"] = k
     rows.sort(key=lambda row: row["wall"])
     return rows[(repeats - 1) // 2], rows  # the median run (the lower one for an even count)
 
@@ -132,7 +133,11 @@ for f in files:
         one = {"wall_s": o["wall"], "walls_s": [r["wall"] for r in o_all], "import_s": oimp["total"],
                "efficiency": o["wall"] / (int(cores) * c["wall"]), "import_efficiency": oimp["total"] / (int(cores) * imp["total"])}
     cad["processes"] = imp.get("processes", 1)
-    results.append({"file": f, "size_bytes": size, "cadclash": cad, "cadclash_one_thread": one, "peer": per,
+    # Which round each tool's median run was (runs/FILE-TOOL-K.json; scripts/import_core_model.py).
+    medians = {"cadclash": c["k"], "peer": p["k"]}
+    if one:
+        medians["cadclash1"] = o["k"]
+    results.append({"file": f, "size_bytes": size, "median_runs": medians, "cadclash": cad, "cadclash_one_thread": one, "peer": per,
                     "mb_per_s": {"cadclash": size / 1e6 / cad["wall_s"], "peer": size / 1e6 / per["wall_s"]},
                     "peer_over_cadclash": {"wall": per["wall_s"] / cad["wall_s"], "import": per["total_s"] / cad["import_s"]}})
 
@@ -195,4 +200,6 @@ plot "$out/import_time.dat" using 1:2 with linespoints lw 2 title "cadclash chec
      "" using 1:10 with lines dt 4 title "OCCT mesh"
 GP
 fi
+# The model of more cores from the median runs' measured costs (appended to results.md).
+python3 "$root/scripts/import_core_model.py" "$out"
 cat "$out/results.md"

@@ -11,8 +11,21 @@ ReportImport import_report(const ImportResult& imported) {
   out.seconds = imported.seconds;
   for (const FileImport& f : imported.files) {
     const ImportTimings& t = f.timings;
-    out.files.push_back({f.path, cache_use_name(f.cache), t.read, t.transfer, t.heal, t.tessellate, t.total,
-                         f.transfer_workers, f.pieces, f.pieces_cached, f.parts_cached});
+    ReportFileImport& r = out.files.emplace_back();
+    r.file = f.path;
+    r.cache = cache_use_name(f.cache);
+    r.read = t.read;
+    r.transfer = t.transfer;
+    r.heal = t.heal;
+    r.tessellate = t.tessellate;
+    r.total = t.total;
+    r.processes = f.transfer_workers;
+    r.pieces = f.pieces;
+    r.pieces_cached = f.pieces_cached;
+    r.parts_cached = f.parts_cached;
+    if (const PieceCosts& c = f.piece_costs; !c.bytes.empty())
+      r.piece_costs = ReportPieceCosts{c.split, c.main_parse, c.workers, {c.bytes.begin(), c.bytes.end()}, c.seconds};
+    r.part_heal_seconds = f.part_heal_seconds;
   }
   return out;
 }

@@ -112,6 +112,14 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(t.split_failed ? 1 : 0);
   w.u64(t.pieces);
   w.u64(t.pieces_cached);
+  w.f64(t.piece_costs.split);
+  w.f64(t.piece_costs.main_parse);
+  w.f64(t.piece_costs.workers);
+  w.u64(t.piece_costs.bytes.size());
+  for (std::size_t p = 0; p < t.piece_costs.bytes.size(); ++p) {
+    w.u64(t.piece_costs.bytes[p]);
+    w.f64(t.piece_costs.seconds[p]);
+  }
   write_component_placements(w, t.placements);
   if (!t.doc.IsNull()) {
     w.u64(1);
@@ -170,6 +178,15 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.split_failed = r.u64() == 1;
   t.pieces = r.u64();
   t.pieces_cached = r.u64();
+  t.piece_costs.split = r.f64();
+  t.piece_costs.main_parse = r.f64();
+  t.piece_costs.workers = r.f64();
+  t.piece_costs.bytes.resize(r.ok ? r.count(16) : 0);
+  t.piece_costs.seconds.resize(t.piece_costs.bytes.size());
+  for (std::size_t p = 0; p < t.piece_costs.bytes.size(); ++p) {
+    t.piece_costs.bytes[p] = r.u64();
+    t.piece_costs.seconds[p] = r.f64();
+  }
   t.unpacked = true;
   if (!read_component_placements(r, t.placements)) {
     why = "the placements are not whole";
@@ -258,10 +275,11 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   ImportResult result;
   result.diagnostics = std::move(t.diagnostics);
   result.complete = t.complete;
-  result.files.push_back(FileImport{path, CacheUse::Off, {}});
+  result.files.emplace_back().path = path;
   result.files.back().transfer_workers = t.parallel_workers;
   result.files.back().pieces = t.pieces;
   result.files.back().pieces_cached = t.pieces_cached;
+  result.files.back().piece_costs = std::move(t.piece_costs);
   ImportTimings& timings = result.files.back().timings;
   timings.read = t.read_seconds;
   BrepPartTimings part_timings;
@@ -296,6 +314,7 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   }
   apply_declared_uncertainty(result.model, t.declared_uncertainty, options.uncertainty);
   timings.heal = part_timings.heal;
+  result.files.back().part_heal_seconds = std::move(part_timings.part_heal);
   timings.tessellate = part_timings.tessellate;
   return result;
 }

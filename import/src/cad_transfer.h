@@ -37,6 +37,7 @@ struct Transfer {
   double split_seconds = 0.0;  // from the start of reading until the pieces' workers started (not sent back)
   // The text cut into this many pieces (0: not cut), of which the import cache held this many.
   std::size_t pieces = 0, pieces_cached = 0;
+  PieceCosts piece_costs;  // of a read in pieces (FileImport::piece_costs)
   // Products: an XCAF document (closed by the destructor) and the entities of its faces.
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;

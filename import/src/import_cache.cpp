@@ -451,7 +451,9 @@ std::optional<ImportResult> placed_import(const std::string& path, const ImportO
   if (!file.payload || !load_file_entry(*file.payload, options, placed, why, record.get()) ||
       placed.model.instances.size() != plan.poses.size())
     return std::nullopt;
-  placed.files.assign(1, FileImport{path, CacheUse::Placements, {}});
+  placed.files.assign(1, FileImport{});
+  placed.files.back().path = path;
+  placed.files.back().cache = CacheUse::Placements;
   if (options.lazy) {  // triangles a check makes go to the entries the parts came from
     record->file = record_entry(plan.file_key, placed);
     placed.files.back().cache_record = std::move(record);
@@ -497,7 +499,9 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     record->max_bytes = options.cache_max_bytes;
     const auto payload = entry_payload(*stored, key, why);
     if (payload && load_file_entry(*payload, options, hit, why, record.get())) {
-      hit.files.assign(1, FileImport{path, CacheUse::Hit, {}});
+      hit.files.assign(1, FileImport{});
+      hit.files.back().path = path;
+      hit.files.back().cache = CacheUse::Hit;
       hit.files.back().timings.read = seconds_since(load_start);
       mark_used(entry.string());
       prune_cache(options.cache_dir, options.cache_max_bytes);

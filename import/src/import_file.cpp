@@ -87,7 +87,7 @@ ImportResult import_one(const std::string& path, const ImportOptions& options) {
       }
     }
     if (r.files.empty()) {  // a mesh file, or a CAD file that could not be opened: reading is all
-      r.files.push_back(FileImport{path, CacheUse::Off, {}});
+      r.files.emplace_back().path = path;
       r.files.back().timings.read = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     }
     return r;

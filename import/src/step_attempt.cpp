@@ -38,6 +38,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <future>
 #include <optional>
@@ -139,16 +140,30 @@ struct SplitRead {
   std::optional<Children> workers;
   std::string cache_dir;  // empty: no cache
   std::size_t cached = 0;
+  std::chrono::steady_clock::time_point started;  // when the workers were forked
+  PieceCosts costs;
 };
 
-// In a worker: each piece of `share` read in turn, their bytes one after another; "" when one failed.
+// CPU seconds of the calling thread (a worker's only thread): what a piece costs wherever it runs.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// In a worker: each piece of `share` read in turn, their bytes one after another, then each one's
+// CPU seconds; "" when one failed.
 std::string read_step_pieces(const std::string& path, const std::vector<StepPiece>& pieces, const std::vector<std::size_t>& share) {
   ByteWriter w;
+  std::vector<double> seconds;
   for (const std::size_t p : share) {
+    const double start = thread_cpu_seconds();
     const std::string bytes = read_step_piece(path, pieces[p]);
     if (bytes.empty()) return {};
     w.str(bytes);
+    seconds.push_back(thread_cpu_seconds() - start);
   }
+  for (const double s : seconds) w.f64(s);
   return std::move(w.out);
 }
 
@@ -199,11 +214,13 @@ bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const
                  const EntityLabelFn& label, const std::string& path, ReadBindings& bound, std::vector<Diagnostic>& notes) {
   std::string why;
   const std::vector<ChildRun> runs = read.workers ? read.workers->wait() : std::vector<ChildRun>{};
+  if (read.workers) read.costs.workers = std::chrono::duration<double>(std::chrono::steady_clock::now() - read.started).count();
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const ChildRun& run = runs[k];
     if (!run.isolated || run.crashed || run.payload.empty()) return false;
     ByteReader r{run.payload};
     for (const std::size_t p : read.shares[k]) read.bytes[p] = r.str();
+    for (const std::size_t p : read.shares[k]) read.costs.seconds[p] = r.f64();
     if (!r.ok || r.at != run.payload.size()) return false;
   }
   for (std::size_t p = 0; p < read.bytes.size(); ++p) {
@@ -246,6 +263,7 @@ void transfer_products(STEPCAFControl_Reader& reader, const Handle(StepData_Step
     result.parallel_workers = std::max<std::size_t>(1, pieces->shares.size());
     result.pieces = pieces->split.pieces.size();
     result.pieces_cached = pieces->cached;
+    result.piece_costs = std::move(pieces->costs);
   } else if (run.attempt == Attempt::Whole && run.workers > 1) {
     const ParallelTransfer parallel = transfer_shapes_in_parallel(model, ws, run.workers);
     result.parallel_workers = parallel.used ? parallel.workers : 1;
@@ -437,7 +455,11 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
           else missing.push_back(p);
         }
         read.shares = share_pieces(read.split.pieces, missing, run.workers);
+        read.costs.seconds.assign(read.split.pieces.size(), 0.0);
+        for (const StepPiece& piece : read.split.pieces) read.costs.bytes.push_back(piece.bytes);
         text_checks.wait();  // no thread but this one when the workers are forked
+        read.started = std::chrono::steady_clock::now();
+        read.costs.split = std::chrono::duration<double>(read.started - read_start).count();
         if (!read.shares.empty())
           read.workers.emplace(read.shares.size(), [&](std::size_t k, const Mark&) {
             return read_step_pieces(path, read.split.pieces, read.shares[k]);
@@ -448,7 +470,9 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     IFSelect_ReturnStatus status;
     if (pieces) {
       std::istringstream main_text(pieces->split.main_text);
+      const double parse_start = thread_cpu_seconds();
       status = reader.ChangeReader().ReadStream(path.c_str(), main_text);
+      pieces->costs.main_parse = thread_cpu_seconds() - parse_start;
     } else {
       status = parse(reader, path, text, readable, result);
     }

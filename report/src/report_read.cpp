@@ -350,8 +350,8 @@ ReportImport read_import(const Json& j, const std::string& p) {
     ReportFileImport f;
     f.file = text(field(object(files[k], pk), pk, "file"), pk + "/file");
     f.cache = text(field(files[k], pk, "cache"), pk + "/cache");
-    if (f.cache != "off" && f.cache != "hit" && f.cache != "miss" && f.cache != "rebuilt")
-      fail(pk + "/cache", "expected \"off\", \"hit\", \"miss\" or \"rebuilt\"");
+    if (f.cache != "off" && f.cache != "hit" && f.cache != "miss" && f.cache != "rebuilt" && f.cache != "placements")
+      fail(pk + "/cache", "expected \"off\", \"hit\", \"miss\", \"rebuilt\" or \"placements\"");
     for (auto [name, member] : {std::pair{"read", &ReportFileImport::read}, {"transfer", &ReportFileImport::transfer},
                                 {"heal", &ReportFileImport::heal}, {"tessellate", &ReportFileImport::tessellate},
                                 {"total", &ReportFileImport::total}})
@@ -360,6 +360,27 @@ ReportImport read_import(const Json& j, const std::string& p) {
     for (auto [name, member] : {std::pair{"pieces", &ReportFileImport::pieces}, {"pieces_cached", &ReportFileImport::pieces_cached},
                                 {"parts_cached", &ReportFileImport::parts_cached}})
       if (files[k].contains(name)) f.*member = count(files[k][name], pk + "/" + name);  // since 2026-11-27
+    // Since 2026-11-29.
+    if (files[k].contains("piece_costs") && !files[k]["piece_costs"].is_null()) {
+      const std::string pc = pk + "/piece_costs";
+      const Json& c = object(files[k]["piece_costs"], pc);
+      ReportPieceCosts& costs = f.piece_costs.emplace();
+      costs.split = number(field(c, pc, "split"), pc + "/split");
+      costs.main_parse = number(field(c, pc, "main_parse"), pc + "/main_parse");
+      costs.workers = number(field(c, pc, "workers"), pc + "/workers");
+      const Json& bytes = array(field(c, pc, "bytes"), pc + "/bytes");
+      const Json& seconds = array(field(c, pc, "seconds"), pc + "/seconds");
+      if (bytes.size() != seconds.size()) fail(pc + "/seconds", "expected one per piece, as many as bytes");
+      for (std::size_t i = 0; i < bytes.size(); ++i) {
+        costs.bytes.push_back(count(bytes[i], pc + "/bytes/" + std::to_string(i)));
+        costs.seconds.push_back(number(seconds[i], pc + "/seconds/" + std::to_string(i)));
+      }
+    }
+    if (files[k].contains("part_heal_seconds")) {
+      const Json& heal = array(files[k]["part_heal_seconds"], pk + "/part_heal_seconds");
+      for (std::size_t i = 0; i < heal.size(); ++i)
+        f.part_heal_seconds.push_back(number(heal[i], pk + "/part_heal_seconds/" + std::to_string(i)));
+    }
     out.files.push_back(std::move(f));
   }
   return out;

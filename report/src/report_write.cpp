@@ -403,10 +403,16 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
   j["complete"] = r.complete;
   if (o.timings && r.import) {
     nlohmann::json files = nlohmann::json::array();
-    for (const ReportFileImport& f : r.import->files)
+    for (const ReportFileImport& f : r.import->files) {
+      nlohmann::json costs = nullptr;
+      if (const auto& c = f.piece_costs)
+        costs = {{"split", c->split}, {"main_parse", c->main_parse}, {"workers", c->workers}, {"bytes", c->bytes},
+                 {"seconds", c->seconds}};
       files.push_back({{"file", f.file}, {"cache", f.cache}, {"read", f.read}, {"transfer", f.transfer},
                        {"heal", f.heal}, {"tessellate", f.tessellate}, {"total", f.total}, {"processes", f.processes},
-                       {"pieces", f.pieces}, {"pieces_cached", f.pieces_cached}, {"parts_cached", f.parts_cached}});
+                       {"pieces", f.pieces}, {"pieces_cached", f.pieces_cached}, {"parts_cached", f.parts_cached},
+                       {"piece_costs", std::move(costs)}, {"part_heal_seconds", f.part_heal_seconds}});
+    }
     j["import_timings"] = {{"seconds", r.import->seconds}, {"files", std::move(files)}};
   }
   return j;

@@ -339,16 +339,22 @@ std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> 
   std::vector<PartWork> work(parts.size());
 
   const Clock::time_point heal_start = Clock::now();
+  std::vector<double> part_heal(parts.size(), 0.0);
   {
     detail::ProgressMeter meter(&options.progress, ProgressStage::CheckPart, parts.size(),
                                 parts.empty() ? std::string() : parts.front().name);
     for_each_part(parts.size(), in_parallel, [&](std::size_t k) {
+      const Clock::time_point part_start = Clock::now();
       prepare_part(parts[k], options, static_cast<PartId>(first_id + k), work[k]);
+      part_heal[k] = seconds_since(part_start);
       meter.add(1, parts[k].name);
     });
     meter.finish();
   }
-  if (timings) timings->heal += seconds_since(heal_start);
+  if (timings) {
+    timings->heal += seconds_since(heal_start);
+    timings->part_heal.insert(timings->part_heal.end(), part_heal.begin(), part_heal.end());
+  }
 
   const Clock::time_point mesh_start = Clock::now();
   if (!lazy) {

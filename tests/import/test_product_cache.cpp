@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <bit>
 #include <filesystem>
 #include <fstream>
@@ -152,6 +154,22 @@ void forget_placements(const std::string& path, const ImportOptions& options) {
   fs::remove(fs::path(options.cache_dir) / detail::placements_entry_name(path, options));
 }
 
+// The costs a read in pieces reports (PieceCosts): one per piece, a worker's time for each piece it
+// read and none for a piece from the cache; a heal time per part made afresh.
+void expect_costs(const FileImport& f, std::size_t pieces_read, std::size_t parts_made) {
+  ASSERT_EQ(f.piece_costs.bytes.size(), f.pieces);
+  ASSERT_EQ(f.piece_costs.seconds.size(), f.pieces);
+  EXPECT_EQ(static_cast<std::size_t>(std::count_if(f.piece_costs.seconds.begin(), f.piece_costs.seconds.end(),
+                                                   [](double s) { return s > 0.0; })),
+            pieces_read);
+  for (const std::size_t b : f.piece_costs.bytes) EXPECT_GT(b, 0u);
+  EXPECT_GT(f.piece_costs.main_parse, 0.0);
+  if (pieces_read > 0) {
+    EXPECT_GT(f.piece_costs.workers, 0.0);
+  }
+  EXPECT_EQ(f.part_heal_seconds.size(), parts_made);
+}
+
 TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
   if (!have_data()) GTEST_SKIP() << "run scripts/setup.sh";
   auto [path, original, options] = cached_board("product_cache_board", false);
@@ -164,6 +182,7 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
   ASSERT_GT(parts, 5u);
   EXPECT_EQ(cold.files[0].pieces_cached, 0u);
   EXPECT_EQ(cold.files[0].parts_cached, 0u);
+  expect_costs(cold.files[0], pieces, parts);
   expect_as_read_afresh(path, cold);
 
   struct Edit {
@@ -190,6 +209,7 @@ TEST(ProductCache, OnlyChangedProductsAreReadAgain) {
     EXPECT_EQ(warm.files[0].pieces_cached, pieces - e.pieces_read);
     EXPECT_EQ(warm.files[0].parts_cached, parts - e.parts_made);
     EXPECT_EQ(warm.files[0].transfer_workers, std::max<std::size_t>(1, std::min<std::size_t>(e.pieces_read, e.workers)));
+    expect_costs(warm.files[0], e.pieces_read, e.parts_made);
     expect_as_read_afresh(path, warm);
   }
 }

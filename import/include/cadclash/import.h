@@ -161,6 +161,20 @@ enum class CacheUse : std::uint8_t { Off, Hit, Miss, Rebuilt, Placements };
 // Returns "off", "hit", "miss", "rebuilt" or "placements".
 const char* cache_use_name(CacheUse c);
 
+// A STEP file read in pieces (FileImport::pieces > 0): what each stage of the cut read cost, so
+// that its time on more cores can be modelled from measured costs (scripts/import_peer_bench.sh;
+// docs/import.md, "One large STEP file on every core"). The workers' costs are CPU seconds, which
+// do not grow when the processes share cores; the rest is wall clock of the reader's process.
+struct PieceCosts {
+  double split = 0.0;       // wall: cutting the text, the cache's lookups, until the workers start (serial)
+  double main_parse = 0.0;  // CPU: the reader parsing the main text, while the workers run
+  double workers = 0.0;     // wall: from the workers' start until the last one's shapes are back
+  // Per piece, in file order: the bytes of its items (what share_pieces balances) and its worker's
+  // CPU seconds for it (parsing, transfer, encoding the shapes); 0 for a piece from the cache.
+  std::vector<std::size_t> bytes;
+  std::vector<double> seconds;
+};
+
 namespace detail {
 struct CacheRecord;  // what store_triangles_in_cache needs of a file read through the cache (import_cache.h)
 struct Placements;   // how a STEP file's numbers place its instances (step_placements.h)
@@ -178,6 +192,12 @@ struct FileImport {
   std::size_t pieces = 0, pieces_cached = 0;
   // CAD parts that came checked and healed from the cache (with a cache only).
   std::size_t parts_cached = 0;
+  // STEP read in pieces by this process's reader (not from a cache entry of the whole file, nor a
+  // distributed check's description): the pieces' costs; empty otherwise.
+  PieceCosts piece_costs;
+  // B-rep parts checked and healed here (not from the cache), in the order they were added: each
+  // one's wall seconds on the thread that checked it (ImportTimings::heal spreads them over threads).
+  std::vector<double> part_heal_seconds;
   // A lazy import through a cache: the entries its B-rep parts came from or went to.
   std::shared_ptr<detail::CacheRecord> cache_record = nullptr;
   // STEP assemblies: how the file's numbers place its instances, for the cache's recomputed poses.

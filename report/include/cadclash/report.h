@@ -307,14 +307,22 @@ struct ClashReview {
 
 // `import_timings`: where reading each input file went, in seconds (cadclash/import.h, ImportTimings),
 // and what the import cache did for it. Written only with timings.
+// A STEP file read in pieces: what each stage cost (cadclash/import.h, PieceCosts).
+struct ReportPieceCosts {
+  double split = 0.0, main_parse = 0.0, workers = 0.0;
+  std::vector<std::uint64_t> bytes;  // per piece
+  std::vector<double> seconds;       // per piece: its worker's CPU seconds (0: from the cache)
+};
 struct ReportFileImport {
   std::string file;           // as given
-  std::string cache = "off";  // "off", "hit", "miss" or "rebuilt"
+  std::string cache = "off";  // "off", "hit", "miss", "rebuilt" or "placements" (cache_use_name)
   double read = 0.0, transfer = 0.0, heal = 0.0, tessellate = 0.0, total = 0.0;
   std::uint64_t processes = 1;  // STEP: processes that read and transferred the file at once
   // STEP: the pieces its products' shapes were cut into and how many came from the cache; CAD parts
   // that came checked and healed from the cache (FileImport).
   std::uint64_t pieces = 0, pieces_cached = 0, parts_cached = 0;
+  std::optional<ReportPieceCosts> piece_costs;  // a STEP file read in pieces by this process
+  std::vector<double> part_heal_seconds;        // per B-rep part checked and healed here (FileImport)
 };
 struct ReportImport {
   double seconds = 0.0;  // wall clock of the whole import (files are read in parallel)

@@ -117,6 +117,8 @@ struct BrepPartInput {
 struct BrepPartTimings {
   double heal = 0.0;        // BRepCheck and ShapeFix of invalid faces, plane pcurves, exact boxes and face facts
   double tessellate = 0.0;  // BRepMesh, reading and measuring the triangles (eager only)
+  // Per part checked and healed, appended in input order: its wall seconds on the thread that did it.
+  std::vector<double> part_heal;
 };
 // `diagnostics_per_part`, when given, gets how many diagnostics each part appended, in input order.
 std::vector<PartId> add_brep_parts(Model& model, std::span<const BrepPartInput> parts,
