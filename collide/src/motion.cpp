@@ -3,6 +3,7 @@
 #include "cadclash/trajectory.h"
 #include "closest.h"
 #include "restricted_check.h"
+#include "screw.h"
 
 #include <algorithm>
 #include <cassert>
@@ -17,58 +18,12 @@
 namespace cadclash {
 namespace {
 
+using detail::Screw;
+using detail::screw_of;
+using detail::turn;
+using detail::rotation_of;
+
 constexpr double kUnit = std::numeric_limits<double>::epsilon() / 2.0;  // 2^-53
-
-Eigen::Quaterniond rotation_of(const Pose& p) { return Eigen::Quaterniond(p.linear()).normalized(); }
-
-// The rotation from a to b as an angle and a unit axis (in a's frame): r = q_a^-1 q_b with w >= 0,
-// half the angle atan2(|v|, w) and the axis v / |v|, both accurate to a few ulps whatever the angle
-// (acos(w), as a textbook slerp takes it, loses half the digits of a small angle).
-struct Turn {
-  double angle = 0.0;
-  Vec3 axis = Vec3::UnitX();
-};
-Turn turn(const Eigen::Quaterniond& qa, const Eigen::Quaterniond& qb) {
-  Eigen::Quaterniond r = qa.conjugate() * qb;
-  if (r.w() < 0.0) r.coeffs() = -r.coeffs();
-  const double v = r.vec().norm();
-  Turn t;
-  t.angle = 2.0 * std::atan2(v, r.w());
-  if (v > 0.0) t.axis = r.vec() / v;
-  return t;
-}
-
-// The screw of the displacement from a to b (Chasles): b = M a with M the turn by `angle` about a
-// world line along `axis`, then the shift `along` along it. Computed once from a and b, and used as
-// it is by interpolate_pose and travel_bound, so that the bound is about the motion the poses follow.
-// `drift` is the velocity (per unit of s) of the point of a's origin across the axis at s = 0,
-// angle * (P t_a - c) for the axis through c (P: across the axis); it stays finite as the angle
-// goes to 0 (the axis then lies far off and the motion becomes the shift t_b - t_a).
-struct Screw {
-  Eigen::Quaterniond qa;
-  Turn local;          // the turn in a's frame (slerp's)
-  Vec3 axis;           // the same axis in the world: q_a * local.axis
-  double along = 0.0;  // d: M's shift along the axis
-  Vec3 drift = Vec3::Zero();
-};
-Screw screw_of(const Pose& a, const Pose& b) {
-  Screw w;
-  w.qa = rotation_of(a);
-  w.local = turn(w.qa, rotation_of(b));
-  w.axis = w.qa * w.local.axis;
-  const double angle = w.local.angle;
-  // M = b a^-1: its rotation turns by angle about axis, its translation is t = t_b - R t_a.
-  const Vec3 t = b.translation() - Eigen::AngleAxisd(angle, w.axis) * a.translation();
-  w.along = w.axis.dot(t);
-  const Vec3 across = t - w.along * w.axis;
-  // The axis point c (across the axis) solves (I - R) c = across: c = across / 2 + cot(angle / 2)
-  // axis x across / 2; angle * c, with g = angle cot(angle / 2) (2 at angle 0).
-  const double half = 0.5 * angle;
-  const double g = half == 0.0 ? 2.0 : angle * std::cos(half) / std::sin(half);
-  const Vec3 ta = a.translation() - w.axis.dot(a.translation()) * w.axis;
-  w.drift = angle * ta - 0.5 * angle * across - 0.5 * g * w.axis.cross(across);
-  return w;
-}
 
 // The velocity (per unit of s) of the world point x under the screw w of a motion from pose a: the
 // turn's angle * axis x (x - t_a) plus the velocity of a's origin, axis x drift + d axis.
@@ -166,6 +121,8 @@ struct Contacts {
   // least over the instance pair's surface pairs for an instance key; -inf for containment, and for
   // every key of a check whose bounds are not certified).
   std::map<PairKey, double> margin;
+  std::map<PairKey, double> uncertainty;  // per open surface key: its two faces' uncertainties
+  std::set<PairKey> containment;          // instance keys open for a containment
   bool complete = true;
 };
 
@@ -190,6 +147,8 @@ Contacts contacts_of(const Report& r, bool certified, const std::set<PairKey>* k
     const double margin = certified && p.contact != ContactClass::Containment
                               ? p.distance_lo - p.uncertainty_a - p.uncertainty_b
                               : -std::numeric_limits<double>::infinity();
+    if (about_surface) c.uncertainty[surface] = p.uncertainty_a + p.uncertainty_b;
+    if (about_whole && containment) c.containment.insert(whole);
     for (const PairKey& k : {whole, surface}) {
       if (!(k == whole ? about_whole : about_surface)) continue;
       c.open.insert(k);
@@ -269,6 +228,22 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       scene.set_pose(moving[i], s == 0.0 ? from[i] : s == 1.0 ? to[i] : interpolate_pose(from[i], to[i], s));
   };
   const bool certified = options.decision != DecisionMode::Fast;
+  // A surface pair of a moving instance and one that stays is apart over a stretch by at least
+  // screw_gap: what the turn cannot change (screw.h). Certified checks only (a fast check's contact
+  // band is its own).
+  std::vector<detail::Screw> screws;
+  for (std::size_t i = 0; i < moving.size(); ++i) screws.push_back(screw_of(from[i], to[i]));
+  auto held_apart = [&](const PairKey& k, double uncertainty, double s0, double s1) {
+    const auto [a, b, sa, sb] = k;
+    if (!certified || sa == kInvalidId) return false;
+    const auto ia = index.find(a), ib = index.find(b);
+    if ((ia == index.end()) == (ib == index.end())) return false;  // both move, or neither
+    const bool a_moves = ia != index.end();
+    const std::size_t i = a_moves ? ia->second : ib->second;
+    const double g = detail::screw_gap(model, a_moves ? sa : sb, from[i], screws[i], a_moves ? sb : sa,
+                                       scene.pose(a_moves ? b : a), s0, s1);
+    return g > options.tolerance + uncertainty;
+  };
   auto moves = [&](const PairKey& k) { return index.count(std::get<0>(k)) > 0 || index.count(std::get<1>(k)) > 0; };
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
   // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
@@ -355,6 +330,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     auto concerns = [&](const PairKey& k) { return st.all ? moves(k) : st.pairs.count(k) > 0; };
     const bool budget = out.checks + 3 <= motion.max_checks;
     std::set<PairKey> suspect;
+    std::map<PairKey, double> margin;  // of each suspect: an instance key's, its suspect surface pairs' least
     Contacts grown;
     if (budget) {
       // Checked in the middle of the stretch: every pose of it is within half its travel of there.
@@ -365,13 +341,25 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       grown = check(mid, options.tolerance + half([&](double u0, double u1) { return travel_of(st.all ? nullptr : &st.pairs, u0, u1); }),
                     st.all ? nullptr : &st.pairs);
       if (grown.complete) {
-        // Open at the grown tolerance, and not proved apart by its own travel: its distance in the
+        // Open at the grown tolerance, and not proved apart by its own travel (its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound
-        // says so.
+        // says so) nor by what the turn keeps (held_apart). An instance pair is suspect with one of
+        // its surface pairs, or a containment.
         for (const PairKey& k : grown.open) {
           const InstanceId a = std::get<0>(k), b = std::get<1>(k);  // a lambda cannot capture a structured binding (C++17)
+          if (std::get<2>(k) == kInvalidId || !concerns(k)) continue;
           const double travel = half([&](double u0, double u1) { return pair_travel(a, b, u0, u1); });
-          if (concerns(k) && !(grown.margin.at(k) > options.tolerance + travel)) suspect.insert(k);
+          if (grown.margin.at(k) > options.tolerance + travel || held_apart(k, grown.uncertainty.at(k), st.s0, st.s1)) continue;
+          suspect.insert(k);
+          const PairKey whole{a, b, kInvalidId, kInvalidId};
+          auto [it, fresh] = margin.try_emplace(whole, grown.margin.at(k));
+          if (!fresh) it->second = std::min(it->second, grown.margin.at(k));
+          margin[k] = grown.margin.at(k);
+        }
+        for (const PairKey& k : grown.open) {
+          if (std::get<2>(k) != kInvalidId || !concerns(k)) continue;
+          if (grown.containment.count(k)) margin[k] = -std::numeric_limits<double>::infinity();
+          if (margin.count(k)) suspect.insert(k);
         }
       } else {
         out.complete = false;
@@ -399,7 +387,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       return ends[end]->contact.count(k) > 0;
     };
     for (const PairKey& k : suspect) {
-      if (!(grown.margin.at(k) > options.tolerance) && in_contact_at(0, k) && in_contact_at(1, k))
+      if (!(margin.at(k) > options.tolerance) && in_contact_at(0, k) && in_contact_at(1, k))
         spans[k].push_back({st.s0, st.s1, true});
       else if (st.s1 - st.s0 <= motion.resolution) spans[k].push_back({st.s0, st.s1, false});
       else halve.insert(k);
@@ -412,7 +400,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     const double mid = 0.5 * (st.s0 + st.s1);
     double r = 0.5 * (st.s1 - st.s0);
     for (const PairKey& k : halve) {
-      const double room = grown.margin.at(k) - options.tolerance;
+      const double room = margin.at(k) - options.tolerance;
       if (!(room > 0.0)) {
         r = 0.0;
         break;
