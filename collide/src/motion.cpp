@@ -247,11 +247,18 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   auto moves = [&](const PairKey& k) { return index.count(std::get<0>(k)) > 0 || index.count(std::get<1>(k)) > 0; };
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
   // run's own check (MotionOptions::check) examines all, and the others are left out of its answer.
-  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys) {
+  // Except at a stretch's ends (`movers_only` false), both examine only the moving instances' pairs
+  // (CollideOptions::involving): the first check of a stretch, grown the most, then reaches every
+  // face a later one of the search can, so a lazy model meshes the same faces either way.
+  std::vector<InstanceId> movers;
+  if (index.size() < model.instances.size())
+    for (const auto& [i, k] : index) movers.push_back(i);
+  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys, bool movers_only = true) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
+    if (movers_only) o.involving = movers;
     ++out.checks;
     if (motion.check) return contacts_of(motion.check(scene, o), certified, keys);
     detail::CheckRestriction only;
@@ -284,7 +291,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     AtS& known = at[s];
     if (known.all) return known;
     if (!keys) {
-      merge(known, check(s, options.tolerance, nullptr));
+      merge(known, check(s, options.tolerance, nullptr, false));
       known.all = true;
       return known;
     }
@@ -306,8 +313,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   // Pairs of two instances that stay where they are keep their state over the stretch, the one at
   // its ends: in contact at both, one span proved at its ends; open but not so (undecided), one span
   // not proved either way (halving cannot tell more). The search is about the moving instances'
-  // pairs. (Its first check still examines every pair, as a distributed run's does: a lazy model
-  // then meshes the same faces either way, and the reports say so alike.)
+  // pairs: its checks examine theirs only (CollideOptions::involving).
   if (index.size() < model.instances.size()) {
     const AtS& start = contacts_at(0.0, nullptr);
     const AtS& finish = contacts_at(1.0, nullptr);

@@ -3,6 +3,7 @@
 #include "scene_stages.h"
 
 #include <algorithm>
+#include <cassert>
 
 namespace cadclash::detail {
 namespace {
@@ -91,12 +92,22 @@ void broad_phase_stage(SceneData& s, QueryState& q) {
     // The largest deflection (+ uncertainty) any surface brings to the reach.
     const double share = s.largest_reach_share(o);
     const double margin = search_reach(o, share, share, 0.0);
-    const std::vector<InstanceId>* side = small_side(s);
+    // The instances asked about (CollideOptions::involving) are a side as the selection's are: the
+    // tree gives the sweep's pairs that have one of them.
+    const std::vector<InstanceId>* side = !o.involving.empty() ? &o.involving : small_side(s);
     ids = side != nullptr ? tree_pairs(s, *side, margin, total) : sweep(s, margin, total);
   } else {
     for (InstanceId i = 0; i < s.poses.size(); ++i)
       for (InstanceId j = i + 1; j < s.poses.size(); ++j)
         if (s.selected(i, j)) ids.push_back({i, j});
+  }
+  if (!o.involving.empty()) {
+    std::vector<char> asked(s.poses.size(), 0);
+    for (const InstanceId i : o.involving) {
+      assert(i < s.poses.size());
+      asked[i] = 1;
+    }
+    std::erase_if(ids, [&](const std::array<InstanceId, 2>& p) { return !asked[p[0]] && !asked[p[1]]; });
   }
   q.pairs.resize(ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) {

@@ -145,6 +145,48 @@ TEST(Scene, SelectionsAndExclusions) {
   EXPECT_EQ(pairs_of(prefix_only).size(), 6u);
 }
 
+// CollideOptions::involving: only the pairs with an instance asked about, each as the whole check
+// gives it, within the scene's selection; the plan of a split check the same.
+TEST(Scene, ChecksOfSomeInstancesPairsOnly) {
+  Model m = row_of_boxes(4);
+  for (InstanceId i = 0; i < 4; ++i) m.instances[i].pose = translation(0.3 * i, 0, 0);  // all overlap
+  using Set = std::set<std::pair<InstanceId, InstanceId>>;
+  auto pairs_of = [&](SceneSelection sel, std::vector<InstanceId> involving) {
+    Scene scene(m, std::move(sel));
+    CollideOptions o;
+    o.involving = std::move(involving);
+    Set out;
+    for (const SurfacePairResult& p : scene.check(o).pairs) out.insert({p.instance_a, p.instance_b});
+    Set planned;
+    for (const PlannedPair& p : scene.plan(o).pairs) planned.insert({p.a, p.b});
+    EXPECT_EQ(planned, out);
+    return out;
+  };
+  EXPECT_EQ(pairs_of({}, {}), (Set{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}));
+  EXPECT_EQ(pairs_of({}, {2}), (Set{{0, 2}, {1, 2}, {2, 3}}));
+  EXPECT_EQ(pairs_of({}, {3, 0}), (Set{{0, 1}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}));
+  SceneSelection a_vs_b;
+  a_vs_b.set_a = {0};
+  a_vs_b.set_b = {2, 3};
+  EXPECT_EQ(pairs_of(a_vs_b, {3}), (Set{{0, 3}}));
+  // Each pair's result is the whole check's.
+  Scene whole(m), some(m);
+  CollideOptions o;
+  const Report all = whole.check(o);
+  o.involving = {1};
+  const Report one = some.check(o);
+  std::vector<SurfacePairResult> expected;
+  for (const SurfacePairResult& p : all.pairs)
+    if (p.instance_a == 1 || p.instance_b == 1) expected.push_back(p);
+  ASSERT_EQ(one.pairs.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(one.pairs[k].surface_a, expected[k].surface_a);
+    EXPECT_EQ(one.pairs[k].surface_b, expected[k].surface_b);
+    EXPECT_EQ(one.pairs[k].contact, expected[k].contact);
+    EXPECT_EQ(one.pairs[k].distance_lo, expected[k].distance_lo);
+  }
+}
+
 // A B-rep stand-in: triangles appear only when asked, and the asks are recorded.
 class LazyBoxes : public SurfaceSource {
  public:

@@ -136,6 +136,10 @@ struct CollideOptions {
   TriangleLevel triangle_level = TriangleLevel::Auto;
   std::size_t flat_limit = 4096;  // Auto switches to the BVH above this many candidate pairs
   bool detect_containment = true;
+  // Examine only the instance pairs with at least one instance in this list (and that the scene's
+  // selection allows); empty: every pair. What a continuous check asks of the motion between steps,
+  // whose pairs of parts that stay need no search (trajectory.h). Ids < model.instances.size().
+  std::vector<InstanceId> involving;
   DecisionMode decision = DecisionMode::Certified;  // see "Certified decisions"
   // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
   // results of the instance pairs it finished, with Report::complete false (see Report).
