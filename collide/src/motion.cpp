@@ -233,16 +233,21 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   // band is its own).
   std::vector<detail::Screw> screws;
   for (std::size_t i = 0; i < moving.size(); ++i) screws.push_back(screw_of(from[i], to[i]));
-  auto held_apart = [&](const PairKey& k, double uncertainty, double s0, double s1) {
+  std::map<PairKey, detail::ScrewKeep> keeps;  // per surface pair asked about: what its screw keeps
+  // `extra`: by this much more than T (in units of the pair's shift per unit of s).
+  auto held_apart = [&](const PairKey& k, double uncertainty, double s0, double s1, double extra = 0.0) {
     const auto [a, b, sa, sb] = k;
     if (!certified || sa == kInvalidId) return false;
-    const auto ia = index.find(a), ib = index.find(b);
-    if ((ia == index.end()) == (ib == index.end())) return false;  // both move, or neither
-    const bool a_moves = ia != index.end();
-    const std::size_t i = a_moves ? ia->second : ib->second;
-    const double g = detail::screw_gap(model, a_moves ? sa : sb, from[i], screws[i], a_moves ? sb : sa,
-                                       scene.pose(a_moves ? b : a), s0, s1);
-    return g > options.tolerance + uncertainty;
+    auto [it, fresh] = keeps.try_emplace(k);
+    if (fresh) {
+      const auto ia = index.find(a), ib = index.find(b);
+      if ((ia == index.end()) == (ib == index.end())) return false;  // both move, or neither: nothing known
+      const bool a_moves = ia != index.end();
+      const std::size_t i = a_moves ? ia->second : ib->second;
+      it->second = detail::screw_keep(model, a_moves ? sa : sb, from[i], screws[i], a_moves ? sb : sa, scene.pose(a_moves ? b : a));
+    }
+    return it->second.known &&
+           detail::screw_gap(it->second, s0, s1) > options.tolerance + uncertainty + extra * std::abs(it->second.shift);
   };
   auto moves = [&](const PairKey& k) { return index.count(std::get<0>(k)) > 0 || index.count(std::get<1>(k)) > 0; };
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
@@ -400,28 +405,76 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     }
     if (halve.empty()) continue;
     // Conservative advancement around the middle: a pair proved apart there by more than T stays
-    // apart while its two sides travel less than that; when every pair halved is, the halves leave
-    // out the part of the stretch around the middle where all of them are (each half then has
-    // less travel, and a pair approaching or leaving contact gets there in fewer checks).
+    // apart while its two sides travel less than that, and a surface pair that the turn keeps apart
+    // (held_apart) while it does; when every pair halved is, the halves leave out the part of the
+    // stretch around the middle where all of them are (each half then has less travel, and a pair
+    // approaching or leaving contact gets there in fewer checks).
     const double mid = 0.5 * (st.s0 + st.s1);
-    double r = 0.5 * (st.s1 - st.s0);
-    for (const PairKey& k : halve) {
-      const double room = margin.at(k) - options.tolerance;
-      if (!(room > 0.0)) {
-        r = 0.0;
-        break;
-      }
+    struct Reach {
+      double left = 0.0, right = 0.0;
+    };
+    auto reach_of = [&](const PairKey& k) {
       const InstanceId a = std::get<0>(k), b = std::get<1>(k);
-      // The travel is affine in the width of the stretch: its rate and what it is over none.
-      const double none = pair_travel(a, b, mid, mid), rate = pair_travel(a, b, 0.0, 1.0) - none;
-      double free = rate > 0.0 ? std::min(r, (1.0 - 1e-6) * (room - none) / rate) : r;
-      // Checked as the grown check clears a pair, halved where the rounding says otherwise.
-      for (int tries = 0; free > 0.0 && !(pair_travel(a, b, mid - free, mid) < room && pair_travel(a, b, mid, mid + free) < room); ++tries)
-        free = tries < 8 ? 0.5 * free : 0.0;
-      r = std::min(r, std::max(free, 0.0));
+      Reach r;
+      if (const double room = margin.at(k) - options.tolerance; room > 0.0) {
+        // The travel is affine in the width of the stretch: its rate and what it is over none.
+        const double none = pair_travel(a, b, mid, mid), rate = pair_travel(a, b, 0.0, 1.0) - none;
+        auto side = [&](double most, auto&& travel) {
+          double free = rate > 0.0 ? std::min(most, (1.0 - 1e-6) * (room - none) / rate) : most;
+          // Checked as the grown check clears a pair, halved where the rounding says otherwise.
+          for (int tries = 0; free > 0.0 && !(travel(free) < room); ++tries) free = tries < 8 ? 0.5 * free : 0.0;
+          return std::max(free, 0.0);
+        };
+        r.left = side(mid - st.s0, [&](double f) { return pair_travel(a, b, mid - f, mid); });
+        r.right = side(st.s1 - mid, [&](double f) { return pair_travel(a, b, mid, mid + f); });
+      }
+      if (std::get<2>(k) != kInvalidId && grown.uncertainty.count(k)) {
+        // The widest the turn keeps apart, found by halving (its bound shrinks as the part widens),
+        // with half the resolution's shift to spare: a check at its end is then not one of a
+        // distance within a hair of T, which a certified decision pays dearly for.
+        const double need = grown.uncertainty.at(k);
+        auto kept = [&](double most, bool left) {
+          auto apart = [&](double w) {
+            return held_apart(k, need, left ? mid - w : mid, left ? mid : mid + w, 0.5 * motion.resolution);
+          };
+          if (apart(most)) return most;
+          if (!apart(0.0)) return 0.0;
+          double lo = 0.0, hi = most;
+          for (int i = 0; i < 40; ++i) {
+            const double m = 0.5 * (lo + hi);
+            (apart(m) ? lo : hi) = m;
+          }
+          return lo;
+        };
+        r.left = std::max(r.left, kept(mid - st.s0, true));
+        r.right = std::max(r.right, kept(st.s1 - mid, false));
+      }
+      return r;
+    };
+    // Each surface pair's reach; an instance pair's: the least of its suspect surface pairs', none
+    // with a containment.
+    std::map<PairKey, Reach> reaches;
+    for (const auto& [k, m] : margin)
+      if (std::get<2>(k) != kInvalidId) reaches.emplace(k, reach_of(k));
+    auto reach_at = [&](const PairKey& k) {
+      if (std::get<2>(k) != kInvalidId) return reaches.at(k);
+      if (grown.containment.count(k)) return Reach{};
+      Reach r{mid - st.s0, st.s1 - mid};
+      for (auto it = reaches.lower_bound({std::get<0>(k), std::get<1>(k), 0, 0});
+           it != reaches.end() && std::get<0>(it->first) == std::get<0>(k) && std::get<1>(it->first) == std::get<1>(k); ++it) {
+        r.left = std::min(r.left, it->second.left);
+        r.right = std::min(r.right, it->second.right);
+      }
+      return r;
+    };
+    Reach r{mid - st.s0, st.s1 - mid};
+    for (const PairKey& k : halve) {
+      const Reach e = reach_at(k);
+      r.left = std::min(r.left, e.left);
+      r.right = std::min(r.right, e.right);
     }
-    if (mid + r < st.s1) stack.push_back({mid + r, st.s1, halve, false});
-    if (st.s0 < mid - r) stack.push_back({st.s0, mid - r, std::move(halve), false});
+    if (mid + r.right < st.s1) stack.push_back({mid + r.right, st.s1, halve, false});
+    if (st.s0 < mid - r.left) stack.push_back({st.s0, mid - r.left, std::move(halve), false});
   }
   std::map<std::pair<InstanceId, InstanceId>, PairMotion> by_pair;
   if (options.clearance > 0.0) {

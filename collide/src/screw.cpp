@@ -142,12 +142,13 @@ std::optional<Vec3> axis_point_along(const Surface& s, const Pose& pose, const V
 
 }  // namespace
 
-double screw_gap(const Model& model, SurfaceId moving, const Pose& from, const Screw& w, SurfaceId still,
-                 const Pose& still_pose, double s0, double s1) {
+ScrewKeep screw_keep(const Model& model, SurfaceId moving, const Pose& from, const Screw& w, SurfaceId still,
+                     const Pose& still_pose) {
+  ScrewKeep keep;
   const Surface& sm = model.surfaces[moving];
   const Surface& ss = model.surfaces[still];
   const Aabb bm = box_of(sm), bs = box_of(ss);
-  if (bm.isEmpty() || bs.isEmpty()) return 0.0;
+  if (bm.isEmpty() || bs.isEmpty()) return keep;
   const double angle = w.local.angle;
   // The direction the points shift along, and how far (per unit of s): the screw's axis, or for a
   // pure shift its own direction.
@@ -158,13 +159,13 @@ double screw_gap(const Model& model, SurfaceId moving, const Pose& from, const S
   if (angle == 0.0) {
     const Vec3 t = w.across + w.along * w.axis;  // the shift t_b - t_a
     const double n = t.norm();
-    if (!(n > 0.0)) return 0.0;
+    if (!(n > 0.0)) return keep;
     u = t / n;
     d = n;
     // Any line along the shift keeps every point's distance: the still face's axis, else the moving one's.
     std::optional<Vec3> p = axis_point_along(ss, still_pose, u);
     if (!p) p = axis_point_along(sm, from, u);
-    if (p) line = Line{*p, u, 0.0, 16.0 * kUnit};
+    if (p) line = Line{*p, u, 64.0 * kUnit * (n + reach), 16.0 * kUnit};
   } else if (angle >= kLeastTurn && angle <= M_PI) {
     // The axis point c = across / 2 + cot(angle / 2) axis x across / 2, off by the rounding of
     // across and of the angle (whose cotangent's error grows as 1 / sin^2(angle / 2)).
@@ -173,17 +174,33 @@ double screw_gap(const Model& model, SurfaceId moving, const Pose& from, const S
     const double pad = 256.0 * kUnit * (reach * (1.0 + cot) + w.across.norm() / (std::sin(half) * std::sin(half)));
     line = Line{c, u, pad, 256.0 * kUnit};
   } else {
-    return 0.0;  // a turn too small to place its axis
+    return keep;  // a turn too small to place its axis
   }
   const double tilt = 256.0 * kUnit;
+  const Range zm = along(bm, from, u, tilt), zs = along(bs, still_pose, u, tilt);
+  keep.moving_lo = zm.lo;
+  keep.moving_hi = zm.hi;
+  keep.still_lo = zs.lo;
+  keep.still_hi = zs.hi;
+  keep.shift = d;
+  keep.shift_pad = 64.0 * kUnit * (std::abs(d) + reach);
+  keep.radial_gap = line ? gap(surface_from_axis(sm, bm, from, *line), surface_from_axis(ss, bs, still_pose, *line)) : 0.0;
+  keep.known = true;
+  return keep;
+}
+
+double screw_gap(const ScrewKeep& keep, double s0, double s1) {
+  if (!keep.known) return 0.0;
   // Along the axis: the moving face's range at s = 0 shifted by s d over [s0, s1].
-  Range zm = along(bm, from, u, tilt);
-  const double shift_pad = 64.0 * kUnit * (std::abs(d) + reach);
-  zm.lo += std::min(s0 * d, s1 * d) - shift_pad;
-  zm.hi += std::max(s0 * d, s1 * d) + shift_pad;
-  const double gz = gap(zm, along(bs, still_pose, u, tilt));
-  const double grho = line ? gap(surface_from_axis(sm, bm, from, *line), surface_from_axis(ss, bs, still_pose, *line)) : 0.0;
-  return std::sqrt(gz * gz + grho * grho) * (1.0 - 8.0 * kUnit);
+  const double d = keep.shift;
+  const Range zm{keep.moving_lo + std::min(s0 * d, s1 * d) - keep.shift_pad, keep.moving_hi + std::max(s0 * d, s1 * d) + keep.shift_pad};
+  const double gz = gap(zm, Range{keep.still_lo, keep.still_hi});
+  return std::sqrt(gz * gz + keep.radial_gap * keep.radial_gap) * (1.0 - 8.0 * kUnit);
+}
+
+double screw_gap(const Model& model, SurfaceId moving, const Pose& from, const Screw& w, SurfaceId still,
+                 const Pose& still_pose, double s0, double s1) {
+  return screw_gap(screw_keep(model, moving, from, w, still, still_pose), s0, s1);
 }
 
 }  // namespace cadclash::detail

@@ -47,4 +47,17 @@ Screw screw_of(const Pose& a, const Pose& b);
 double screw_gap(const Model& model, SurfaceId moving, const Pose& from, const Screw& w, SurfaceId still,
                  const Pose& still_pose, double s0, double s1);
 
+// screw_gap in two steps, for many stretches of one motion: what does not depend on the stretch,
+// then the bound over [s0, s1] from it (a few operations).
+struct ScrewKeep {
+  double moving_lo = 0.0, moving_hi = 0.0;  // the moving face's coordinate along the axis at s = 0
+  double still_lo = 0.0, still_hi = 0.0;    // the still face's
+  double shift = 0.0, shift_pad = 0.0;      // per unit of s, and its rounding
+  double radial_gap = 0.0;                  // between their distances from the axis
+  bool known = false;                       // false: nothing is known (screw_gap 0)
+};
+ScrewKeep screw_keep(const Model& model, SurfaceId moving, const Pose& from, const Screw& w, SurfaceId still,
+                     const Pose& still_pose);
+double screw_gap(const ScrewKeep& keep, double s0, double s1);
+
 }  // namespace cadclash::detail
