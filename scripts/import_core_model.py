@@ -12,7 +12,7 @@ whole check's wall time on P cores:
 - rest: the process outside import and query (start-up, writing the report), as measured;
 - split: cutting the text and the cache's lookups, serial, as measured;
 - window(P): the pieces' workers and the main text's parse, which run at once. The pieces are shared
-  out over P workers as cadclash shares them (share_pieces: by bytes, largest first onto the least
+  out over P workers as cadclash shares them (share_pieces: by weight, largest first onto the least
   loaded), each worker's load the sum of its pieces' measured CPU seconds; the main parse takes a
   core too, so window(P) = max(largest worker load, main parse, (all loads + main parse) / P), plus
   what the measured window took beyond that model at the run's own core count (forks, pipes);
@@ -56,7 +56,7 @@ def share_by(weights, which, workers):
 def window(costs, workers, by_cost=False):
     seconds = costs["seconds"]
     which = [p for p, s in enumerate(seconds) if s > 0]
-    weights = [round(s * 1e6) for s in seconds] if by_cost else costs["bytes"]
+    weights = [round(s * 1e6) for s in seconds] if by_cost else costs.get("weights", costs["bytes"])
     loads = [sum(seconds[p] for p in share) for share in share_by(weights, which, workers)]
     main = costs["main_parse"]
     return max([main, (sum(loads) + main) / workers] + loads)
@@ -140,7 +140,7 @@ def main():
     with open(os.path.join(out, "results.md"), "a") as md:
         md.write("\n#### A model of more cores\n\n")
         md.write(f"Predicted from the median {cores_run}-core run's measured costs (scripts/import_core_model.py: each "
-                 "piece's CPU seconds in its worker, shared out over P workers by bytes as cadclash shares them; each "
+                 "piece's CPU seconds in its worker, shared out over P workers by weight as cadclash shares them; each "
                  "part's check-and-heal seconds dealt as OpenMP's dynamic schedule deals them; the query by Amdahl's "
                  "law from its 1- and 2-thread times; the rest serial as measured). Plain OCCT: read and transfer "
                  "serial, its meshing perfectly parallel. The model at the run's own cores is the measured run by "

@@ -24,7 +24,8 @@ ReportImport import_report(const ImportResult& imported) {
     r.pieces_cached = f.pieces_cached;
     r.parts_cached = f.parts_cached;
     if (const PieceCosts& c = f.piece_costs; !c.bytes.empty())
-      r.piece_costs = ReportPieceCosts{c.split, c.main_parse, c.workers, {c.bytes.begin(), c.bytes.end()}, c.seconds};
+      r.piece_costs = ReportPieceCosts{c.split, c.main_parse, c.workers, {c.bytes.begin(), c.bytes.end()},
+                                       {c.weights.begin(), c.weights.end()}, c.seconds};
     r.part_heal_seconds = f.part_heal_seconds;
   }
   return out;

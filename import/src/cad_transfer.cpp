@@ -118,6 +118,7 @@ std::string pack_transfer(const Transfer& t) {
   w.u64(t.piece_costs.bytes.size());
   for (std::size_t p = 0; p < t.piece_costs.bytes.size(); ++p) {
     w.u64(t.piece_costs.bytes[p]);
+    w.u64(t.piece_costs.weights[p]);
     w.f64(t.piece_costs.seconds[p]);
   }
   write_component_placements(w, t.placements);
@@ -181,10 +182,12 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   t.piece_costs.split = r.f64();
   t.piece_costs.main_parse = r.f64();
   t.piece_costs.workers = r.f64();
-  t.piece_costs.bytes.resize(r.ok ? r.count(16) : 0);
+  t.piece_costs.bytes.resize(r.ok ? r.count(24) : 0);
+  t.piece_costs.weights.resize(t.piece_costs.bytes.size());
   t.piece_costs.seconds.resize(t.piece_costs.bytes.size());
   for (std::size_t p = 0; p < t.piece_costs.bytes.size(); ++p) {
     t.piece_costs.bytes[p] = r.u64();
+    t.piece_costs.weights[p] = r.u64();
     t.piece_costs.seconds[p] = r.f64();
   }
   t.unpacked = true;

@@ -456,7 +456,10 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
         }
         read.shares = share_pieces(read.split.pieces, missing, run.workers);
         read.costs.seconds.assign(read.split.pieces.size(), 0.0);
-        for (const StepPiece& piece : read.split.pieces) read.costs.bytes.push_back(piece.bytes);
+        for (const StepPiece& piece : read.split.pieces) {
+          read.costs.bytes.push_back(piece.bytes);
+          read.costs.weights.push_back(piece.weight);
+        }
         text_checks.wait();  // no thread but this one when the workers are forked
         read.started = std::chrono::steady_clock::now();
         read.costs.split = std::chrono::duration<double>(read.started - read_start).count();

@@ -369,10 +369,13 @@ ReportImport read_import(const Json& j, const std::string& p) {
       costs.main_parse = number(field(c, pc, "main_parse"), pc + "/main_parse");
       costs.workers = number(field(c, pc, "workers"), pc + "/workers");
       const Json& bytes = array(field(c, pc, "bytes"), pc + "/bytes");
+      const Json& weights = array(field(c, pc, "weights"), pc + "/weights");
       const Json& seconds = array(field(c, pc, "seconds"), pc + "/seconds");
       if (bytes.size() != seconds.size()) fail(pc + "/seconds", "expected one per piece, as many as bytes");
+      if (bytes.size() != weights.size()) fail(pc + "/weights", "expected one per piece, as many as bytes");
       for (std::size_t i = 0; i < bytes.size(); ++i) {
         costs.bytes.push_back(count(bytes[i], pc + "/bytes/" + std::to_string(i)));
+        costs.weights.push_back(count(weights[i], pc + "/weights/" + std::to_string(i)));
         costs.seconds.push_back(number(seconds[i], pc + "/seconds/" + std::to_string(i)));
       }
     }

@@ -406,7 +406,7 @@ nlohmann::json check_report_json(const CheckReport& r, const ReportWriteOptions&
     for (const ReportFileImport& f : r.import->files) {
       nlohmann::json costs = nullptr;
       if (const auto& c = f.piece_costs)
-        costs = {{"split", c->split}, {"main_parse", c->main_parse}, {"workers", c->workers}, {"bytes", c->bytes},
+        costs = {{"split", c->split}, {"main_parse", c->main_parse}, {"workers", c->workers}, {"bytes", c->bytes}, {"weights", c->weights},
                  {"seconds", c->seconds}};
       files.push_back({{"file", f.file}, {"cache", f.cache}, {"read", f.read}, {"transfer", f.transfer},
                        {"heal", f.heal}, {"tessellate", f.tessellate}, {"total", f.total}, {"processes", f.processes},

@@ -10,7 +10,13 @@
 #include "step_split_text.h"
 #include "xcaf_test_doc.h"
 
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
+#include <gp_Circ.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -169,6 +175,63 @@ TEST(CadStyles, StyledFacesGoIntoTheirPiecesWithTheSameColours) {
   EXPECT_EQ(cut.pieces, 3u);
   EXPECT_EQ(cut.main, 1u);
   expect_same_when_split(write_text("styled_board.step", text), 4);
+}
+
+// A piece's weight (what the pieces are shared out by) is its bytes and, for each face of n bounds,
+// 2.5 n^2: counted here from the pieces' own text.
+// A plate drilled `holes` times (its two large faces have holes + 1 bounds each) beside a block.
+std::string write_drilled_board(int holes) {
+  testing::XcafTestDoc doc;
+  const Handle(XCAFDoc_ShapeTool)& tool = doc.tool();
+  const auto name = testing::XcafTestDoc::name;
+  BRepBuilderAPI_MakeFace face(BRepBuilderAPI_MakePolygon(gp_Pnt(0, 0, 0), gp_Pnt(40, 0, 0), gp_Pnt(40, 10, 0),
+                                                          gp_Pnt(0, 10, 0), Standard_True).Wire());
+  for (int k = 0; k < holes; ++k) {
+    const gp_Circ circle(gp_Ax2(gp_Pnt(2.0 + 3.0 * k, 5, 0), gp_Dir(0, 0, 1)), 0.5);
+    face.Add(TopoDS::Wire(BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle).Edge()).Wire().Reversed()));
+  }
+  const TDF_Label plate = name(tool->AddShape(BRepPrimAPI_MakePrism(face.Face(), gp_Vec(0, 0, 1.6)).Shape(), Standard_False), "plate");
+  const TDF_Label block = name(tool->AddShape(BRepPrimAPI_MakeBox(4, 3, 2).Shape(), Standard_False), "block");
+  const TDF_Label board = name(tool->NewShape(), "board");
+  name(tool->AddComponent(board, plate, TopLoc_Location()), "PCB");
+  gp_Trsf t;
+  t.SetTranslation(gp_Vec(2, 2, 1.6));
+  name(tool->AddComponent(board, block, TopLoc_Location(t)), "U1");
+  return slurp(doc.write_step("drilled_board.step"));
+}
+
+TEST(CadSplit, APiecesWeightCountsItsFacesWires) {
+  std::string why;
+  const auto split = detail::split_step_text(write_drilled_board(12), false, why);
+  ASSERT_TRUE(split.has_value()) << why;
+  const std::regex face(R"(=\s*(ADVANCED_FACE|FACE_SURFACE)\s*\(\s*'[^']*'\s*,\s*\(([^)]*)\))");
+  std::size_t faces = 0;
+  for (const detail::StepPiece& piece : split->pieces) {
+    std::size_t wires = 0;
+    for (auto it = std::sregex_iterator(piece.text.begin(), piece.text.end(), face); it != std::sregex_iterator(); ++it) {
+      const std::string bounds = (*it)[2];
+      const auto n = static_cast<std::size_t>(std::count(bounds.begin(), bounds.end(), '#'));
+      wires += n * n * 5 / 2;
+      ++faces;
+    }
+    EXPECT_EQ(piece.weight, piece.bytes + wires);
+  }
+  EXPECT_GT(faces, 6u + 12u);
+  // The plate's piece: its two drilled faces of 13 bounds weigh 2 x 422.
+  const auto heaviest = std::max_element(split->pieces.begin(), split->pieces.end(),
+                                         [](const auto& a, const auto& b) { return a.weight - a.bytes < b.weight - b.bytes; });
+  EXPECT_GE(heaviest->weight - heaviest->bytes, 2u * 422u);
+}
+
+// The pieces go to the workers by weight, not bytes: largest first onto the least loaded.
+TEST(CadSplit, PiecesAreSharedOutByWeight) {
+  std::vector<detail::StepPiece> pieces(4);
+  const std::size_t bytes[] = {10, 60, 50, 40}, weights[] = {100, 60, 50, 40};
+  for (std::size_t p = 0; p < 4; ++p) pieces[p].bytes = bytes[p], pieces[p].weight = weights[p];
+  using Shares = std::vector<std::vector<std::size_t>>;
+  EXPECT_EQ(detail::share_pieces(pieces, {0, 1, 2, 3}, 2), (Shares{{0, 3}, {1, 2}}));
+  EXPECT_EQ(detail::share_pieces(pieces, {1, 2, 3}, 2), (Shares{{1}, {2, 3}}));
+  EXPECT_EQ(detail::share_pieces(pieces, {0, 1, 2, 3}, 8).size(), 4u);
 }
 
 // An invisible styled face, and a face styled twice (the style ReadColors reads last wins), keep

@@ -159,6 +159,8 @@ void forget_placements(const std::string& path, const ImportOptions& options) {
 void expect_costs(const FileImport& f, std::size_t pieces_read, std::size_t parts_made) {
   ASSERT_EQ(f.piece_costs.bytes.size(), f.pieces);
   ASSERT_EQ(f.piece_costs.seconds.size(), f.pieces);
+  ASSERT_EQ(f.piece_costs.weights.size(), f.pieces);
+  for (std::size_t p = 0; p < f.pieces; ++p) EXPECT_GE(f.piece_costs.weights[p], f.piece_costs.bytes[p]);
   EXPECT_EQ(static_cast<std::size_t>(std::count_if(f.piece_costs.seconds.begin(), f.piece_costs.seconds.end(),
                                                    [](double s) { return s > 0.0; })),
             pieces_read);

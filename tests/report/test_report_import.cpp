@@ -31,7 +31,7 @@ CheckReport with_import() {
   ReportFileImport& a = file("a.step", "miss", 0.375, 0.25, 0.125, 0.0625, 0.8125);
   a.pieces = 3;
   a.pieces_cached = 1;
-  a.piece_costs = ReportPieceCosts{0.03125, 0.25, 0.5, {4096, 1024, 77}, {0.375, 0.0, 1.0 / 7.0}};
+  a.piece_costs = ReportPieceCosts{0.03125, 0.25, 0.5, {4096, 1024, 77}, {5000, 1024, 77}, {0.375, 0.0, 1.0 / 7.0}};
   a.part_heal_seconds = {0.0625, 1.0 / 3.0};
   file("b.obj", "hit", 1.0 / 3.0, 0.0, 0.0, 0.0, 0.5);
   file("c.step", "placements", 0.125, 0.0, 0.0, 0.0, 0.25);
@@ -53,6 +53,7 @@ TEST(ReportImportTimings, RoundTripAndLeftOutWithoutTimings) {
   ASSERT_TRUE(costs);
   EXPECT_EQ(costs->bytes, (std::vector<std::uint64_t>{4096, 1024, 77}));
   EXPECT_EQ(costs->seconds[2], 1.0 / 7.0);
+  EXPECT_EQ(costs->weights[0], 5000u);
   EXPECT_EQ(costs->main_parse, 0.25);
   EXPECT_EQ(back.report.import->files[0].part_heal_seconds, (std::vector<double>{0.0625, 1.0 / 3.0}));
   EXPECT_FALSE(back.report.import->files[1].piece_costs);

@@ -169,9 +169,10 @@ struct PieceCosts {
   double split = 0.0;       // wall: cutting the text, the cache's lookups, until the workers start (serial)
   double main_parse = 0.0;  // CPU: the reader parsing the main text, while the workers run
   double workers = 0.0;     // wall: from the workers' start until the last one's shapes are back
-  // Per piece, in file order: the bytes of its items (what share_pieces balances) and its worker's
-  // CPU seconds for it (parsing, transfer, encoding the shapes); 0 for a piece from the cache.
-  std::vector<std::size_t> bytes;
+  // Per piece, in file order: the bytes of its items, its weight (what the pieces are shared out by:
+  // its bytes and its faces' wires, step_split_text.h) and its worker's CPU seconds for it (parsing,
+  // transfer, encoding the shapes); 0 for a piece from the cache.
+  std::vector<std::size_t> bytes, weights;
   std::vector<double> seconds;
 };
 

@@ -310,8 +310,8 @@ struct ClashReview {
 // A STEP file read in pieces: what each stage cost (cadclash/import.h, PieceCosts).
 struct ReportPieceCosts {
   double split = 0.0, main_parse = 0.0, workers = 0.0;
-  std::vector<std::uint64_t> bytes;  // per piece
-  std::vector<double> seconds;       // per piece: its worker's CPU seconds (0: from the cache)
+  std::vector<std::uint64_t> bytes, weights;  // per piece
+  std::vector<double> seconds;                // per piece: its worker's CPU seconds (0: from the cache)
 };
 struct ReportFileImport {
   std::string file;           // as given
