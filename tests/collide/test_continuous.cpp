@@ -206,35 +206,41 @@ TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
 // than the rise does (screw.h): one check clears the stretch. Coming down 0.5 mm instead it meets
 // the plate where it has come down 0.2 mm.
 TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
-  Model m;
-  const InstanceId plate = add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)));
-  const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
-  auto at = [](double turn, double z) {
-    Pose p = Pose::Identity();
-    p.translate(Vec3(10, 10, z));
-    p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
-    return p;
-  };
-  const double turn = 170.0 * std::numbers::pi / 180.0;
-  Scene scene(m);
-  const InstanceId moving[] = {block};
-  {
-    const Pose from[] = {at(0.0, 1.2)}, to[] = {at(turn, 2.2)};
-    scene.set_pose(block, from[0]);
-    const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
-    EXPECT_TRUE(r.pairs.empty());
-    EXPECT_TRUE(r.complete);
-    EXPECT_LE(r.checks, 3u);
-    EXPECT_GT(travel_bound(from[0], to[0], m.surfaces[m.parts[1].first_surface].aabb, 0.0, 0.01), 0.15);
+  // The same wherever the assembly is placed: here, and turned and moved 20 m off the origin.
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1.2e4, -2.0e4, 5.0e3));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  for (const Pose& place : {Pose(Pose::Identity()), far}) {
+    Model m;
+    const InstanceId plate = add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
+    const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
+    auto at = [&](double turn, double z) {
+      Pose p = place;
+      p.translate(Vec3(10, 10, z));
+      p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
+      return p;
+    };
+    const double turn = 170.0 * std::numbers::pi / 180.0;
+    Scene scene(m);
+    const InstanceId moving[] = {block};
+    {
+      const Pose from[] = {at(0.0, 1.2)}, to[] = {at(turn, 2.2)};
+      scene.set_pose(block, from[0]);
+      const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
+      EXPECT_TRUE(r.pairs.empty());
+      EXPECT_TRUE(r.complete);
+      EXPECT_LE(r.checks, 3u);
+      EXPECT_GT(travel_bound(from[0], to[0], m.surfaces[m.parts[1].first_surface].aabb, 0.0, 0.01), 0.15);
+    }
+    {
+      const Pose from[] = {at(0.0, 1.2)}, to[] = {at(turn, 0.7)};
+      scene.set_pose(block, from[0]);
+      const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
+      expect_spans(r, 0.4 + 1e-3, 1.0, 0.4 - 2e-3, 1.0);
+      EXPECT_TRUE(r.complete);
+    }
+    (void)plate;
   }
-  {
-    const Pose from[] = {at(0.0, 1.2)}, to[] = {at(turn, 0.7)};
-    scene.set_pose(block, from[0]);
-    const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
-    expect_spans(r, 0.4 + 1e-3, 1.0, 0.4 - 2e-3, 1.0);
-    EXPECT_TRUE(r.complete);
-  }
-  (void)plate;
 }
 
 // A block resting on the plate stays while the cube falls through the plate beside it: the two
