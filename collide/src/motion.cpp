@@ -122,6 +122,7 @@ struct Contacts {
   // every key of a check whose bounds are not certified).
   std::map<PairKey, double> margin;
   std::map<PairKey, double> uncertainty;  // per open surface key: its two faces' uncertainties
+  std::map<PairKey, double> upper;        // per open surface key: its distance's upper bound less those (+inf: not certified)
   std::set<PairKey> containment;          // instance keys open for a containment
   bool complete = true;
 };
@@ -147,7 +148,10 @@ Contacts contacts_of(const Report& r, bool certified, const std::set<PairKey>* k
     const double margin = certified && p.contact != ContactClass::Containment
                               ? p.distance_lo - p.uncertainty_a - p.uncertainty_b
                               : -std::numeric_limits<double>::infinity();
-    if (about_surface) c.uncertainty[surface] = p.uncertainty_a + p.uncertainty_b;
+    if (about_surface) {
+      c.uncertainty[surface] = p.uncertainty_a + p.uncertainty_b;
+      c.upper[surface] = certified ? p.distance_hi - p.uncertainty_a - p.uncertainty_b : std::numeric_limits<double>::infinity();
+    }
     if (about_whole && containment) c.containment.insert(whole);
     for (const PairKey& k : {whole, surface}) {
       if (!(k == whole ? about_whole : about_surface)) continue;
@@ -351,6 +355,35 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       // its own travel.
       grown = check(mid, options.tolerance + half([&](double u0, double u1) { return travel_of(st.all ? nullptr : &st.pairs, u0, u1); }),
                     st.all ? nullptr : &st.pairs);
+      if (grown.complete && certified) {
+        // What the grown check says of its pairs at T where its bounds settle it (an upper bound
+        // within T: in contact; a lower bound beyond T: apart), known at mid without a check at T
+        // there when a half asks. An instance pair: in contact with one of its surface pairs or a
+        // containment (boxes that nest and surfaces that do not cross: not a matter of tolerance),
+        // apart when all of its surface pairs are; otherwise left to a check at T.
+        AtS& here = at[mid];
+        const std::set<PairKey>& about = st.all ? grown.open : st.pairs;
+        std::map<std::pair<InstanceId, InstanceId>, int> whole;  // 1: in contact, 0: apart, -1: not settled
+        auto settle = [&](const PairKey& k, int state) {
+          if (state < 0 || here.examined.count(k)) return;
+          here.examined.insert(k);
+          if (state == 1) here.contact.insert(k), here.open.insert(k);
+        };
+        for (const PairKey& k : about) {
+          if (std::get<2>(k) == kInvalidId) continue;
+          int state = 0;
+          if (grown.open.count(k)) state = grown.upper.at(k) <= options.tolerance ? 1 : grown.margin.at(k) > options.tolerance ? 0 : -1;
+          int& w = whole.try_emplace({std::get<0>(k), std::get<1>(k)}, 0).first->second;
+          if (state == 1 || w == 1) w = 1;
+          else if (state == -1) w = -1;
+          settle(k, state);
+        }
+        for (const PairKey& k : about) {
+          if (std::get<2>(k) != kInvalidId) continue;
+          const auto w = whole.find({std::get<0>(k), std::get<1>(k)});
+          settle(k, grown.containment.count(k) ? 1 : w == whole.end() ? 0 : w->second);
+        }
+      }
       if (grown.complete) {
         // Open at the grown tolerance, and not proved apart by its own travel (its distance in the
         // middle less what its two sides can travel from there stays above T where its lower bound
