@@ -117,12 +117,11 @@ using PairKey = std::tuple<InstanceId, InstanceId, SurfaceId, SurfaceId>;
 struct Contacts {
   std::set<PairKey> contact;
   std::set<PairKey> open;  // in contact or undecided: not cleared
-  // Per open key, a certified lower bound of its exact distance less the faces' uncertainties (the
-  // least over the instance pair's surface pairs for an instance key; -inf for containment, and for
-  // every key of a check whose bounds are not certified).
-  std::map<PairKey, double> margin;
-  std::map<PairKey, double> uncertainty;  // per open surface key: its two faces' uncertainties
-  std::map<PairKey, double> upper;        // per open surface key: its distance's upper bound less those (+inf: not certified)
+  // Per open surface key: a certified lower bound of its exact distance less the faces'
+  // uncertainties (-inf for a check whose bounds are not certified), those uncertainties, and the
+  // distance's upper bound less them (+inf: not certified). An instance key's come from its surface
+  // keys' and `containment`.
+  std::map<PairKey, double> margin, uncertainty, upper;
   std::set<PairKey> containment;          // instance keys open for a containment
   bool complete = true;
 };
@@ -145,20 +144,17 @@ Contacts contacts_of(const Report& r, bool certified, const std::set<PairKey>* k
     const bool about_whole = listed && (!keys || keys->count(whole) > 0);
     const bool about_surface = listed && !containment;
     if (!about_whole && !about_surface) continue;
-    const double margin = certified && p.contact != ContactClass::Containment
-                              ? p.distance_lo - p.uncertainty_a - p.uncertainty_b
-                              : -std::numeric_limits<double>::infinity();
     if (about_surface) {
-      c.uncertainty[surface] = p.uncertainty_a + p.uncertainty_b;
-      c.upper[surface] = certified ? p.distance_hi - p.uncertainty_a - p.uncertainty_b : std::numeric_limits<double>::infinity();
+      const double eps = p.uncertainty_a + p.uncertainty_b;
+      c.margin[surface] = certified ? p.distance_lo - eps : -std::numeric_limits<double>::infinity();
+      c.uncertainty[surface] = eps;
+      c.upper[surface] = certified ? p.distance_hi - eps : std::numeric_limits<double>::infinity();
     }
     if (about_whole && containment) c.containment.insert(whole);
     for (const PairKey& k : {whole, surface}) {
       if (!(k == whole ? about_whole : about_surface)) continue;
       c.open.insert(k);
       if (p.contact != ContactClass::Undecided) c.contact.insert(k);
-      auto [it, fresh] = c.margin.try_emplace(k, margin);
-      if (!fresh) it->second = std::min(it->second, margin);
     }
   }
   return c;
