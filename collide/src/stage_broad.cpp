@@ -86,6 +86,7 @@ void broad_phase_stage(SceneData& s, QueryState& q) {
     if (s.instance_tree.built()) s.instance_tree.refit(i, s.world_box[i]);
   }
   s.dirty_list.clear();
+  for (const InstanceId i : o.involving) assert(i < s.poses.size()), (void)i;
   std::vector<std::array<InstanceId, 2>> ids;
   if (o.use_oaabb) {
     s.refresh_reach_shares();
@@ -97,17 +98,11 @@ void broad_phase_stage(SceneData& s, QueryState& q) {
     const std::vector<InstanceId>* side = !o.involving.empty() ? &o.involving : small_side(s);
     ids = side != nullptr ? tree_pairs(s, *side, margin, total) : sweep(s, margin, total);
   } else {
+    std::vector<char> asked(s.poses.size(), o.involving.empty() ? 1 : 0);
+    for (const InstanceId i : o.involving) asked[i] = 1;
     for (InstanceId i = 0; i < s.poses.size(); ++i)
       for (InstanceId j = i + 1; j < s.poses.size(); ++j)
-        if (s.selected(i, j)) ids.push_back({i, j});
-  }
-  if (!o.involving.empty()) {
-    std::vector<char> asked(s.poses.size(), 0);
-    for (const InstanceId i : o.involving) {
-      assert(i < s.poses.size());
-      asked[i] = 1;
-    }
-    std::erase_if(ids, [&](const std::array<InstanceId, 2>& p) { return !asked[p[0]] && !asked[p[1]]; });
+        if ((asked[i] || asked[j]) && s.selected(i, j)) ids.push_back({i, j});
   }
   q.pairs.resize(ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) {

@@ -160,6 +160,10 @@ TEST(Scene, ChecksOfSomeInstancesPairsOnly) {
     Set planned;
     for (const PlannedPair& p : scene.plan(o).pairs) planned.insert({p.a, p.b});
     EXPECT_EQ(planned, out);
+    o.use_oaabb = false;  // brute force: the same pairs
+    Set brute;
+    for (const SurfacePairResult& p : scene.check(o).pairs) brute.insert({p.instance_a, p.instance_b});
+    EXPECT_EQ(brute, out);
     return out;
   };
   EXPECT_EQ(pairs_of({}, {}), (Set{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}));

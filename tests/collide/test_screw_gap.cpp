@@ -53,9 +53,9 @@ Surface square(double h, double z) {
 std::vector<Vec3> samples(const Surface& s) {
   std::vector<Vec3> out;
   const Aabb& b = s.aabb;
-  for (int i = 0; i <= 20; ++i)
-    for (int j = 0; j <= 20; ++j) {
-      const double u = i / 20.0, v = j / 20.0;
+  for (int i = 0; i <= 16; ++i)
+    for (int j = 0; j <= 16; ++j) {
+      const double u = i / 16.0, v = j / 16.0;
       if (s.analytic.shape == SurfaceShape::Cylinder) {
         const double phi = 2.0 * kPi * u;
         out.push_back(s.analytic.radius * Vec3(std::cos(phi), std::sin(phi), 0.0) +
@@ -75,8 +75,8 @@ double sampled_distance(const Surface& moving, const Pose& from, const Pose& to,
   std::vector<Vec3> fixed;
   for (const Vec3& p : ps) fixed.push_back(still_pose * p);
   double least = std::numeric_limits<double>::infinity();
-  for (int k = 0; k <= 40; ++k) {
-    const Pose at = interpolate_pose(from, to, s0 + (s1 - s0) * k / 40.0);
+  for (int k = 0; k <= 24; ++k) {
+    const Pose at = interpolate_pose(from, to, s0 + (s1 - s0) * k / 24.0);
     for (const Vec3& p : pm) {
       const Vec3 x = at * p;
       for (const Vec3& y : fixed) least = std::min(least, (x - y).norm());
