@@ -233,21 +233,26 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   // band is its own).
   std::vector<detail::Screw> screws;
   for (std::size_t i = 0; i < moving.size(); ++i) screws.push_back(screw_of(from[i], to[i]));
-  std::map<PairKey, detail::ScrewKeep> keeps;  // per surface pair asked about: what its screw keeps
+  // What the screw keeps of surface pair k (nothing when both sides move, or neither). Reads only:
+  // a check's threads ask it (kept_apart).
+  auto keep_of = [&](InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb) {
+    const auto ia = index.find(a), ib = index.find(b);
+    if ((ia == index.end()) == (ib == index.end())) return detail::ScrewKeep{};
+    const bool a_moves = ia != index.end();
+    const std::size_t i = a_moves ? ia->second : ib->second;
+    return detail::screw_keep(model, a_moves ? sa : sb, from[i], screws[i], a_moves ? sb : sa, scene.pose(a_moves ? b : a));
+  };
   // `extra`: by this much more than T (in units of the pair's shift per unit of s).
+  auto apart_by = [&](const detail::ScrewKeep& keep, double uncertainty, double s0, double s1, double extra) {
+    return keep.known && detail::screw_gap(keep, s0, s1) > options.tolerance + uncertainty + extra * std::abs(keep.shift);
+  };
+  std::map<PairKey, detail::ScrewKeep> keeps;  // per surface pair asked about: what its screw keeps
   auto held_apart = [&](const PairKey& k, double uncertainty, double s0, double s1, double extra = 0.0) {
     const auto [a, b, sa, sb] = k;
     if (!certified || sa == kInvalidId) return false;
     auto [it, fresh] = keeps.try_emplace(k);
-    if (fresh) {
-      const auto ia = index.find(a), ib = index.find(b);
-      if ((ia == index.end()) == (ib == index.end())) return false;  // both move, or neither: nothing known
-      const bool a_moves = ia != index.end();
-      const std::size_t i = a_moves ? ia->second : ib->second;
-      it->second = detail::screw_keep(model, a_moves ? sa : sb, from[i], screws[i], a_moves ? sb : sa, scene.pose(a_moves ? b : a));
-    }
-    return it->second.known &&
-           detail::screw_gap(it->second, s0, s1) > options.tolerance + uncertainty + extra * std::abs(it->second.shift);
+    if (fresh) it->second = keep_of(a, b, sa, sb);
+    return apart_by(it->second, uncertainty, s0, s1, extra);
   };
   auto moves = [&](const PairKey& k) { return index.count(std::get<0>(k)) > 0 || index.count(std::get<1>(k)) > 0; };
   // A check at s about the pairs `keys` (null: all). Here it examines those pairs only; a distributed
@@ -258,12 +263,22 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   std::vector<InstanceId> movers;
   if (index.size() < model.instances.size())
     for (const auto& [i, k] : index) movers.push_back(i);
-  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys, bool movers_only = true) {
+  // `over`: the stretch the check stands for; its surface pairs that the turn keeps apart over all
+  // of it (held_apart) are left out of it (CollideOptions::proved_apart), a distributed check's on
+  // every rank alike: the search would clear them whatever the check said of them.
+  auto check = [&](double s, double tolerance, const std::set<PairKey>* keys, bool movers_only = true,
+                   const std::pair<double, double>* over = nullptr) {
     place(s);
     CollideOptions o = options;
     o.tolerance = tolerance;
     o.clearance = 0.0;
     if (movers_only) o.involving = movers;
+    if (over && certified) {
+      const auto [s0, s1] = *over;
+      o.proved_apart = [&keep_of, &apart_by, s0, s1](InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb, double eps) {
+        return apart_by(keep_of(a, b, sa, sb), eps, s0, s1, 0.0);
+      };
+    }
     ++out.checks;
     if (motion.check) return contacts_of(motion.check(scene, o), certified, keys);
     detail::CheckRestriction only;
@@ -349,8 +364,9 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       auto half = [&](const auto& travel) { return std::max(travel(st.s0, mid), travel(mid, st.s1)); };
       // Grown by the largest travel of its pairs: a pair it leaves out is apart by more than T plus
       // its own travel.
+      const std::pair<double, double> over{st.s0, st.s1};
       grown = check(mid, options.tolerance + half([&](double u0, double u1) { return travel_of(st.all ? nullptr : &st.pairs, u0, u1); }),
-                    st.all ? nullptr : &st.pairs);
+                    st.all ? nullptr : &st.pairs, true, &over);
       if (grown.complete && certified) {
         // What the grown check says of its pairs at T where its bounds settle it (an upper bound
         // within T: in contact; a lower bound beyond T: apart), known at mid without a check at T

@@ -60,9 +60,14 @@ void surface_pairs(const SceneData& s, InstancePair& ip, const CollideOptions& o
       else if (wb.contains(wa)) ip.containment = 2;
     }
   }
+  // A pair the caller has proved apart is left out (CollideOptions::proved_apart).
+  auto settled = [&](SurfaceId sa, SurfaceId sb) {
+    return o.proved_apart && o.proved_apart(ip.a, ip.b, sa, sb, s.eps[sa] + s.eps[sb]);
+  };
   if (!o.use_oaabb) {
     for (SurfaceId sa = s.first(ia.part); sa < s.end(ia.part); ++sa)
-      for (SurfaceId sb = s.first(ib.part); sb < s.end(ib.part); ++sb) ip.candidates.push_back({sa, sb});
+      for (SurfaceId sb = s.first(ib.part); sb < s.end(ib.part); ++sb)
+        if (!settled(sa, sb)) ip.candidates.push_back({sa, sb});
     c.surface_pairs += ip.candidates.size();
     return;
   }
@@ -101,7 +106,7 @@ void surface_pairs(const SceneData& s, InstancePair& ip, const CollideOptions& o
     for (std::size_t k = 0; k < surv_b.size(); ++k) {
       const double m = search_reach(o, share_a, share_b[k], ip.roundoff);
       ++c.aabb_tests;
-      if (boxes_within(box_a, box_b[k], m + pad_b[k])) ip.candidates.push_back({sa, surv_b[k]});
+      if (boxes_within(box_a, box_b[k], m + pad_b[k]) && !settled(sa, surv_b[k])) ip.candidates.push_back({sa, surv_b[k]});
     }
   }
   c.surface_pairs += ip.candidates.size();

@@ -226,7 +226,23 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
     {
       const Pose from[] = {at(0.0, 1.2)}, to[] = {at(turn, 2.2)};
       scene.set_pose(block, from[0]);
-      const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
+      // The checks the search grows leave out what the turn keeps apart (CollideOptions::
+      // proved_apart): here every pair of the block and the plate, which they would have examined.
+      MotionOptions mo;
+      std::size_t grown = 0;
+      mo.check = [&](Scene& sc, const CollideOptions& o) {
+        Report r = sc.check(o);
+        if (o.tolerance > 0.0) {
+          ++grown;
+          EXPECT_TRUE(r.pairs.empty());
+          CollideOptions all = o;
+          all.proved_apart = nullptr;
+          EXPECT_FALSE(sc.check(all).pairs.empty());
+        }
+        return r;
+      };
+      const MotionResult r = check_motion(scene, m, moving, from, to, {}, mo);
+      EXPECT_GE(grown, 1u);
       EXPECT_TRUE(r.pairs.empty());
       EXPECT_TRUE(r.complete);
       EXPECT_LE(r.checks, 3u);

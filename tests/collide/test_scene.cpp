@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <map>
+#include <tuple>
 #include <mutex>
 
 namespace cadclash {
@@ -188,6 +190,47 @@ TEST(Scene, ChecksOfSomeInstancesPairsOnly) {
     EXPECT_EQ(one.pairs[k].surface_b, expected[k].surface_b);
     EXPECT_EQ(one.pairs[k].contact, expected[k].contact);
     EXPECT_EQ(one.pairs[k].distance_lo, expected[k].distance_lo);
+  }
+}
+
+// CollideOptions::proved_apart: the surface pairs it names are left out, every other pair as the
+// whole check gives it; it is asked with the two surfaces' uncertainties as the report gives them.
+TEST(Scene, PairsProvedApartAreLeftOut) {
+  Model m = row_of_boxes(3);
+  for (InstanceId i = 0; i < 3; ++i) m.instances[i].pose = translation(0.3 * i, 0, 0);  // all overlap
+  for (const bool brute : {false, true}) {
+    Scene whole(m), some(m);
+    CollideOptions o;
+    o.use_oaabb = !brute;
+    const Report all = whole.check(o);
+    ASSERT_FALSE(all.pairs.empty());
+    std::mutex asked_lock;
+    std::map<std::tuple<InstanceId, InstanceId, SurfaceId, SurfaceId>, double> asked;
+    // Every pair of the first reported pair's instance and surface is proved apart.
+    const InstanceId zero = all.pairs[0].instance_a;
+    const SurfaceId first = all.pairs[0].surface_a;
+    o.proved_apart = [&](InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb, double eps) {
+      std::lock_guard<std::mutex> lock(asked_lock);
+      asked[{a, b, sa, sb}] = eps;
+      return a == zero && sa == first;
+    };
+    const Report left = some.check(o);
+    std::vector<SurfacePairResult> expected;
+    for (const SurfacePairResult& p : all.pairs) {
+      const auto it = asked.find({p.instance_a, p.instance_b, p.surface_a, p.surface_b});
+      ASSERT_NE(it, asked.end());
+      EXPECT_EQ(it->second, p.uncertainty_a + p.uncertainty_b);
+      if (!(p.instance_a == zero && p.surface_a == first)) expected.push_back(p);
+    }
+    ASSERT_LT(expected.size(), all.pairs.size());
+    ASSERT_EQ(left.pairs.size(), expected.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(left.pairs[k].instance_a, expected[k].instance_a);
+      EXPECT_EQ(left.pairs[k].surface_a, expected[k].surface_a);
+      EXPECT_EQ(left.pairs[k].surface_b, expected[k].surface_b);
+      EXPECT_EQ(left.pairs[k].contact, expected[k].contact);
+      EXPECT_EQ(left.pairs[k].distance_lo, expected[k].distance_lo);
+    }
   }
 }
 

@@ -140,6 +140,13 @@ struct CollideOptions {
   // selection allows); empty: every pair. What a continuous check asks of the motion between steps,
   // whose pairs of parts that stay need no search (trajectory.h). Ids < model.instances.size().
   std::vector<InstanceId> involving;
+  // Surface pairs the caller has proved apart already, farther than tolerance + `uncertainty` (the
+  // two surfaces' model uncertainties, as the report gives them): left out as if their boxes were
+  // apart, so a pair it names is neither meshed nor decided. What a continuous check knows of the
+  // pairs a turn cannot bring together (trajectory.h). Called from the check's threads with the
+  // pair as the report orders it: thread-safe, and the same answer for the same arguments. Empty:
+  // none.
+  std::function<bool(InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb, double uncertainty)> proved_apart;
   DecisionMode decision = DecisionMode::Certified;  // see "Certified decisions"
   // Budgets; 0 = none. When one runs out the query ends early and returns a partial report: the
   // results of the instance pairs it finished, with Report::complete false (see Report).
