@@ -210,7 +210,8 @@ void read_faces(OffScanner& sc, std::int64_t nf, std::int64_t nv, std::int64_t c
     std::string problem;
     OffFace face{line_no, {}, 0};
     if (!parse_int(tokens[0], n) || n < 0) {
-      problem = "'" + printable_token(tokens[0]) + "' is not a corner count";
+      // Appended, not "'" + string: GCC 12 warns wrongly (-Wrestrict, bug 105329) on that at -O2.
+      problem.append("'").append(printable_token(tokens[0])).append("' is not a corner count");
     } else if (n < 3) {
       problem = "a face needs at least 3 vertices, found " + std::to_string(n);
     } else if (tokens.size() < static_cast<std::size_t>(n) + 1) {

@@ -112,7 +112,7 @@ inline std::vector<Surface> random_surfaces(std::mt19937_64& rng, int surfaces, 
     const Vec3 c(u(rng), u(rng), u(rng));
     const Vec3 a = Vec3(u(rng), u(rng), u(rng)).normalized() * size * 0.5;
     const Vec3 b = Vec3(u(rng), u(rng), u(rng)).normalized() * size * 0.5;
-    Surface s = grid_surface("r" + std::to_string(k), c, a, b, grid);
+    Surface s = grid_surface(std::string("r").append(std::to_string(k)), c, a, b, grid);
     for (Vec3& v : s.mesh.vertices) v += Vec3(j(rng), j(rng), j(rng)) * size * 0.1;
     out.push_back(std::move(s));
   }

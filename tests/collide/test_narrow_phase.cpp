@@ -13,7 +13,7 @@ using namespace cadclash::testing;
 Model random_scene(std::uint64_t seed, int parts, int instances, double offset = 0.0) {
   std::mt19937_64 rng(seed);
   Model m;
-  for (int p = 0; p < parts; ++p) add_part(m, "p" + std::to_string(p), random_surfaces(rng, 6, 3, 1.0));
+  for (int p = 0; p < parts; ++p) add_part(m, std::string("p").append(std::to_string(p)), random_surfaces(rng, 6, 3, 1.0));
   std::uniform_int_distribution<int> pick(0, parts - 1);
   for (int i = 0; i < instances; ++i) {
     Pose pose = random_pose(rng, 0.6);
