@@ -98,7 +98,8 @@ double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, 
 // (a point's coordinate along the screw's axis shifts by s times the shift, its distance from the
 // axis stays: a nut's face rising off a plate, its bore turning about the bolt's exact cylinder;
 // from the faces' boxes and their exact cylinders, cones and tori about the axis; certified checks
-// only). Pairs it cannot clear are halved, down to `resolution`;
+// only; such pairs are left out of the stretch's check, CollideOptions::proved_apart, so that it
+// neither meshes nor decides them). Pairs it cannot clear are halved, down to `resolution`;
 // when every pair halved is proved apart in the middle, the part around it where their travel stays
 // below that margin is left out of both halves (conservative advancement). A part of the stretch
 // where the pair is proved in contact at both ends is not halved further (in between it is not
