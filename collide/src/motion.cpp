@@ -274,7 +274,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     o.clearance = 0.0;
     if (movers_only) o.involving = movers;
     if (over && certified) {
-      const auto [s0, s1] = *over;
+      const double s0 = over->first, s1 = over->second;  // clang 14 cannot capture a structured binding
       o.proved_apart = [&keep_of, &apart_by, s0, s1](InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb, double eps) {
         return apart_by(keep_of(a, b, sa, sb), eps, s0, s1, 0.0);
       };
