@@ -10,6 +10,9 @@ build=${1:-$root/build}
 out=$root/out/results
 docs=$root/docs/results
 cd "$root"
+# The tables this page takes from benches it does not run: on a fresh clone, put back from the page
+# as it stands (their commit and date with them), so that they are not lost until those benches run.
+python3 "$root/scripts/results_kept.py" "$root"
 
 # Configured as scripts/build.sh does, but only the programs this page runs are built: a whole tree
 # takes longer than the benchmarks.
