@@ -233,8 +233,9 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
   // band is its own).
   std::vector<detail::Screw> screws;
   for (std::size_t i = 0; i < moving.size(); ++i) screws.push_back(screw_of(from[i], to[i]));
-  // What the screw keeps of surface pair k (nothing when both sides move, or neither). Reads only:
-  // a check's threads ask it (kept_apart).
+  // What the screw keeps of a surface pair (nothing when both sides move, or neither). It only
+  // reads, so a check's threads can ask it (proved_apart, below); a few box transforms, computed
+  // again per candidate rather than shared through a locked cache.
   auto keep_of = [&](InstanceId a, InstanceId b, SurfaceId sa, SurfaceId sb) {
     const auto ia = index.find(a), ib = index.find(b);
     if ((ia == index.end()) == (ib == index.end())) return detail::ScrewKeep{};
