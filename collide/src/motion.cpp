@@ -189,6 +189,19 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     const std::size_t i = ia->second, j = ib->second;
     return std::min(apart, relative_travel_bound(from[i], to[i], boxes[i], from[j], to[j], boxes[j], s0, s1));
   };
+  // A surface pair of a moving part and one that stays moves apart or together by at most the moving
+  // face's own travel (its box's: within the part's); other pairs by the instance pair's.
+  auto key_travel = [&](const PairKey& k, double s0, double s1) {
+    const auto [a, b, sa, sb] = k;
+    const double whole = pair_travel(a, b, s0, s1);
+    const auto ia = index.find(a), ib = index.find(b);
+    if (sa == kInvalidId || (ia == index.end()) == (ib == index.end())) return whole;
+    const std::size_t i = ia != index.end() ? ia->second : ib->second;
+    const Surface& face = model.surfaces[ia != index.end() ? sa : sb];
+    const Aabb box = face.aabb.isEmpty() ? mesh_aabb(face.mesh) : face.aabb;
+    if (box.isEmpty()) return whole;
+    return std::min(whole, travel_bound(from[i], to[i], box, s0, s1));
+  };
   // Any pair's: at most the two largest.
   auto travel_over = [&](double s0, double s1) {
     double first = 0.0, second = 0.0;
@@ -405,7 +418,7 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
         for (const PairKey& k : grown.open) {
           const InstanceId a = std::get<0>(k), b = std::get<1>(k);  // a lambda cannot capture a structured binding (C++17)
           if (std::get<2>(k) == kInvalidId || !concerns(k)) continue;
-          const double travel = half([&](double u0, double u1) { return pair_travel(a, b, u0, u1); });
+          const double travel = half([&](double u0, double u1) { return key_travel(k, u0, u1); });
           if (grown.margin.at(k) > options.tolerance + travel || held_apart(k, grown.uncertainty.at(k), st.s0, st.s1)) continue;
           suspect.insert(k);
           const PairKey whole{a, b, kInvalidId, kInvalidId};
@@ -460,19 +473,18 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       double left = 0.0, right = 0.0;
     };
     auto reach_of = [&](const PairKey& k) {
-      const InstanceId a = std::get<0>(k), b = std::get<1>(k);
       Reach r;
       if (const double room = margin.at(k) - options.tolerance; room > 0.0) {
         // The travel is affine in the width of the stretch: its rate and what it is over none.
-        const double none = pair_travel(a, b, mid, mid), rate = pair_travel(a, b, 0.0, 1.0) - none;
+        const double none = key_travel(k, mid, mid), rate = key_travel(k, 0.0, 1.0) - none;
         auto side = [&](double most, auto&& travel) {
           double free = rate > 0.0 ? std::min(most, (1.0 - 1e-6) * (room - none) / rate) : most;
           // Checked as the grown check clears a pair, halved where the rounding says otherwise.
           for (int tries = 0; free > 0.0 && !(travel(free) < room); ++tries) free = tries < 8 ? 0.5 * free : 0.0;
           return std::max(free, 0.0);
         };
-        r.left = side(mid - st.s0, [&](double f) { return pair_travel(a, b, mid - f, mid); });
-        r.right = side(st.s1 - mid, [&](double f) { return pair_travel(a, b, mid, mid + f); });
+        r.left = side(mid - st.s0, [&](double f) { return key_travel(k, mid - f, mid); });
+        r.right = side(st.s1 - mid, [&](double f) { return key_travel(k, mid, mid + f); });
       }
       if (std::get<2>(k) != kInvalidId && grown.uncertainty.count(k)) {
         // The widest the turn keeps apart, found by halving (its bound shrinks as the part widens),

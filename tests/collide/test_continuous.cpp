@@ -259,6 +259,34 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
   }
 }
 
+// A face near the axis of a turn moves only as far as its own points do, not as far as the part's
+// far end: a hub 0.5 mm from a wall, on a part whose arm reaches 50 mm from the axis, is cleared
+// by the first check (the arm's travel would halve the stretch again and again). What the turn
+// keeps proves nothing here: the boxes' distances from the axis overlap and so do their heights.
+TEST(ContinuousMotion, AFaceNearTheAxisMovesOnlyAsFarAsItsOwnPoints) {
+  // Here, and with the whole assembly turned and moved 20 m off the origin.
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1.2e4, -2.0e4, 5.0e3));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  for (const Pose& place : {Pose(Pose::Identity()), far}) {
+    Model m;
+    std::vector<Surface> turning{grid_surface("hub", Vec3(1, -0.5, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), 2),
+                                 grid_surface("arm", Vec3(-50, -0.5, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), 2)};
+    const InstanceId part = add_instance(m, "/part", add_part(m, "part", std::move(turning)), place);
+    add_instance(m, "/wall", add_part(m, "wall", {grid_surface("wall", Vec3(1.6, -1, 0), Vec3(0, 2, 0), Vec3(0, 0, 1), 2)}),
+                 place);
+    Scene scene(m);
+    Pose end = place;
+    end.rotate(Eigen::AngleAxisd(20.0 * std::numbers::pi / 180.0, Vec3::UnitZ()));
+    const Pose from[] = {place}, to[] = {end};
+    const InstanceId moving[] = {part};
+    const MotionResult r = check_motion(scene, m, moving, from, to, {}, {});
+    EXPECT_TRUE(r.pairs.empty());
+    EXPECT_TRUE(r.complete);
+    EXPECT_LE(r.checks, 3u);
+  }
+}
+
 // A block resting on the plate stays while the cube falls through the plate beside it: the two
 // that stay are in contact over the whole stretch, one span proved at its ends (their state is the
 // one at the stretch's ends; the search is about the moving cube's pairs), and the cube's pair

@@ -93,7 +93,9 @@ double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, 
 // How: a stretch [s0, s1] is free for a pair when the certified check in its middle with the
 // tolerance grown by the two largest travel_bounds of the moving instances over its halves proves
 // the pair apart by more than T plus the pair's own travel (travel_bound of each side, or
-// relative_travel_bound when both move), or, for a surface pair of a moving part and one that
+// relative_travel_bound when both move; for a surface pair of which one side moves, that face's own
+// travel: a face near the axis of a turn moves less than the part's far end), or, for a surface
+// pair of a moving part and one that
 // stays, when what the part's screw keeps proves them apart by more than T over the whole stretch
 // (a point's coordinate along the screw's axis shifts by s times the shift, its distance from the
 // axis stays: a nut's face rising off a plate, its bore turning about the bolt's exact cylinder;
