@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace cadclash {
 namespace {
@@ -23,6 +24,15 @@ struct PlateAndCube {
     add_instance(m, "/cube", add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2)));
   }
 };
+
+// Where a test places its whole assembly: at the origin, and turned and moved 20 m off it (the
+// verdicts must not depend on it).
+std::vector<Pose> placements() {
+  Pose far = Pose::Identity();
+  far.translate(Vec3(1.2e4, -2.0e4, 5.0e3));
+  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  return {Pose::Identity(), far};
+}
 
 // The union of a pair's spans covers [lo, hi], and no span reaches below `before` or above `after`.
 void expect_spans(const MotionResult& r, double lo, double hi, double before, double after) {
@@ -206,11 +216,8 @@ TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
 // than the rise does (screw.h): one check clears the stretch. Coming down 0.5 mm instead it meets
 // the plate where it has come down 0.2 mm.
 TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
-  // The same wherever the assembly is placed: here, and turned and moved 20 m off the origin.
-  Pose far = Pose::Identity();
-  far.translate(Vec3(1.2e4, -2.0e4, 5.0e3));
-  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
-  for (const Pose& place : {Pose(Pose::Identity()), far}) {
+  // The same wherever the assembly is placed.
+  for (const Pose& place : placements()) {
     Model m;
     const InstanceId plate = add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
     const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
@@ -264,11 +271,7 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
 // by the first check (the arm's travel would halve the stretch again and again). What the turn
 // keeps proves nothing here: the boxes' distances from the axis overlap and so do their heights.
 TEST(ContinuousMotion, AFaceNearTheAxisMovesOnlyAsFarAsItsOwnPoints) {
-  // Here, and with the whole assembly turned and moved 20 m off the origin.
-  Pose far = Pose::Identity();
-  far.translate(Vec3(1.2e4, -2.0e4, 5.0e3));
-  far.rotate(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
-  for (const Pose& place : {Pose(Pose::Identity()), far}) {
+  for (const Pose& place : placements()) {
     Model m;
     std::vector<Surface> turning{grid_surface("hub", Vec3(1, -0.5, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), 2),
                                  grid_surface("arm", Vec3(-50, -0.5, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), 2)};
