@@ -469,8 +469,27 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     // stretch around the middle where all of them are (each half then has less travel, and a pair
     // approaching or leaving contact gets there in fewer checks).
     const double mid = 0.5 * (st.s0 + st.s1);
+    // `*_screw`: that side's reach is what the turn keeps apart (not the distance's room), so a
+    // contact the screw's shift makes or breaks lies just beyond it (probed below).
     struct Reach {
       double left = 0.0, right = 0.0;
+      bool left_screw = false, right_screw = false;
+    };
+    // Half the resolution's shift to spare in what the turn keeps apart: a check at the end of such
+    // a window is then not one of a distance within a hair of T, which a certified decision pays
+    // dearly for.
+    const double spare = 0.5 * motion.resolution;
+    // The largest w in [0, most] for which holds(w), found by halving (what the turn keeps apart
+    // shrinks as the stretch widens).
+    auto longest = [](double most, auto&& holds) {
+      if (holds(most)) return most;
+      if (!holds(0.0)) return 0.0;
+      double lo = 0.0, hi = most;
+      for (int i = 0; i < 40; ++i) {
+        const double m = 0.5 * (lo + hi);
+        (holds(m) ? lo : hi) = m;
+      }
+      return lo;
     };
     auto reach_of = [&](const PairKey& k) {
       Reach r;
@@ -487,25 +506,12 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
         r.right = side(st.s1 - mid, [&](double f) { return key_travel(k, mid, mid + f); });
       }
       if (std::get<2>(k) != kInvalidId && grown.uncertainty.count(k)) {
-        // The widest the turn keeps apart, found by halving (its bound shrinks as the part widens),
-        // with half the resolution's shift to spare: a check at its end is then not one of a
-        // distance within a hair of T, which a certified decision pays dearly for.
+        // The widest the turn keeps apart on either side.
         const double need = grown.uncertainty.at(k);
-        auto kept = [&](double most, bool left) {
-          auto apart = [&](double w) {
-            return held_apart(k, need, left ? mid - w : mid, left ? mid : mid + w, 0.5 * motion.resolution);
-          };
-          if (apart(most)) return most;
-          if (!apart(0.0)) return 0.0;
-          double lo = 0.0, hi = most;
-          for (int i = 0; i < 40; ++i) {
-            const double m = 0.5 * (lo + hi);
-            (apart(m) ? lo : hi) = m;
-          }
-          return lo;
-        };
-        r.left = std::max(r.left, kept(mid - st.s0, true));
-        r.right = std::max(r.right, kept(st.s1 - mid, false));
+        const double left = longest(mid - st.s0, [&](double w) { return held_apart(k, need, mid - w, mid, spare); });
+        const double right = longest(st.s1 - mid, [&](double w) { return held_apart(k, need, mid, mid + w, spare); });
+        if (left > r.left) r.left = left, r.left_screw = true;
+        if (right > r.right) r.right = right, r.right_screw = true;
       }
       return r;
     };
@@ -514,25 +520,104 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
     std::map<PairKey, Reach> reaches;
     for (const auto& [k, m] : margin)
       if (std::get<2>(k) != kInvalidId) reaches.emplace(k, reach_of(k));
+    auto least = [](Reach& into, const Reach& e) {
+      if (e.left < into.left) into.left = e.left, into.left_screw = e.left_screw;
+      if (e.right < into.right) into.right = e.right, into.right_screw = e.right_screw;
+    };
+    // The suspect surface pairs of an instance key's pair (its others were cleared over the stretch).
+    auto surfaces_of = [&](const PairKey& k) {
+      std::vector<PairKey> found;
+      for (auto it = reaches.lower_bound({std::get<0>(k), std::get<1>(k), 0, 0});
+           it != reaches.end() && std::get<0>(it->first) == std::get<0>(k) && std::get<1>(it->first) == std::get<1>(k); ++it)
+        found.push_back(it->first);
+      return found;
+    };
     auto reach_at = [&](const PairKey& k) {
       if (std::get<2>(k) != kInvalidId) return reaches.at(k);
       if (grown.containment.count(k)) return Reach{};
       Reach r{mid - st.s0, st.s1 - mid};
-      for (auto it = reaches.lower_bound({std::get<0>(k), std::get<1>(k), 0, 0});
-           it != reaches.end() && std::get<0>(it->first) == std::get<0>(k) && std::get<1>(it->first) == std::get<1>(k); ++it) {
-        r.left = std::min(r.left, it->second.left);
-        r.right = std::min(r.right, it->second.right);
-      }
+      for (const PairKey& sk : surfaces_of(k)) least(r, reaches.at(sk));
       return r;
     };
     Reach r{mid - st.s0, st.s1 - mid};
-    for (const PairKey& k : halve) {
-      const Reach e = reach_at(k);
-      r.left = std::min(r.left, e.left);
-      r.right = std::min(r.right, e.right);
-    }
-    if (mid + r.right < st.s1) stack.push_back({mid + r.right, st.s1, halve, false});
-    if (st.s0 < mid - r.left) stack.push_back({st.s0, mid - r.left, std::move(halve), false});
+    for (const PairKey& k : halve) least(r, reach_at(k));
+    // What the turn keeps apart at a part's ends: a surface pair's longest start [a, p] and end
+    // [q, b] held apart (p = a, q = b: none; p >= q: apart over the whole part). An instance pair
+    // is also in contact where one part holds the other (containment), which needs no face to
+    // touch: while all of its suspect surface pairs are apart (the others were cleared over the
+    // stretch) that stays as it is, so only where such a stretch joins the middle of this one,
+    // where the grown check saw no containment, is the instance pair kept apart by its surface
+    // pairs: at the end of the part before the middle (`before_mid`), the start of the one after.
+    auto surface_ends = [&](const PairKey& k, double a, double b) {
+      const auto it = grown.uncertainty.find(k);
+      if (it == grown.uncertainty.end()) return std::pair{a, b};
+      auto apart = [&](double u0, double u1) { return held_apart(k, it->second, u0, u1, spare); };
+      return std::pair{a + longest(b - a, [&](double w) { return apart(a, a + w); }),
+                       b - longest(b - a, [&](double w) { return apart(b - w, b); })};
+    };
+    auto kept_ends = [&](const PairKey& k, double a, double b, bool before_mid) {
+      if (std::get<2>(k) != kInvalidId) return surface_ends(k, a, b);
+      const std::vector<PairKey> surfaces = surfaces_of(k);
+      if (grown.containment.count(k) || surfaces.empty()) return std::pair{a, b};
+      std::pair<double, double> hull = before_mid ? std::pair{a, a} : std::pair{b, b};
+      for (const PairKey& sk : surfaces) {
+        const auto [p, q] = surface_ends(sk, a, b);
+        if (p >= q) continue;  // apart over the whole part
+        if (before_mid) hull.second = std::max(hull.second, q);
+        else hull.first = std::min(hull.first, p);
+      }
+      return hull;
+    };
+    // The parts of the stretch left to search, earliest first, each with the pairs it searches.
+    // Each pair is searched only between the ends the turn keeps it apart beyond; and where it is
+    // kept apart beyond a point, a contact the screw's shift makes or breaks there is likely just
+    // inside it: a piece one resolution wide next to it is searched on its own (a check or two
+    // settle it), as is what lies between such pieces (often in contact at both ends, settled by
+    // one check), instead of halving down to them from the whole part. A surface pair whose instance
+    // pair is halved too is searched where its instance pair is (the instance pair's state is its
+    // surface pairs').
+    const double probe = (1.0 - 1e-6) * motion.resolution;
+    std::vector<Stretch> parts;
+    auto add_part = [&](double a, double b, bool before_mid, bool screw_start, bool screw_end) {
+      if (!(a < b)) return;
+      std::vector<std::pair<PairKey, std::pair<double, double>>> where;  // each pair's [p, q]
+      std::vector<std::pair<double, double>> windows;
+      if (screw_start) windows.emplace_back(a, a + probe);
+      if (screw_end) windows.emplace_back(b - probe, b);
+      for (const PairKey& k : halve) {
+        const PairKey whole{std::get<0>(k), std::get<1>(k), kInvalidId, kInvalidId};
+        const auto [p, q] = kept_ends(halve.count(whole) ? whole : k, a, b, before_mid);
+        if (p >= q) continue;  // kept apart at one end or the other: free over the part
+        where.push_back({k, {p, q}});
+        if (p > a) windows.emplace_back(p, p + probe);
+        if (q < b) windows.emplace_back(q - probe, q);
+      }
+      // The windows, joined where they overlap or leave less than a resolution between them, and
+      // the parts between them.
+      std::sort(windows.begin(), windows.end());
+      std::vector<std::pair<double, double>> joined;
+      for (auto [u, v] : windows) {
+        u = std::max(u, a), v = std::min(v, b);
+        if (!joined.empty() && u <= joined.back().second + probe) joined.back().second = std::max(joined.back().second, v);
+        else joined.emplace_back(u, v);
+      }
+      std::vector<std::pair<double, double>> pieces;
+      double next = a;
+      for (const auto& [u, v] : joined) {
+        if (u > next) pieces.emplace_back(next, u);
+        if (v > std::max(u, next)) pieces.emplace_back(std::max(u, next), v), next = v;
+      }
+      if (next < b) pieces.emplace_back(next, b);
+      for (const auto& [u, v] : pieces) {
+        std::set<PairKey> pairs;
+        for (const auto& [k, pq] : where)
+          if (std::max(pq.first, u) < std::min(pq.second, v)) pairs.insert(k);
+        if (!pairs.empty()) parts.push_back({u, v, std::move(pairs), false});
+      }
+    };
+    add_part(st.s0, mid - r.left, true, false, r.left > 0.0 && r.left_screw);
+    add_part(mid + r.right, st.s1, false, r.right > 0.0 && r.right_screw, false);
+    for (auto it = parts.rbegin(); it != parts.rend(); ++it) stack.push_back(std::move(*it));
   }
   std::map<std::pair<InstanceId, InstanceId>, PairMotion> by_pair;
   if (options.clearance > 0.0) {

@@ -74,11 +74,42 @@ Range along(const Aabb& box, const Pose& pose, const Vec3& u, double tilt) {
   return {mid - half - pad, mid + half + pad};
 }
 
+// The least distance from `line` of the placed box's points: across the line the box is the zonotope
+// y0 + sum t_i g_i (|t_i| <= 1) in the plane normal to it, and for any unit n of that plane
+// n.y0 - sum |n.g_i| is at most its distance from the line (the least of n.y over the zonotope).
+// The distance itself is that at the normal of an edge (a g_i turned a quarter) or at the direction
+// of a corner, whichever is nearest: the largest over those candidates is exact.
+double least_from_axis(const Aabb& box, const Pose& pose, const Line& line) {
+  const Vec3 e1 = line.u.unitOrthogonal(), e2 = line.u.cross(e1);
+  const Vec3 c = pose * box.center(), h = 0.5 * box.sizes();
+  const Eigen::Vector2d y0(e1.dot(c - line.point), e2.dot(c - line.point));
+  Eigen::Vector2d g[3];
+  double spread = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 col = h[i] * pose.linear().col(i);
+    g[i] = Eigen::Vector2d(e1.dot(col), e2.dot(col));
+    spread += g[i].norm();
+  }
+  auto below = [&](const Eigen::Vector2d& n) {
+    return n.dot(y0) - std::abs(n.dot(g[0])) - std::abs(n.dot(g[1])) - std::abs(n.dot(g[2]));
+  };
+  double best = 0.0;
+  auto try_direction = [&](const Eigen::Vector2d& v) {
+    if (const double n = v.norm(); n > 0.0) best = std::max(best, below(v / n));
+  };
+  for (const Eigen::Vector2d& gi : g) try_direction(Eigen::Vector2d(-gi.y(), gi.x())), try_direction(Eigen::Vector2d(gi.y(), -gi.x()));
+  for (int k = 0; k < 8; ++k)
+    try_direction(y0 + (k & 1 ? 1.0 : -1.0) * g[0] + (k & 2 ? 1.0 : -1.0) * g[1] + (k & 4 ? 1.0 : -1.0) * g[2]);
+  // The line's own error over the box, and the rounding of the placed centre, the projections and
+  // the sums (a few ulps of their magnitudes).
+  const double round = 64.0 * kUnit * (c.norm() + line.point.norm() + y0.norm() + spread + h.norm() + 1.0);
+  return std::max(0.0, best - line.error(c) - (line.tilt + 16.0 * kUnit) * h.norm() - round);
+}
+
 // The distance from `line` of the points of the box (part-local) placed by `pose`: its largest at a
-// corner (convex), its least at most the box's half diagonal below the centre's.
+// corner (convex), its least least_from_axis.
 Range from_axis(const Aabb& box, const Pose& pose, const Line& line) {
-  const Vec3 c = pose * box.center();
-  Range r{std::max(0.0, line.rho(c) - 0.5 * box.sizes().norm() - line.error(c)), 0.0};
+  Range r{least_from_axis(box, pose, line), 0.0};
   for (int k = 0; k < 8; ++k) {
     const Vec3 x = pose * box.corner(static_cast<Aabb::CornerType>(k));
     r.hi = std::max(r.hi, line.rho(x) + line.error(x));

@@ -266,6 +266,71 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
   }
 }
 
+// A block resting on the plate lifts off it while it turns 170 degrees (a nut unscrewed off its
+// seat): in contact until it has risen T = 0.01 mm (s = 0.01), clear after. What the turn keeps
+// (the rise) places the end of the contact within a hair: the search checks one resolution-wide
+// span there and the contact before it, instead of halving down to it from the whole stretch (about
+// two checks per halving, twenty for a resolution of 1/1000). Lowered onto the plate instead, the
+// contact begins as it arrives (s = 0.99), found the same way.
+TEST(ContinuousMotion, AContactTheShiftEndsIsBracketedWithoutHalvingDownToIt) {
+  for (const Pose& place : placements()) {
+    Model m;
+    add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
+    const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
+    auto at = [&](double turn, double z) {
+      Pose p = place;
+      p.translate(Vec3(10, 10, z));
+      p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
+      return p;
+    };
+    const double turn = 170.0 * std::numbers::pi / 180.0;
+    Scene scene(m);
+    const InstanceId moving[] = {block};
+    CollideOptions o;
+    o.tolerance = 0.01;
+    MotionOptions mo;
+    mo.resolution = 1e-3;
+    for (const bool up : {true, false}) {
+      SCOPED_TRACE(up);
+      const Pose from[] = {up ? at(0.0, 1.0) : at(-turn, 2.0)}, to[] = {up ? at(turn, 2.0) : at(0.0, 1.0)};
+      scene.set_pose(block, from[0]);
+      const MotionResult r = check_motion(scene, m, moving, from, to, o, mo);
+      EXPECT_TRUE(r.complete);
+      ASSERT_EQ(r.pairs.size(), 1u);
+      const double lo = up ? 0.0 : 0.99 + 1e-4, hi = up ? 0.01 - 1e-4 : 1.0;
+      expect_spans(r, lo, hi, up ? 0.0 : 0.99 - mo.resolution, up ? 0.01 + mo.resolution : 1.0);
+      for (const MotionSpan& s : r.pairs[0].spans) {
+        if (!s.contact_at_ends) {
+          EXPECT_LE(s.s1 - s.s0, mo.resolution + 1e-15);
+        }
+      }
+      EXPECT_LE(r.checks, 8u);
+    }
+  }
+}
+
+// A cube falling through a slab 10 mm thick is inside it, touching none of its faces, while its
+// bottom goes from 8 mm down to 0 (s in [0.23, 0.5]): in contact all the same (containment), so
+// the pair's spans cover its whole passage, s in [1/6, 17/30], although what the fall keeps apart
+// clears every pair of their faces over the middle of it.
+TEST(ContinuousMotion, APartInsideAnotherBetweenItsFacesStaysInContact) {
+  for (const Pose& place : placements()) {
+    Model m;
+    add_instance(m, "/slab", add_part(m, "slab", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 10), 4)), place);
+    const InstanceId cube = add_instance(m, "/cube", add_part(m, "cube", box_surfaces(Vec3(0, 0, 0), Vec3(2, 2, 2), 2)));
+    Scene scene(m);
+    const Pose from[] = {place * translation(9, 9, 15)}, to[] = {place * translation(9, 9, -15)};
+    scene.set_pose(cube, from[0]);
+    const InstanceId moving[] = {cube};
+    MotionOptions mo;
+    mo.resolution = 1e-3;
+    const MotionResult r = check_motion(scene, m, moving, from, to, {}, mo);
+    EXPECT_TRUE(r.complete);
+    ASSERT_EQ(r.pairs.size(), 1u);
+    expect_spans(r, 1.0 / 6.0 + 1e-3, 17.0 / 30.0 - 1e-3, 1.0 / 6.0 - 2e-3, 17.0 / 30.0 + 2e-3);
+  }
+}
+
 // A face near the axis of a turn moves only as far as its own points do, not as far as the part's
 // far end: a hub 0.5 mm from a wall, on a part whose arm reaches 50 mm from the axis, is cleared
 // by the first check (the arm's travel would halve the stretch again and again). What the turn
@@ -464,6 +529,54 @@ TEST(ContinuousMotion, EachSurfacePairGetsItsOwnSpans) {
       for (const MotionSpan& q : p.spans) inside |= q.s0 <= s.s0 && s.s1 <= q.s1;
       EXPECT_TRUE(inside) << sm.a << " x " << sm.b << " [" << s.s0 << ", " << s.s1 << "]";
     }
+}
+
+// A plate turning 170 degrees about a post that pierces it (in contact throughout) while it rises
+// 2 mm past a ledge of the post's part at its own height half-way up, and along a fin of it 0.6 mm
+// high: the plate touches the ledge while they are within T of one plane, s in [0.495, 0.505], and
+// the fin for s in [0.495, 0.805]. What the rise keeps apart places the ends of each within a
+// hair, in each part of the stretch the search looks at, where halving would go down to them level
+// by level (the plate's corners sweep 10 mm: its travel proves nothing, and the fin is in contact
+// in the middle of the parts around the ledge's end).
+TEST(ContinuousMotion, ContactsThatBeginAndEndWithinAStretchAreFoundWhereTheShiftPlacesThem) {
+  for (const Pose& place : placements()) {
+    Model m;
+    std::vector<Surface> frame = box_surfaces(Vec3(-1, -1, 0), Vec3(1, 1, 20), 2);
+    frame.push_back(grid_surface("ledge", Vec3(2, -0.5, 10), Vec3(1.5, 0, 0), Vec3(0, 1, 0), 2));
+    frame.push_back(grid_surface("fin", Vec3(-3.5, 0, 10), Vec3(1.5, 0, 0), Vec3(0, 0, 0.6), 2));
+    add_instance(m, "/frame", add_part(m, "frame", std::move(frame)), place);
+    const InstanceId plate = add_instance(
+        m, "/plate", add_part(m, "plate", {grid_surface("face", Vec3(-4, -4, 0), Vec3(8, 0, 0), Vec3(0, 8, 0), 4)}));
+    const SurfaceId ledge = 6, fin = 7, face = 8;
+    auto at = [&](double turn, double z) {
+      Pose p = place;
+      p.translate(Vec3(0, 0, z));
+      p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
+      return p;
+    };
+    Scene scene(m);
+    const Pose from[] = {at(0.0, 9.0)}, to[] = {at(170.0 * std::numbers::pi / 180.0, 11.0)};
+    scene.set_pose(plate, from[0]);
+    const InstanceId moving[] = {plate};
+    CollideOptions o;
+    o.tolerance = 0.01;
+    MotionOptions mo;
+    mo.resolution = 1e-3;
+    const MotionResult r = check_motion(scene, m, moving, from, to, o, mo);
+    EXPECT_TRUE(r.complete);
+    ASSERT_EQ(r.pairs.size(), 1u);
+    ASSERT_EQ(r.pairs[0].spans.size(), 1u);
+    EXPECT_TRUE(r.pairs[0].spans[0].contact_at_ends);
+    for (const auto& [with, end] : {std::pair{ledge, 0.505}, std::pair{fin, 0.805}}) {
+      SCOPED_TRACE(with);
+      const std::vector<MotionSpan> spans = surface_spans(r.pairs[0], with, face);
+      ASSERT_FALSE(spans.empty());
+      EXPECT_TRUE(covers(spans, 0.495, end, 0.495 - mo.resolution, end + mo.resolution));
+    }
+    // 13 checks; 16 when the parts' ends are not placed by the rise (the fin's contact in the
+    // middle of a part halves it again), 37 without the resolution-wide pieces.
+    EXPECT_LE(r.checks, 14u);
+  }
 }
 
 // A whole path (replay_continuous): the cube goes down through the plate between steps 0 and 10

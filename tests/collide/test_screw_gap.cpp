@@ -139,6 +139,37 @@ TEST(ScrewGap, AFaceAlongTheAxisMovesOnlyByTheShift) {
                 sampled_distance(s.model.surfaces[0], from, to, s.model.surfaces[1], still, s0, s1));
 }
 
+// A square turning about its centre beside a wall parallel to the axis (a nut turned beside its
+// neighbour's flank): its corners reach 4 sqrt(2) from the axis and the wall is 8 from it, however
+// tall and wide, so the turn keeps them 8 - 4 sqrt(2) apart. (The wall's box centre is 8 from the
+// axis but its half diagonal is 3.4: the wall's least distance is its box's own, not the centre's
+// less the half diagonal.)
+TEST(ScrewGap, AWallBesideTheTurnKeepsItsDistanceFromTheAxis) {
+  Surface wall;
+  wall.aabb = Aabb(Vec3(8, -3, -1), Vec3(8, 3, 3));
+  wall.analytic.shape = SurfaceShape::Plane;
+  wall.analytic.origin = Vec3(8, 0, 0);
+  wall.analytic.axis = Vec3::UnitX();
+  wall.uncertainty = wall.tolerance = 1e-7;
+  const Scene2 s = two(square(4.0, 0.0), wall);
+  // The wall as built, turned about the axis (its box's edges then run across it), and leaning
+  // 0.3 radians about its own foot line, which brings its lower edge sin(0.3) nearer the axis.
+  Pose lean = pose(Vec3::UnitY(), 0.3, Vec3::Zero());
+  lean.translation() = Vec3(8, 0, 0) - lean.linear() * Vec3(8, 0, 0);
+  const double reach = 4.0 * std::sqrt(2.0);
+  for (const Vec3& where : {Vec3(0, 0, 0), Vec3(1.2e4, -2e4, 5e3)})
+    for (const auto& [placed, gap] : {std::pair{pose(Vec3::UnitZ(), 0.0, Vec3::Zero()), 8.0 - reach},
+                                      std::pair{pose(Vec3::UnitZ(), 0.5, Vec3::Zero()), 8.0 - reach},
+                                      std::pair{lean, 8.0 - std::sin(0.3) - reach}}) {
+      const Pose from = pose(Vec3::UnitZ(), 0.2, where), to = pose(Vec3::UnitZ(), 2.9, where + Vec3(0, 0, 1));
+      const Pose still = pose(Vec3::UnitZ(), 0.0, where) * placed;
+      const double g = screw_gap(s.model, s.moving, from, screw_of(from, to), s.still, still, 0.0, 1.0);
+      EXPECT_GT(g, gap - 1e-6);
+      EXPECT_LE(g, gap);
+      EXPECT_LE(g, sampled_distance(s.model.surfaces[0], from, to, s.model.surfaces[1], still, 0.0, 1.0));
+    }
+}
+
 // A pin pulled along a bore's axis (a shift, no turn) keeps the radial gap; pulled across, not.
 TEST(ScrewGap, APinPulledAlongItsBoreKeepsTheGap) {
   const Scene2 s = two(cylinder(3.0, 0.0, 10.0), cylinder(3.1, 0.0, 10.0));
@@ -179,7 +210,9 @@ TEST(ScrewGap, NeverAboveTheSampledDistance) {
     const Surface still_face = trial % 3 == 1 ? square(6.0, 2.0 * unit(rng)) : cylinder(1.0 + 3.0 * pos(rng), -4.0, 4.0);
     Pose still = Pose::Identity();
     still.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis).toRotationMatrix();
-    still.translation() = c;
+    // Some still faces lie off the axis, across it, and turned about another line.
+    still.translation() = c + (trial % 7 == 0 ? 6.0 * pos(rng) : 0.0) * axis.unitOrthogonal();
+    if (trial % 7 == 0) still.linear() = Eigen::AngleAxisd(0.6 * unit(rng), axis.unitOrthogonal()).toRotationMatrix() * still.linear();
     const Scene2 s = two(moving, still_face);
     const double s0 = 0.5 * pos(rng), s1 = s0 + 0.5 * pos(rng);
     const double g = screw_gap(s.model, s.moving, from, screw_of(from, to), s.still, still, s0, s1);

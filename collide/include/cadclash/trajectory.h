@@ -99,11 +99,18 @@ double relative_travel_bound(const Pose& a0, const Pose& a1, const Aabb& box_a, 
 // stays, when what the part's screw keeps proves them apart by more than T over the whole stretch
 // (a point's coordinate along the screw's axis shifts by s times the shift, its distance from the
 // axis stays: a nut's face rising off a plate, its bore turning about the bolt's exact cylinder;
-// from the faces' boxes and their exact cylinders, cones and tori about the axis; certified checks
-// only; such pairs are left out of the stretch's check, CollideOptions::proved_apart, so that it
-// neither meshes nor decides them). Pairs it cannot clear are halved, down to `resolution`;
-// when every pair halved is proved apart in the middle, the part around it where their travel stays
-// below that margin is left out of both halves (conservative advancement). A part of the stretch
+// from the faces' boxes (each box's least and largest distance from the axis) and their exact
+// cylinders, cones and tori about the axis; certified checks only; such pairs are left out of the
+// stretch's check, CollideOptions::proved_apart, so that it neither meshes nor decides them). Pairs
+// it cannot clear are halved, down to `resolution`; when every pair halved is proved apart in the
+// middle, the part around it where their travel stays below that margin, or where the screw keeps
+// them apart, is left out of both halves (conservative advancement). Each half is searched, for
+// each pair, only between the ends the screw keeps that pair apart beyond, and where a part ends
+// at such a point a piece one resolution wide beside it is searched on its own: a contact the
+// screw's shift makes or breaks (a nut leaving its seat, a face passing a plane) lies there, and
+// is bracketed by a check or two instead of halving down to it. An instance pair is kept apart by
+// its surface pairs only where that joins the middle, where the check saw no containment (a part
+// held inside another touches none of its faces). A part of the stretch
 // where the pair is proved in contact at both ends is not halved further (in between it is not
 // proved either way). Contact that begins and ends between two steps, a part passing through a thin
 // plate, is found: such a stretch is never cleared. A pair of two instances that stay keeps the
