@@ -6,6 +6,8 @@
 #include <atomic>
 #include <cassert>
 #include <cctype>
+#include <charconv>
+#include <cstring>
 #include <exception>
 #include <numeric>
 #include <span>
@@ -40,6 +42,11 @@ std::optional<Scan> scan(const std::string& text, std::string& why) {
   Scan out;
   out.header = std::string_view(text).substr(0, text.find("DATA;"));
   std::vector<std::int64_t> raw;  // referenced ids, resolved to statements below
+  // At most one statement per ';' (strings may hold more): reserved at once, as growing tens of MB
+  // of statements step by step copies them again and again.
+  const auto semicolons = static_cast<std::size_t>(std::count(text.begin(), text.end(), ';'));
+  out.statements.reserve(semicolons);
+  raw.reserve(semicolons + semicolons / 2);
   std::size_t first_ref = 0;
   const bool scanned = for_each_statement(
       text,
@@ -184,8 +191,15 @@ std::string_view file_schema(std::string_view header) {
   return header.substr(at, end == std::string_view::npos ? std::string_view::npos : end + 1 - at);
 }
 
+void append_number(std::string& out, std::int64_t v) {
+  char digits[24];
+  const auto end = std::to_chars(digits, digits + sizeof digits, v).ptr;
+  out.append(digits, end);
+}
+
 // Statement k with its own id and the ones it references (`refs`, in the order for_each_statement
-// found them) replaced by `number`'s of their statements, copied in runs between them.
+// found them) replaced by `number`'s of their statements, copied in runs between them. The next '#'
+// and the next quote are found a run at a time (memchr); a quoted string is skipped whole.
 void renumbered(const std::string& text, std::uint32_t k, const Statement& s, std::span<const std::uint32_t> refs,
                 const std::vector<std::int64_t>& number, std::string& out) {
   auto id_end = [&](std::size_t hash) {  // just after the digits of the id at text[hash] == '#'
@@ -194,23 +208,34 @@ void renumbered(const std::string& text, std::uint32_t k, const Statement& s, st
     while (j < s.end && step_digit(text[j]) && id < (std::int64_t{1} << 50)) id = id * 10 + (text[j++] - '0');
     return j;
   };
+  auto next = [&](char c, std::size_t from) {  // the first c in [from, s.end), or s.end
+    if (from >= s.end) return s.end;
+    const void* at = std::memchr(text.data() + from, c, s.end - from);
+    return at ? static_cast<std::size_t>(static_cast<const char*>(at) - text.data()) : s.end;
+  };
   out += '#';
-  out += std::to_string(number[k]);
+  append_number(out, number[k]);
   std::size_t from = id_end(s.begin), r = 0;
-  for (std::size_t i = s.body; i < s.end; ++i) {
-    const char c = text[i];
-    if (c == '\'') {
-      i = text.find('\'', i + 1);  // the statement ends after its strings: found
-    } else if (c == '#') {
-      const std::size_t j = id_end(i);
-      if (j == i + 1) continue;
-      assert(r < refs.size());
-      out.append(text, from, i - from);
-      out += '#';
-      out += std::to_string(number[refs[r++]]);
-      from = j;
-      i = j - 1;
+  std::size_t quote = next('\'', s.body), hash = next('#', s.body);
+  while (hash < s.end) {
+    if (quote < hash) {
+      const std::size_t close = next('\'', quote + 1);  // the statement ends after its strings: found
+      if (close >= s.end) break;
+      quote = next('\'', close + 1);
+      if (hash <= close) hash = next('#', close + 1);
+      continue;
     }
+    const std::size_t j = id_end(hash);
+    if (j == hash + 1) {
+      hash = next('#', j);
+      continue;
+    }
+    assert(r < refs.size());
+    out.append(text, from, hash - from);
+    out += '#';
+    append_number(out, number[refs[r++]]);
+    from = j;
+    hash = next('#', j);
   }
   assert(r == refs.size());
   out.append(text, from, s.end - from);
@@ -479,7 +504,6 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
         stamp[k] = w;
         members[w].push_back(k);
       }
-    std::sort(members[w].begin(), members[w].end());
   }
 
   // The main text: every statement no piece took as an item's inside, the leaves they reach, and a
@@ -580,6 +604,7 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
   // one thread again.
   auto write_piece = [&](std::uint32_t w, std::vector<std::int64_t>& number) {
     StepPiece& piece = out.pieces[w];
+    std::sort(members[w].begin(), members[w].end());  // in file order (here: on the writers' threads)
     piece.text.append(sc.header);
     piece.text += "DATA;\n";
     for (const std::uint32_t k : members[w]) {
