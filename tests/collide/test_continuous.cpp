@@ -210,6 +210,24 @@ TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
   (void)rod;
 }
 
+// An 8 x 8 x 1 block over the plate (both placed by `place`), the block's pose at height z above
+// the plate's bottom, turned by `turn` about the vertical through its centre.
+struct BlockOverPlate {
+  Model m;
+  InstanceId plate = 0, block = 1;
+  Pose place;
+  explicit BlockOverPlate(const Pose& where) : place(where) {
+    plate = add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
+    block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
+  }
+  Pose at(double turn, double z) const {
+    Pose p = place;
+    p.translate(Vec3(10, 10, z));
+    p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
+    return p;
+  }
+};
+
 // A block 0.2 mm above the plate turned 170 degrees about the vertical through its centre while it
 // rises 1 mm: its corners sweep 17 mm over the plate, so its travel proves nothing short of a
 // hundredth of the stretch, but a turn about the vertical cannot bring a face nearer the plate
@@ -218,15 +236,10 @@ TEST(ContinuousMotion, AFrameUnscrewedOffARodStaysAroundIt) {
 TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
   // The same wherever the assembly is placed.
   for (const Pose& place : placements()) {
-    Model m;
-    const InstanceId plate = add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
-    const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
-    auto at = [&](double turn, double z) {
-      Pose p = place;
-      p.translate(Vec3(10, 10, z));
-      p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
-      return p;
-    };
+    BlockOverPlate f(place);
+    Model& m = f.m;
+    const InstanceId block = f.block;
+    auto at = [&](double turn, double z) { return f.at(turn, z); };
     const double turn = 170.0 * std::numbers::pi / 180.0;
     Scene scene(m);
     const InstanceId moving[] = {block};
@@ -262,7 +275,6 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
       expect_spans(r, 0.4 + 1e-3, 1.0, 0.4 - 2e-3, 1.0);
       EXPECT_TRUE(r.complete);
     }
-    (void)plate;
   }
 }
 
@@ -273,28 +285,20 @@ TEST(ContinuousMotion, ABlockTurningAboveThePlateIsClearedByWhatTheTurnKeeps) {
 // two checks per halving, twenty for a resolution of 1/1000). Lowered onto the plate instead, the
 // contact begins as it arrives (s = 0.99), found the same way.
 TEST(ContinuousMotion, AContactTheShiftEndsIsBracketedWithoutHalvingDownToIt) {
+  const double turn = 170.0 * std::numbers::pi / 180.0;
+  CollideOptions o;
+  o.tolerance = 0.01;
+  MotionOptions mo;
+  mo.resolution = 1e-3;
   for (const Pose& place : placements()) {
-    Model m;
-    add_instance(m, "/plate", add_part(m, "plate", box_surfaces(Vec3(0, 0, 0), Vec3(20, 20, 1), 4)), place);
-    const InstanceId block = add_instance(m, "/block", add_part(m, "block", box_surfaces(Vec3(-4, -4, 0), Vec3(4, 4, 1), 2)));
-    auto at = [&](double turn, double z) {
-      Pose p = place;
-      p.translate(Vec3(10, 10, z));
-      p.rotate(Eigen::AngleAxisd(turn, Vec3::UnitZ()));
-      return p;
-    };
-    const double turn = 170.0 * std::numbers::pi / 180.0;
-    Scene scene(m);
-    const InstanceId moving[] = {block};
-    CollideOptions o;
-    o.tolerance = 0.01;
-    MotionOptions mo;
-    mo.resolution = 1e-3;
+    BlockOverPlate f(place);
+    Scene scene(f.m);
+    const InstanceId moving[] = {f.block};
     for (const bool up : {true, false}) {
       SCOPED_TRACE(up);
-      const Pose from[] = {up ? at(0.0, 1.0) : at(-turn, 2.0)}, to[] = {up ? at(turn, 2.0) : at(0.0, 1.0)};
-      scene.set_pose(block, from[0]);
-      const MotionResult r = check_motion(scene, m, moving, from, to, o, mo);
+      const Pose from[] = {up ? f.at(0.0, 1.0) : f.at(-turn, 2.0)}, to[] = {up ? f.at(turn, 2.0) : f.at(0.0, 1.0)};
+      scene.set_pose(f.block, from[0]);
+      const MotionResult r = check_motion(scene, f.m, moving, from, to, o, mo);
       EXPECT_TRUE(r.complete);
       ASSERT_EQ(r.pairs.size(), 1u);
       const double lo = up ? 0.0 : 0.99 + 1e-4, hi = up ? 0.01 - 1e-4 : 1.0;
