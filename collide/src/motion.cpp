@@ -584,9 +584,13 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       std::vector<std::pair<double, double>> windows;
       if (screw_start) windows.emplace_back(a, a + probe);
       if (screw_end) windows.emplace_back(b - probe, b);
+      std::map<PairKey, std::pair<double, double>> kept;  // per key asked: an instance pair's is its surface pairs'
       for (const PairKey& k : halve) {
         const PairKey whole{std::get<0>(k), std::get<1>(k), kInvalidId, kInvalidId};
-        const auto [p, q] = kept_ends(halve.count(whole) ? whole : k, a, b, before_mid);
+        const PairKey& by = halve.count(whole) ? whole : k;
+        auto found = kept.find(by);
+        if (found == kept.end()) found = kept.emplace(by, kept_ends(by, a, b, before_mid)).first;
+        const auto [p, q] = found->second;
         if (p >= q) continue;  // kept apart at one end or the other: free over the part
         where.push_back({k, {p, q}});
         if (p > a) windows.emplace_back(p, p + probe);
@@ -603,9 +607,9 @@ MotionResult check_motion(Scene& scene, const Model& model, std::span<const Inst
       }
       std::vector<std::pair<double, double>> pieces;
       double next = a;
-      for (const auto& [u, v] : joined) {
+      for (const auto& [u, v] : joined) {  // ascending, apart, within [a, b]
         if (u > next) pieces.emplace_back(next, u);
-        if (v > std::max(u, next)) pieces.emplace_back(std::max(u, next), v), next = v;
+        if (v > u) pieces.emplace_back(u, v), next = v;
       }
       if (next < b) pieces.emplace_back(next, b);
       for (const auto& [u, v] : pieces) {
