@@ -2,12 +2,15 @@
 #include "cad_xcaf.h"
 
 #include "brep_part_cache.h"
+#include "transfer_fix_context.h"
 
 #include <Interface_Check.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
 #include <Quantity_Color.hxx>
+#include <ShapeAlgo.hxx>
+#include <ShapeAlgo_AlgoContainer.hxx>
 #include <Standard_Failure.hxx>
 #include <TCollection_AsciiString.hxx>
 #include <TDF_Label.hxx>
@@ -393,8 +396,12 @@ void prepare_occt_exchange() {
   std::call_once(once, [] {
     const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
     if (!messenger.IsNull()) messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
-    XSAlgo::Init();
+    XSAlgo::Init();  // ShapeAlgo::Init() too
     XSAlgo::SetAlgoContainer(new SwitchedHealing);
+    // The healing's ShapeFix_Shape works in a context that does not walk a face's unchanged wires
+    // once per wire (transfer_fix_context.h): the same shapes, a drilled board plate's transfer
+    // in half the time.
+    ShapeAlgo::AlgoContainer()->SetToolContainer(transfer_fix_tools());
   });
 }
 
