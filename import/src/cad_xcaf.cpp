@@ -377,15 +377,22 @@ thread_local bool t_transfer_healing = true;
 // ProcessShape; this one runs it only when the reading thread asks for it. A container, not a
 // resource file: Interface_Static's sequence names are global to the process, and the resource
 // manager ShapeProcess loads is a static shared by every thread.
+//
+// OCCT takes the healing's parameters from the resource file the environment names for the
+// reader's resource ("STEP": CSF_STEPDefaults; "IGES": CSF_IGESDefaults) and heals with its own
+// defaults when none is named (Debian names none). Asked for a resource no environment names, it
+// always heals with those defaults: the same file gives the same faces on every machine.
+constexpr const char* kNoHealingResource = "cadclash-default-healing";
+
 class SwitchedHealing final : public XSAlgo_AlgoContainer {
  public:
   TopoDS_Shape ProcessShape(const TopoDS_Shape& shape, const Standard_Real precision, const Standard_Real max_tolerance,
-                            const Standard_CString resource, const Standard_CString sequence,
+                            const Standard_CString /*resource*/, const Standard_CString sequence,
                             Handle(Standard_Transient)& info, const Message_ProgressRange& progress,
                             const Standard_Boolean non_manifold) const override {
     if (!t_transfer_healing) return shape;
-    return XSAlgo_AlgoContainer::ProcessShape(shape, precision, max_tolerance, resource, sequence, info, progress,
-                                              non_manifold);
+    return XSAlgo_AlgoContainer::ProcessShape(shape, precision, max_tolerance, kNoHealingResource, sequence, info,
+                                              progress, non_manifold);
   }
 };
 
