@@ -21,7 +21,7 @@ struct StepPiece {
   std::vector<std::int64_t> bind;  // ids whose shapes the main reader needs (its placeholders), ascending
   std::size_t bytes = 0;           // of the statements inside its items
   // What it costs to read, in bytes' worth (for sharing pieces out): its bytes, and for each face
-  // with n bounds 2.5 n^2 (OCCT's healing at transfer compares every wire with every other).
+  // with n bounds 2 n^2 / 3 (OCCT's healing at transfer compares every wire with every other).
   std::size_t weight = 0;
   // With `canonical` asked: the piece's schema and statements with ids renumbered 1, 2, ... in the
   // order the piece defines them (the same for the same product however the rest of the file is

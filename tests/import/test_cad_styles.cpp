@@ -178,7 +178,7 @@ TEST(CadStyles, StyledFacesGoIntoTheirPiecesWithTheSameColours) {
 }
 
 // A piece's weight (what the pieces are shared out by) is its bytes and, for each face of n bounds,
-// 2.5 n^2: counted here from the pieces' own text.
+// 2 n^2 / 3: counted here from the pieces' own text.
 // A plate drilled `holes` times (its two large faces have holes + 1 bounds each) beside a block.
 std::string write_drilled_board(int holes) {
   testing::XcafTestDoc doc;
@@ -211,16 +211,16 @@ TEST(CadSplit, APiecesWeightCountsItsFacesWires) {
     for (auto it = std::sregex_iterator(piece.text.begin(), piece.text.end(), face); it != std::sregex_iterator(); ++it) {
       const std::string bounds = (*it)[2];
       const auto n = static_cast<std::size_t>(std::count(bounds.begin(), bounds.end(), '#'));
-      wires += n * n * 5 / 2;
+      wires += n * n * 2 / 3;
       ++faces;
     }
     EXPECT_EQ(piece.weight, piece.bytes + wires);
   }
   EXPECT_GT(faces, 6u + 12u);
-  // The plate's piece: its two drilled faces of 13 bounds weigh 2 x 422.
+  // The plate's piece: its two drilled faces of 13 bounds weigh 2 x 112.
   const auto heaviest = std::max_element(split->pieces.begin(), split->pieces.end(),
                                          [](const auto& a, const auto& b) { return a.weight - a.bytes < b.weight - b.bytes; });
-  EXPECT_GE(heaviest->weight - heaviest->bytes, 2u * 422u);
+  EXPECT_GE(heaviest->weight - heaviest->bytes, 2u * 112u);
 }
 
 // The pieces go to the workers by weight, not bytes: largest first onto the least loaded.
