@@ -87,7 +87,7 @@ void store_plane_pcurves(const std::vector<TopoDS_Face>& faces) {
 // Faces marked in `far` (a vertex past the supported range: dropped with an error once their exact
 // boxes are taken) are neither checked nor healed.
 std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& impl, const std::vector<char>& far,
-                                     std::vector<Diagnostic>& diagnostics) {
+                                     bool parallel, std::vector<Diagnostic>& diagnostics) {
   const std::size_t n = impl.faces.size();
   std::vector<char> healed(n, 0);
   const bool any_far = std::any_of(far.begin(), far.end(), [](char c) { return c != 0; });
@@ -104,8 +104,17 @@ std::vector<char> heal_invalid_faces(const BrepPartInput& in, BrepSource::Impl& 
     }
   }
   if (whole_valid) return healed;
+  // The faces' checks only read them (BRepCheck runs its own in parallel on one shape's faces);
+  // on threads when this part is checked alone (a re-run whose one changed part is a drilled
+  // board plate: its two large faces and its holes' walls). The healing writes: in face order.
+  std::vector<char> valid(n, 1);
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1)
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(n); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (!far[i]) valid[i] = detail::face_is_valid(impl.faces[i]) ? 1 : 0;
+  }
   for (std::size_t i = 0; i < n; ++i) {
-    if (far[i] || detail::face_is_valid(impl.faces[i])) continue;
+    if (far[i] || valid[i]) continue;
     healed[i] = heal_face(impl.faces[i]) ? 1 : 0;
     const bool fixed = healed[i] != 0 && detail::face_is_valid(impl.faces[i]);
     diagnostics.push_back(Diagnostic{Severity::Warning, in.source_file, 0, impl.entity_ids[i],
@@ -236,7 +245,7 @@ void prepare_part(const BrepPartInput& in, const TessellationOptions& options, P
       const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(ex.Current()));
       far[i] = !in_supported_range(std::max({std::abs(p.X()), std::abs(p.Y()), std::abs(p.Z())}));
     }
-  const std::vector<char> healed = heal_invalid_faces(in, impl, far, w.diagnostics);
+  const std::vector<char> healed = heal_invalid_faces(in, impl, far, options.parallel, w.diagnostics);
   store_plane_pcurves(impl.faces);
 
   impl.boxes.resize(n);

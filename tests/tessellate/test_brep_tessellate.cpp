@@ -4,6 +4,13 @@
 #include "cadclash/tessellate.h"
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRep_Builder.hxx>
+#include <Geom_Plane.hxx>
+#include <Precision.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Wire.hxx>
+#include <gp_Pln.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepClass_FaceClassifier.hxx>
 #include <BRepGProp.hxx>
@@ -23,6 +30,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -177,6 +185,53 @@ TEST(BrepTessellate, DrilledPlatesFacesAreCoveredByTheirTriangles) {
     drilled += s.mesh.triangles.size() > 500;
   }
   EXPECT_EQ(drilled, 2);  // the top and the bottom
+}
+
+// A square in z = `z` whose four edges each carry their own end vertices (coincident, not shared):
+// BRepCheck rejects it, ShapeFix_Face heals it.
+TopoDS_Face square_with_unshared_vertices(double z) {
+  const gp_Pnt p[4] = {{0, 0, z}, {10, 0, z}, {10, 10, z}, {0, 10, z}};
+  BRep_Builder builder;
+  TopoDS_Wire wire;
+  builder.MakeWire(wire);
+  for (int i = 0; i < 4; ++i) builder.Add(wire, BRepBuilderAPI_MakeEdge(p[i], p[(i + 1) % 4]).Edge());
+  TopoDS_Face face;
+  builder.MakeFace(face, new Geom_Plane(gp_Pln(gp_Pnt(0, 0, z), gp::DZ())), Precision::Confusion());
+  builder.Add(face, wire);
+  return face;
+}
+
+// A part holding a drilled face has its faces checked one by one; alone (a re-run whose one
+// changed part is a board plate) they are checked on threads: the same faces healed, the same
+// warnings in face order, as on one thread.
+TEST(BrepTessellate, APartsFacesCheckedOnThreadsAreHealedAsOnOne) {
+  TopoDS_Compound part;
+  BRep_Builder builder;
+  builder.MakeCompound(part);
+  builder.Add(part, drilled_plate(8));
+  for (int k = 0; k < 5; ++k) builder.Add(part, square_with_unshared_vertices(20.0 + 5.0 * k));
+  std::vector<std::vector<std::string>> warnings;
+  std::vector<std::vector<bool>> healed;
+  for (const bool parallel : {false, true}) {
+    BrepPartInput in;
+    const TopoDS_Shape shape = part;
+    in.shape = &shape;
+    in.name = "plate and squares";
+    TessellationOptions options;
+    options.parallel = parallel;
+    Model m;
+    std::vector<Diagnostic> ds;
+    bool complete = true;
+    add_brep_parts(m, std::span<const BrepPartInput>(&in, 1), options, true, ds, complete);
+    warnings.emplace_back();
+    for (const Diagnostic& d : ds) warnings.back().push_back(d.message);
+    healed.emplace_back();
+    for (const Surface& s : m.surfaces) healed.back().push_back(s.provenance.healed);
+  }
+  EXPECT_EQ(warnings[1], warnings[0]);
+  EXPECT_EQ(healed[1], healed[0]);
+  EXPECT_EQ(std::count(healed[0].begin(), healed[0].end(), true), 5);
+  EXPECT_EQ(warnings[0].size(), 5u);
 }
 
 // OCCT picks its default triangulation from the CSF_MeshAlgo environment variable; cadclash names
