@@ -43,6 +43,7 @@
 #include <future>
 #include <optional>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
 #include <utility>
 
@@ -213,8 +214,30 @@ void colour_styled_faces(const Handle(TDocStd_Document)& doc, const std::vector<
 bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const Handle(XSControl_WorkSession)& ws,
                  const EntityLabelFn& label, const std::string& path, ReadBindings& bound, std::vector<Diagnostic>& notes) {
   std::string why;
-  const std::vector<ChildRun> runs = read.workers ? read.workers->wait() : std::vector<ChildRun>{};
-  if (read.workers) read.costs.workers = std::chrono::duration<double>(std::chrono::steady_clock::now() - read.started).count();
+  // The pieces the cache gave are decoded on a thread of their own while this one waits for the
+  // workers (a re-run's changed pieces): each piece apart, joined in piece order below as one pass
+  // in piece order makes them; the workers' time stays theirs.
+  std::vector<ReadBindings> each(read.bytes.size());
+  std::vector<char> decoded(read.bytes.size(), 0);
+  bool cached_whole = true;
+  auto decode_cached = [&] {
+    try {
+      for (std::size_t p = 0; p < read.bytes.size() && cached_whole; ++p)
+        if (read.bytes[p]) cached_whole = (decoded[p] = read_binding_bytes(*read.bytes[p], each[p], why)) != 0;
+    } catch (...) {
+      cached_whole = false;
+    }
+  };
+  std::vector<ChildRun> runs;
+  if (read.workers) {
+    std::thread decoding(decode_cached);
+    runs = read.workers->wait();
+    read.costs.workers = std::chrono::duration<double>(std::chrono::steady_clock::now() - read.started).count();
+    decoding.join();
+  } else {
+    decode_cached();
+  }
+  if (!cached_whole) return false;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const ChildRun& run = runs[k];
     if (!run.isolated || run.crashed || run.payload.empty()) return false;
@@ -224,7 +247,8 @@ bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const
     if (!r.ok || r.at != run.payload.size()) return false;
   }
   for (std::size_t p = 0; p < read.bytes.size(); ++p) {
-    if (!read.bytes[p] || !read_binding_bytes(*read.bytes[p], bound, why)) return false;
+    if (!read.bytes[p] || (!decoded[p] && !read_binding_bytes(*read.bytes[p], each[p], why))) return false;
+    append_bindings(bound, std::move(each[p]));
   }
   // Stored in piece order until one cannot be (one warning says so, not one per piece).
   if (!read.cache_dir.empty()) {

@@ -37,6 +37,7 @@
 #include <XSControl_TransferReader.hxx>
 
 #include <algorithm>
+#include <iterator>
 #include <numeric>
 #include <sstream>
 #include <unordered_set>
@@ -394,6 +395,17 @@ bool read_binding_bytes(std::string_view payload, ReadBindings& out, std::string
   }
   out.keep.push_back(all);
   return true;
+}
+
+void append_bindings(ReadBindings& out, ReadBindings&& more) {
+  auto append = [](auto& to, auto& from) {
+    to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
+  };
+  append(out.shapes, more.shapes);
+  append(out.tags, more.tags);
+  append(out.styles, more.styles);
+  append(out.keep, more.keep);
+  out.parse_seconds = std::max(out.parse_seconds, more.parse_seconds);
 }
 
 std::optional<std::string> renumber_bindings(std::string_view payload, const std::function<std::optional<std::int64_t>(std::int64_t)>& id) {

@@ -76,6 +76,8 @@ struct ReadBindings {
 bool read_bindings(const std::vector<ChildRun>& runs, ReadBindings& out, std::string& why);
 // One ShapeBindings' bytes added to `out`; false (and why) when they are a failure or not whole.
 bool read_binding_bytes(std::string_view bytes, ReadBindings& out, std::string& why);
+// `more` added after what `out` holds: what reading their bytes into `out` after its own gives.
+void append_bindings(ReadBindings& out, ReadBindings&& more);
 // ShapeBindings' bytes with every key and face entity id replaced by id(it) (ids < 0 kept) and no
 // parse time; nullopt when the bytes are not whole or `id` has no answer for one.
 std::optional<std::string> renumber_bindings(std::string_view bytes,
