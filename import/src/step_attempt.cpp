@@ -230,10 +230,10 @@ bool bind_pieces(SplitRead& read, const Handle(StepData_StepModel)& model, const
   };
   std::vector<ChildRun> runs;
   if (read.workers) {
-    std::thread decoding(decode_cached);
+    // Joined however the wait ends (a worker's payload too large to hold throws bad_alloc there).
+    std::jthread decoding(decode_cached);
     runs = read.workers->wait();
     read.costs.workers = std::chrono::duration<double>(std::chrono::steady_clock::now() - read.started).count();
-    decoding.join();
   } else {
     decode_cached();
   }
