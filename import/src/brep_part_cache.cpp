@@ -7,10 +7,13 @@
 #include <BRep_Builder.hxx>
 #include <BinTools.hxx>
 #include <Standard_Failure.hxx>
+#include <TopoDS_Compound.hxx>
 
+#include <cassert>
 #include <chrono>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 
 namespace cadclash::detail {
@@ -19,17 +22,24 @@ namespace {
 // Everything add_brep_parts' result for one part depends on, as text (doubles in hexadecimal);
 // nullopt when OCCT cannot write the shape. Not the file it came from, which only names it
 // (load_part names the file reading it): a product in several files, or a file renamed, is one entry.
-std::optional<std::string> part_key(const BrepPartInput& in, const ImportOptions& options) {
-  std::ostringstream shape;
-  try {
-    BinTools::Write(*in.shape, shape, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
-  } catch (const Standard_Failure&) {
-    return std::nullopt;
+// `written`, when given, is the shape as BinTools wrote it (PackedShapes), which is not written again.
+std::optional<std::string> part_key(const BrepPartInput& in, const ImportOptions& options, const std::string* written) {
+  std::string digest;
+  if (written != nullptr) {
+    digest = sha256_hex(*written);
+  } else {
+    std::ostringstream shape;
+    try {
+      BinTools::Write(*in.shape, shape, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
+    } catch (const Standard_Failure&) {
+      return std::nullopt;
+    }
+    digest = sha256_hex(shape.str());
   }
   const TessellationOptions& t = options.tessellation;
   std::ostringstream k;
   k << std::hexfloat;
-  k << cache_versions() << "brep part\nshape sha256 " << sha256_hex(shape.str()) << "\nkind "
+  k << cache_versions() << "brep part\nshape sha256 " << digest << "\nkind "
     << static_cast<int>(in.kind) << "\nname " << in.name.size() << ' ' << in.name << "\ndeflection " << t.linear_deflection << " relative " << t.relative << " angular "
     << t.angular_deflection << " verify " << t.verify_deflection << "\nlazy " << options.lazy << "\ntags "
     << in.tags.size() << '\n';
@@ -111,14 +121,62 @@ bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, st
   return true;
 }
 
+// How BinTools' format opens (after a line feed), whatever its version.
+constexpr std::string_view kBinToolsHeader = "Open CASCADE Topology V";
+
+// The shapes of the parts listed in `which` made from their packed bytes, on every thread; a shape
+// OCCT cannot make is an error in `notes` (in part order) and an empty compound.
+void unpack_shapes(const PackedShapes& packed, std::span<const BrepPartInput> parts, const std::vector<std::size_t>& which,
+                   std::vector<Diagnostic>& notes) {
+  std::vector<std::string> failed(which.size());
+#pragma omp parallel for schedule(dynamic, 1) if (which.size() > 1)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(which.size()); ++i) {
+    const std::size_t k = which[static_cast<std::size_t>(i)];
+    // (OCCT prints, to standard output, when the bytes do not open with its format's version line.)
+    if (packed.bytes[k].find(kBinToolsHeader) > 1) {
+      failed[static_cast<std::size_t>(i)] = "not OCCT's binary shape format";
+      continue;
+    }
+    try {
+      std::istringstream stream(packed.bytes[k]);
+      BinTools::Read(packed.shapes[k], stream);
+      if (!stream || packed.shapes[k].IsNull()) failed[static_cast<std::size_t>(i)] = "the shape is cut short";
+    } catch (const Standard_Failure& e) {
+      failed[static_cast<std::size_t>(i)] = e.GetMessageString();
+    }
+  }
+  for (std::size_t i = 0; i < which.size(); ++i) {
+    if (failed[i].empty()) continue;
+    const std::size_t k = which[i];
+    TopoDS_Compound empty;
+    BRep_Builder().MakeCompound(empty);
+    packed.shapes[k] = empty;
+    notes.push_back({Severity::Error, parts[k].source_file, 0, -1,
+                     "part '" + parts[k].name + "' could not be made again from what the isolated reader sent (" + failed[i] +
+                         "); it is left without faces"});
+  }
+}
+
 }  // namespace
 
 std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPartInput> parts, const ImportOptions& options,
                                           std::vector<Diagnostic>& diagnostics, bool& complete, BrepPartTimings* timings,
-                                          std::size_t* from_cache, CacheRecord* record) {
+                                          std::size_t* from_cache, CacheRecord* record, const PackedShapes* packed) {
+  assert(packed == nullptr || (packed->bytes.size() == parts.size() && packed->shapes.size() == parts.size()));
   if (from_cache) *from_cache = 0;
-  if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() || brep_inputs_share_edges(parts))
+  // Parts sent apart share no edge (PackedShapes): their shapes are not made to be asked.
+  if (options.cache_dir.empty() || options.tessellation.time_limit_seconds > 0.0 || parts.empty() ||
+      (packed == nullptr && brep_inputs_share_edges(parts))) {
+    if (packed != nullptr) {
+      std::vector<std::size_t> all(parts.size());
+      for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
+      std::vector<Diagnostic> notes;
+      unpack_shapes(*packed, parts, all, notes);
+      for (const Diagnostic& d : notes) complete = complete && d.severity != Severity::Error;
+      diagnostics.insert(diagnostics.end(), notes.begin(), notes.end());
+    }
     return add_brep_parts(model, parts, options.tessellation, options.lazy, diagnostics, complete, timings);
+  }
 
   const std::size_t n = parts.size();
   std::vector<std::optional<std::string>> keys(n);
@@ -134,7 +192,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
     const auto k = static_cast<std::size_t>(i);
-    keys[k] = part_key(parts[k], options);
+    keys[k] = part_key(parts[k], options, packed != nullptr ? &packed->bytes[k] : nullptr);
     if (!keys[k]) continue;
     const CacheRead read = read_cache_entry(options.cache_dir, *keys[k]);
     std::string why = read.damaged;
@@ -156,6 +214,13 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
   }
   // Finding and loading the held parts stands in for checking and healing them.
   if (timings) timings->heal += std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+  // The others' shapes, when they came packed: made now (reading them, not healing).
+  if (packed != nullptr && !missing.empty()) {
+    std::vector<Diagnostic> said;
+    unpack_shapes(*packed, parts, missing, said);
+    for (const Diagnostic& d : said) complete = complete && d.severity != Severity::Error;
+    notes.insert(notes.end(), said.begin(), said.end());
+  }
 
   std::vector<char> written(n, 0);  // made parts whose entry was written
   if (!to_make.empty()) {

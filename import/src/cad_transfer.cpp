@@ -3,6 +3,11 @@
 
 #include "cadclash/internal/byte_io.h"
 
+#include <BRep_Builder.hxx>
+#include <BRep_CurveRepresentation.hxx>
+#include <BRep_ListIteratorOfListOfCurveRepresentation.hxx>
+#include <BRep_TEdge.hxx>
+#include <BRep_TFace.hxx>
 #include <BinTools.hxx>
 #include <BinXCAFDrivers.hxx>
 #include <PCDM_ReaderStatus.hxx>
@@ -11,6 +16,8 @@
 #include <TDF_LabelSequence.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Iterator.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
@@ -18,6 +25,7 @@
 #include <algorithm>
 #include <mutex>
 #include <sstream>
+#include <unordered_map>
 
 namespace cadclash::detail {
 namespace {
@@ -35,15 +43,168 @@ Handle(XCAFApp_Application) application() {
   return XCAFApp_Application::GetApplication();
 }
 
-// Every face of the document's shapes, in one order that a stored and reloaded document repeats:
-// shape labels in tag order, faces in TopExp::MapShapes order.
-TopTools_IndexedMapOfShape document_faces(const Handle(TDocStd_Document)& doc) {
-  TopTools_IndexedMapOfShape faces;
-  TDF_LabelSequence labels;
-  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetShapes(labels);
-  for (Standard_Integer i = 1; i <= labels.Length(); ++i)
-    TopExp::MapShapes(XCAFDoc_ShapeTool::GetShape(labels(i)), TopAbs_FACE, faces);
-  return faces;
+// Whether two of the parts reach one sub-shape, surface or curve: written apart, each would get a
+// copy of its own, which the healing of one part could then change without the other.
+bool parts_share(const std::vector<WalkedPart>& parts) {
+  std::unordered_map<const void*, std::size_t> owner;
+  auto claim = [&](const void* held, std::size_t p) {  // false when another part holds it too
+    const auto [it, inserted] = owner.try_emplace(held, p);
+    return inserted || it->second == p;
+  };
+  std::vector<TopoDS_Shape> todo;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (parts[p].dropped) continue;
+    todo.assign(1, parts[p].shape);
+    while (!todo.empty()) {
+      const TopoDS_Shape shape = std::move(todo.back());
+      todo.pop_back();
+      const auto [it, inserted] = owner.try_emplace(shape.TShape().get(), p);
+      if (!inserted) {
+        if (it->second != p) return true;
+        continue;  // this part's, met again
+      }
+      if (const auto* face = dynamic_cast<const BRep_TFace*>(shape.TShape().get()); face != nullptr) {
+        if (!face->Surface().IsNull() && !claim(face->Surface().get(), p)) return true;
+      } else if (const auto* edge = dynamic_cast<const BRep_TEdge*>(shape.TShape().get()); edge != nullptr) {
+        for (BRep_ListIteratorOfListOfCurveRepresentation c(edge->Curves()); c.More(); c.Next()) {
+          const Handle(BRep_CurveRepresentation)& r = c.Value();
+          if (r->IsCurve3D() && !r->Curve3D().IsNull() && !claim(r->Curve3D().get(), p)) return true;
+          if (r->IsCurveOnSurface() && !r->PCurve().IsNull() && !claim(r->PCurve().get(), p)) return true;
+          if (r->IsCurveOnClosedSurface() && !r->PCurve2().IsNull() && !claim(r->PCurve2().get(), p)) return true;
+        }
+      }
+      for (TopoDS_Iterator sub(shape, Standard_False, Standard_False); sub.More(); sub.Next()) todo.push_back(sub.Value());
+    }
+  }
+  return false;
+}
+
+// A shape as BinTools writes it without triangles (as a part's cache key does); nullopt when it cannot.
+std::optional<std::string> shape_bytes(const TopoDS_Shape& shape) {
+  std::ostringstream out;
+  try {
+    BinTools::Write(shape, out, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);
+  } catch (const Standard_Failure&) {
+    return std::nullopt;
+  }
+  return std::move(out).str();
+}
+
+void write_walked(ByteWriter& w, const WalkedDocument& d) {
+  write_diagnostics(w, d.diagnostics);
+  w.u64(d.complete ? 1 : 0);
+  w.u64(d.parts.size());
+  for (const WalkedPart& part : d.parts) {
+    w.str(part.name);
+    w.u64(part.dropped ? 1 : 0);
+    w.u64(part.tags.size());
+    for (const BrepFaceTag& tag : part.tags) {
+      w.i64(tag.entity_id);
+      w.str(tag.name);
+      w.u64(tag.colour ? 1 : 0);
+      if (tag.colour)
+        for (const float v : *tag.colour) w.f64(v);
+    }
+  }
+  // Each part on its own when none shares anything with another: the reader then makes only the
+  // shapes of parts its cache does not hold, and keys them by these bytes.
+  std::vector<std::string> apart;
+  if (!parts_share(d.parts)) {
+    for (const WalkedPart& part : d.parts) {
+      if (part.dropped) continue;
+      std::optional<std::string> bytes = shape_bytes(part.shape);
+      if (!bytes) {
+        apart.clear();
+        break;
+      }
+      apart.push_back(std::move(*bytes));
+    }
+  }
+  const bool is_apart = !apart.empty() || std::all_of(d.parts.begin(), d.parts.end(), [](const WalkedPart& p) { return p.dropped; });
+  w.u64(is_apart ? 1 : 0);
+  if (is_apart) {
+    for (const std::string& bytes : apart) w.str(bytes);
+  } else {
+    TopoDS_Compound together;
+    BRep_Builder builder;
+    builder.MakeCompound(together);
+    for (const WalkedPart& part : d.parts)
+      if (!part.dropped) builder.Add(together, part.shape);
+    std::ostringstream out;
+    BinTools::Write(together, out, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);  // throws: no payload
+    w.str(std::move(out).str());
+  }
+  w.u64(d.instances.size());
+  for (std::size_t k = 0; k < d.instances.size(); ++k) {
+    const Instance& instance = d.instances[k];
+    w.str(instance.path);
+    w.u64(instance.part);
+    const double* m = instance.pose.matrix().data();
+    for (int i = 0; i < 16; ++i) w.f64(m[i]);
+    const std::vector<std::string>& chain = k < d.chains.size() ? d.chains[k] : std::vector<std::string>{};
+    w.u64(chain.size());
+    for (const std::string& entry : chain) w.str(entry);
+  }
+}
+
+bool read_walked(ByteReader& r, WalkedDocument& d, std::string& why) {
+  d.diagnostics = read_diagnostics(r);
+  d.complete = r.u64() == 1;
+  d.parts.resize(r.ok ? r.count(24) : 0);
+  for (WalkedPart& part : d.parts) {
+    part.name = r.str();
+    part.dropped = r.u64() == 1;
+    part.tags.resize(r.ok ? r.count(24) : 0);
+    for (BrepFaceTag& tag : part.tags) {
+      tag.entity_id = r.i64();
+      tag.name = r.str();
+      if (r.u64() == 1) {
+        std::array<float, 3> rgb{};
+        for (float& v : rgb) v = static_cast<float>(r.f64());
+        tag.colour = rgb;
+      }
+    }
+  }
+  const bool apart = r.u64() == 1;
+  if (apart) {
+    for (WalkedPart& part : d.parts)
+      if (!part.dropped) part.packed = r.str();
+  } else {
+    std::istringstream stored(r.str());
+    if (!r.ok) {
+      why = "the reader's output is cut short";
+      return false;
+    }
+    TopoDS_Shape together;
+    BinTools::Read(together, stored);
+    TopoDS_Iterator it(together);
+    for (WalkedPart& part : d.parts) {
+      if (part.dropped) continue;
+      if (!it.More()) {
+        why = "the reader's output is not whole";
+        return false;
+      }
+      part.shape = it.Value();
+      it.Next();
+    }
+  }
+  d.instances.resize(r.ok ? r.count(8 + 8 + 128 + 8) : 0);
+  d.chains.resize(d.instances.size());
+  for (std::size_t k = 0; k < d.instances.size(); ++k) {
+    Instance& instance = d.instances[k];
+    instance.path = r.str();
+    instance.part = static_cast<PartId>(r.u64());
+    double* m = instance.pose.matrix().data();
+    for (int i = 0; i < 16; ++i) m[i] = r.f64();
+    d.chains[k].resize(r.ok ? r.count(8) : 0);
+    for (std::string& entry : d.chains[k]) entry = r.str();
+    if (r.ok && instance.part >= d.parts.size()) {
+      why = "the reader's output is not whole";
+      return false;
+    }
+  }
+  if (!r.ok) why = "the reader's output is cut short";
+  return r.ok;
 }
 
 // Each face's ε from its OCCT tolerance (what tessellate put there) and the file's declared length
@@ -71,6 +232,8 @@ void Transfer::discard_shapes() {
   }
   doc.Nullify();
   faces.clear();
+  side_colours.clear();
+  walked.reset();
   loose.Nullify();
   loose_ids.clear();
 }
@@ -122,34 +285,9 @@ std::string pack_transfer(const Transfer& t) {
     w.f64(t.piece_costs.seconds[p]);
   }
   write_component_placements(w, t.placements);
-  if (!t.doc.IsNull()) {
+  if (t.walked) {
     w.u64(1);
-    const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
-    std::vector<std::pair<Standard_Integer, const FaceEntity*>> tagged;
-    for (Standard_Integer f = 1; f <= faces.Extent(); ++f)
-      if (const auto it = t.faces.find(faces(f).TShape().get()); it != t.faces.end()) tagged.emplace_back(f, &it->second);
-    w.u64(tagged.size());
-    for (const auto& [f, entity] : tagged) {
-      w.i64(f);
-      w.i64(entity->id);
-      w.str(entity->name);
-    }
-    std::unordered_map<const void*, Standard_Integer> index_of;  // by TShape, as the tags
-    if (!t.side_colours.empty())
-      for (Standard_Integer f = 1; f <= faces.Extent(); ++f) index_of.try_emplace(faces(f).TShape().get(), f);
-    std::vector<std::pair<Standard_Integer, const SideColour*>> sides;
-    for (const SideColour& c : t.side_colours)
-      if (const auto it = index_of.find(c.face.TShape().get()); it != index_of.end()) sides.emplace_back(it->second, &c);
-    w.u64(sides.size());
-    for (const auto& [f, c] : sides) {
-      w.i64(f);
-      w.str(c->part);
-      for (const float v : c->rgb) w.f64(v);
-    }
-    std::ostringstream stored;
-    const std::lock_guard<std::mutex> lock(application_mutex());
-    if (application()->SaveAs(t.doc, stored) != PCDM_SS_OK) return {};
-    w.str(stored.str());
+    write_walked(w, *t.walked);
   } else if (!t.loose.IsNull()) {
     w.u64(2);
     w.u64(t.loose_ids.size());
@@ -198,39 +336,7 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   const std::uint64_t what = r.u64();
   try {
     if (r.ok && what == 1) {
-      std::vector<std::pair<std::int64_t, FaceEntity>> tagged(r.count(24));
-      for (auto& [f, entity] : tagged) {
-        f = r.i64();
-        entity.id = r.i64();
-        entity.name = r.str();
-      }
-      std::vector<std::pair<std::int64_t, SideColour>> sides(r.count(40));
-      for (auto& [f, c] : sides) {
-        f = r.i64();
-        c.part = r.str();
-        for (float& v : c.rgb) v = static_cast<float>(r.f64());
-      }
-      std::istringstream stored(r.str());
-      if (!r.ok) {
-        why = "the reader's output is cut short";
-        return false;
-      }
-      const std::lock_guard<std::mutex> lock(application_mutex());
-      if (application()->Open(stored, t.doc) != PCDM_RS_OK || t.doc.IsNull()) {
-        why = "OCCT could not load the document the reader stored";
-        return false;
-      }
-      const TopTools_IndexedMapOfShape faces = document_faces(t.doc);
-      for (const auto& [f, entity] : tagged)
-        if (f >= 1 && f <= faces.Extent()) t.faces.emplace(faces(static_cast<Standard_Integer>(f)).TShape().get(), entity);
-      for (auto& [f, c] : sides) {
-        if (f < 1 || f > faces.Extent()) {
-          why = "the reader's output is not whole";
-          return false;
-        }
-        c.face = faces(static_cast<Standard_Integer>(f));
-        t.side_colours.push_back(std::move(c));
-      }
+      if (!read_walked(r, t.walked.emplace(), why)) return false;
     } else if (r.ok && what == 2) {
       t.loose_ids.resize(r.u64());
       for (std::int64_t& id : t.loose_ids) id = r.i64();
@@ -246,6 +352,15 @@ bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why) {
   return r.ok;
 }
 
+void walk_transfer(Transfer& t, const std::string& path, bool as_stored) {
+  if (t.doc.IsNull() || t.walked) return;
+  try {
+    t.walked = walk_xcaf_document(t.doc, path, t.kind, t.faces, t.side_colours, as_stored);
+  } catch (const Standard_Failure& e) {
+    record_occt_failure(t, path, t.kind == SourceKind::IgesFace ? "IGES" : "STEP", e);
+  }
+}
+
 IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
                                    const std::function<Transfer(const Mark&)>& transfer) {
   IsolatedTransfer out;
@@ -253,14 +368,23 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double
   // this process, files read in parallel take turns.
   static std::mutex unprotected;
   if (!isolate) {
-    const std::lock_guard<std::mutex> lock(unprotected);
-    out.transfer = transfer([&out](char c) { out.child.marks += c; });
+    {
+      const std::lock_guard<std::mutex> lock(unprotected);
+      out.transfer = transfer([&out](char c) { out.child.marks += c; });
+    }
+    walk_transfer(out.transfer, path, false);
     out.child.isolated = false;
     return out;
   }
   // The child's Transfer (its document and shapes) is not taken apart after it is packed: the child
   // ends with _exit, which frees it all at once (a 40 MB board's document took 0.04 s to destroy).
-  out.child = run_in_child([&](const Mark& mark) { return pack_transfer(*new Transfer(transfer(mark))); }, time_limit_seconds);
+  out.child = run_in_child(
+      [&](const Mark& mark) {
+        auto* made = new Transfer(transfer(mark));
+        walk_transfer(*made, path, true);
+        return pack_transfer(*made);
+      },
+      time_limit_seconds);
   std::string why;
   if (out.child.isolated && (out.child.crashed || unpack_transfer(out.child.payload, out.transfer, why))) return out;
   out.warning = Diagnostic{Severity::Warning, path, 0, -1,
@@ -269,12 +393,16 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double
                                "; read in this process, unprotected from OCCT crashes"};
   out.child = ChildRun{};
   out.child.isolated = false;
-  const std::lock_guard<std::mutex> lock(unprotected);
-  out.transfer = transfer([&out](char c) { out.child.marks += c; });
+  {
+    const std::lock_guard<std::mutex> lock(unprotected);
+    out.transfer = transfer([&out](char c) { out.child.marks += c; });
+  }
+  walk_transfer(out.transfer, path, false);
   return out;
 }
 
 ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options) {
+  walk_transfer(t, path, false);  // (transfer_in_child walks what it makes)
   ImportResult result;
   result.diagnostics = std::move(t.diagnostics);
   result.complete = t.complete;
@@ -287,9 +415,9 @@ ImportResult finish_transfer(Transfer&& t, const std::string& path, const Import
   timings.read = t.read_seconds;
   BrepPartTimings part_timings;
   const char* format = t.kind == SourceKind::IgesFace ? "IGES" : "STEP";
-  if (!t.doc.IsNull()) {
+  if (t.walked) {
     std::vector<std::vector<std::string>> chains;
-    add_xcaf_document(t.doc, path, t.kind, t.faces, options, result, &part_timings, &chains, t.side_colours);
+    add_walked_document(std::move(*t.walked), path, t.kind, options, result, &part_timings, &chains);
     if (t.placements)
       if (std::optional<Placements> p = file_placements(*t.placements, chains)) {
         p->stored = t.unpacked;

@@ -38,14 +38,17 @@ struct Transfer {
   // The text cut into this many pieces (0: not cut), of which the import cache held this many.
   std::size_t pieces = 0, pieces_cached = 0;
   PieceCosts piece_costs;  // of a read in pieces (FileImport::piece_costs)
-  // Products: an XCAF document (closed by the destructor) and the entities of its faces.
+  // Products: an XCAF document (closed by the destructor) and the entities of its faces, as the
+  // reader made them; then walked into parts and instances (walk_transfer), which is what a child
+  // sends back (the document stays in the child).
   Handle(TDocStd_Document) doc;
   FaceEntityMap faces;
-  std::vector<SideColour> side_colours;  // face colours kept beside the document (add_xcaf_document)
+  std::vector<SideColour> side_colours;  // face colours kept beside the document (walk_xcaf_document)
+  std::optional<WalkedDocument> walked;
   // STEP products: every occurrence's component and placement (step_placements.h); nullopt when
   // one is placed otherwise, or not STEP.
   std::optional<std::vector<ComponentPlacement>> placements;
-  bool unpacked = false;  // brought back from a child process (unpack_transfer): the document was stored and read
+  bool unpacked = false;  // brought back from a child process (unpack_transfer)
   // Or loose faces of one part: a compound, the entity #id of each face in TopExp::MapShapes order,
   // and the error that says how many were recovered (none for a .brep's shape, one part by design).
   TopoDS_Shape loose;
@@ -100,7 +103,16 @@ std::optional<Handle(Transfer_TransientProcess)> transfer_document(CafReader& re
   return process;
 }
 
-// The transfer as bytes (OCCT's binary XCAF document or shape format, plus our tags and diagnostics).
+// The document walked (walk_xcaf_document) into t.walked, when there is one and it was not, with
+// its instances placed as the document stored and read back places them when `as_stored` (a
+// child's walk: the poses of an isolated read, whatever process walks). What OCCT throws while
+// walking is an error and leaves no shapes (record_occt_failure).
+void walk_transfer(Transfer& t, const std::string& path, bool as_stored);
+
+// The transfer as bytes (its walked parts in OCCT's binary shape format, plus our tags and
+// diagnostics). The parts go each on its own, with the bytes that key them in the cache
+// (WalkedPart::packed), unless two of them share a sub-shape, a surface or a curve (then all in one
+// compound, as they were). Precondition: a document, if any, has been walked.
 std::string pack_transfer(const Transfer& t);
 
 // Back from pack_transfer's bytes; false (and `why`) if they are not whole.
@@ -117,7 +129,7 @@ struct IsolatedTransfer {
 IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
                                    const std::function<Transfer(const Mark&)>& transfer);
 
-// Tessellates and walks the transfer into parts and instances (add_xcaf_document / add_brep_parts).
+// Tessellates the walked transfer's parts into the model (add_walked_document / add_brep_parts).
 ImportResult finish_transfer(Transfer&& t, const std::string& path, const ImportOptions& options);
 
 }  // namespace cadclash::detail

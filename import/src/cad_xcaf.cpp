@@ -18,6 +18,7 @@
 #include <TDF_Tool.hxx>
 #include <TDataStd_Name.hxx>
 #include <TopExp.hxx>
+#include <TopLoc_Datum3D.hxx>
 #include <TopLoc_Location.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TransferBRep.hxx>
@@ -35,8 +36,10 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string_view>
+#include <unordered_map>
 
 namespace cadclash::detail {
 namespace {
@@ -99,9 +102,33 @@ Pose pose_of_transformation(const gp_Trsf& trsf) {
 
 namespace {
 
+// A location as the XCAF document's binary format reads it back (BinMXCAFDoc_LocationDriver over
+// BinTools_LocationSet): the same chain of datums and powers, each datum's transformation made
+// again from its twelve values by SetValues (which normalises a reflection's scale of -1 to +1 and
+// negates its matrix); a datum met twice is one datum both times, as the format keeps it.
+class StoredLocations {
+ public:
+  TopLoc_Location operator()(const TopLoc_Location& l) {
+    if (l.IsIdentity()) return l;
+    Handle(TopLoc_Datum3D)& datum = made_[l.FirstDatum().get()];
+    if (datum.IsNull()) {
+      const gp_Trsf& t = l.FirstDatum()->Transformation();
+      gp_Trsf read;
+      read.SetValues(t.Value(1, 1), t.Value(1, 2), t.Value(1, 3), t.Value(1, 4), t.Value(2, 1), t.Value(2, 2), t.Value(2, 3),
+                     t.Value(2, 4), t.Value(3, 1), t.Value(3, 2), t.Value(3, 3), t.Value(3, 4));
+      datum = new TopLoc_Datum3D(read);
+    }
+    return (*this)(l.NextLocation()) * TopLoc_Location(datum).Powered(l.FirstPower());
+  }
+
+ private:
+  std::unordered_map<const TopLoc_Datum3D*, Handle(TopLoc_Datum3D)> made_;
+};
+
 struct Walker {
   Handle(XCAFDoc_ShapeTool) shapes;
   const std::string& file;
+  std::optional<StoredLocations> stored;  // the components' locations as a stored document has them
   std::map<std::string, std::size_t> part_of_label;  // TDF entry → index in `leaves`
   std::vector<TDF_Label> leaves;
   std::vector<std::string> leaf_names;  // the part name of each of `leaves` (see import.h)
@@ -146,7 +173,8 @@ struct Walker {
       const std::vector<std::string> parts = sibling_components(names);
       for (std::size_t i = 0; i < referred.size(); ++i) {
         const TDF_Label& component = components(static_cast<Standard_Integer>(i) + 1);
-        const TopLoc_Location child = location * XCAFDoc_ShapeTool::GetLocation(component);
+        const TopLoc_Location own = XCAFDoc_ShapeTool::GetLocation(component);
+        const TopLoc_Location child = location * (stored ? (*stored)(own) : own);
         TCollection_AsciiString entry;
         TDF_Tool::Entry(component, entry);
         chain.emplace_back(entry.ToCString());
@@ -279,13 +307,13 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
   return fails;
 }
 
-void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
-                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings, std::vector<std::vector<std::string>>* chains,
-                       const std::vector<SideColour>& side) {
+WalkedDocument walk_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
+                                  const FaceEntityMap& faces, const std::vector<SideColour>& side, bool stored_locations) {
+  WalkedDocument out;
   std::unordered_map<std::string, std::vector<std::pair<const void*, std::array<float, 3>>>> side_of;  // by part
   for (const SideColour& c : side) side_of[c.part].emplace_back(c.face.TShape().get(), c.rgb);
-  Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, {}, result.diagnostics};
+  Walker walker{XCAFDoc_DocumentTool::ShapeTool(doc->Main()), file, {}, {}, {}, {}, {}, out.diagnostics};
+  if (stored_locations) walker.stored.emplace();
   TDF_LabelSequence roots;
   walker.shapes->GetFreeShapes(roots);
   std::vector<std::string> names;
@@ -294,17 +322,13 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
   for (Standard_Integer i = 1; i <= roots.Length(); ++i)
     walker.visit(roots(i), TopLoc_Location(), "/" + components[static_cast<std::size_t>(i - 1)], 0);
 
-  std::vector<TopoDS_Shape> shapes(walker.leaves.size());
-  std::vector<BrepPartInput> inputs(walker.leaves.size());
+  out.parts.resize(walker.leaves.size());
   for (std::size_t p = 0; p < walker.leaves.size(); ++p) {
     const TDF_Label& label = walker.leaves[p];
-    shapes[p] = XCAFDoc_ShapeTool::GetShape(label);
-    BrepPartInput& in = inputs[p];
-    in.shape = &shapes[p];
-    in.name = walker.leaf_names[p];
-    if (in.name.empty()) in.name = "part" + std::to_string(p);
-    in.source_file = file;
-    in.kind = kind;
+    WalkedPart& part = out.parts[p];
+    part.shape = XCAFDoc_ShapeTool::GetShape(label);
+    part.name = walker.leaf_names[p];
+    if (part.name.empty()) part.name = "part" + std::to_string(p);
     const std::unordered_map<const void*, std::array<float, 3>> colours = [&] {
       if (side_of.empty()) return part_face_colours(label, nullptr);
       TCollection_AsciiString entry;
@@ -313,11 +337,11 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
       return part_face_colours(label, it == side_of.end() ? nullptr : &it->second);
     }();
     TopTools_IndexedMapOfShape face_map;
-    if (!shapes[p].IsNull()) TopExp::MapShapes(shapes[p], TopAbs_FACE, face_map);
-    in.tags.resize(static_cast<std::size_t>(face_map.Extent()));
+    if (!part.shape.IsNull()) TopExp::MapShapes(part.shape, TopAbs_FACE, face_map);
+    part.tags.resize(static_cast<std::size_t>(face_map.Extent()));
     std::size_t untagged = 0;
     for (Standard_Integer f = 1; f <= face_map.Extent(); ++f) {
-      BrepFaceTag& tag = in.tags[static_cast<std::size_t>(f - 1)];
+      BrepFaceTag& tag = part.tags[static_cast<std::size_t>(f - 1)];
       const void* key = face_map(f).TShape().get();
       if (auto it = faces.find(key); it != faces.end()) {
         tag.entity_id = it->second.id;
@@ -328,42 +352,76 @@ void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& f
       if (auto it = colours.find(key); it != colours.end()) tag.colour = it->second;
     }
     if (face_map.Extent() == 0)
-      result.diagnostics.push_back({Severity::Warning, file, 0, -1, "part '" + in.name + "' has no faces"});
+      out.diagnostics.push_back({Severity::Warning, file, 0, -1, "part '" + part.name + "' has no faces"});
     if (untagged > 0 && kind != SourceKind::BrepFace)
-      result.diagnostics.push_back({Severity::Warning, file, 0, -1,
-                                    "part '" + in.name + "': " + std::to_string(untagged) +
-                                        " faces could not be traced to a file entity"});
+      out.diagnostics.push_back({Severity::Warning, file, 0, -1,
+                                 "part '" + part.name + "': " + std::to_string(untagged) +
+                                     " faces could not be traced to a file entity"});
   }
-  std::vector<BrepPartInput> nonempty_inputs;
+  for (WalkedPart& part : out.parts) {
+    if (!part.shape.IsNull()) continue;
+    part.dropped = true;
+    out.diagnostics.push_back({Severity::Error, file, 0, -1, "part '" + part.name + "' has no shape; dropped"});
+    out.complete = false;
+  }
+  out.instances = std::move(walker.instances);
+  out.chains = std::move(walker.chains);
+  return out;
+}
+
+void add_walked_document(WalkedDocument&& walked, const std::string& file, SourceKind kind, const ImportOptions& options,
+                         ImportResult& result, BrepPartTimings* timings, std::vector<std::vector<std::string>>* chains) {
+  result.diagnostics.insert(result.diagnostics.end(), std::make_move_iterator(walked.diagnostics.begin()),
+                            std::make_move_iterator(walked.diagnostics.end()));
+  result.complete = result.complete && walked.complete;
+  std::vector<BrepPartInput> inputs;
   std::vector<std::size_t> input_of;
-  for (std::size_t p = 0; p < inputs.size(); ++p) {
-    if (shapes[p].IsNull()) {
-      result.diagnostics.push_back({Severity::Error, file, 0, -1, "part '" + inputs[p].name + "' has no shape; dropped"});
-      result.complete = false;
-      continue;
-    }
+  std::vector<std::string> packed;  // per input, when the parts came packed apart
+  std::vector<TopoDS_Shape> unpacked;
+  bool apart = false;
+  for (std::size_t p = 0; p < walked.parts.size(); ++p) {
+    WalkedPart& part = walked.parts[p];
+    if (part.dropped) continue;
+    apart = apart || !part.packed.empty();
     input_of.push_back(p);
-    nonempty_inputs.push_back(std::move(inputs[p]));
+    BrepPartInput& in = inputs.emplace_back();
+    in.shape = &part.shape;
+    in.name = std::move(part.name);
+    in.source_file = file;
+    in.kind = kind;
+    in.tags = std::move(part.tags);
+  }
+  std::optional<PackedShapes> shapes;
+  if (apart) {
+    packed.reserve(inputs.size());
+    unpacked.resize(inputs.size());
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      WalkedPart& part = walked.parts[input_of[k]];
+      packed.push_back(std::move(part.packed));
+      unpacked[k] = part.shape;
+      inputs[k].shape = &unpacked[k];
+    }
+    shapes = PackedShapes{packed, unpacked};
   }
   std::size_t cached = 0;
   auto record = std::make_shared<CacheRecord>();
   record->dir = options.cache_dir;
   record->max_bytes = options.cache_max_bytes;
-  const std::vector<PartId> ids = add_brep_parts_cached(result.model, nonempty_inputs, options, result.diagnostics,
-                                                        result.complete, timings, &cached, record.get());
+  const std::vector<PartId> ids = add_brep_parts_cached(result.model, inputs, options, result.diagnostics, result.complete,
+                                                        timings, &cached, record.get(), shapes ? &*shapes : nullptr);
   if (!result.files.empty()) {
     result.files.back().parts_cached = cached;
     if (!record->parts.empty() || !record->part_keys.empty()) result.files.back().cache_record = std::move(record);
   }
-  std::vector<PartId> id_of_leaf(walker.leaves.size(), kInvalidId);
+  std::vector<PartId> id_of_leaf(walked.parts.size(), kInvalidId);
   for (std::size_t k = 0; k < ids.size(); ++k) id_of_leaf[input_of[k]] = ids[k];
-  for (std::size_t k = 0; k < walker.instances.size(); ++k) {
-    Instance& instance = walker.instances[k];
+  for (std::size_t k = 0; k < walked.instances.size(); ++k) {
+    Instance& instance = walked.instances[k];
     const PartId id = id_of_leaf[instance.part];
-    if (id == kInvalidId) continue;  // its part was dropped and reported above
+    if (id == kInvalidId) continue;  // its part was dropped and reported in the walk
     instance.part = id;
     result.model.instances.push_back(std::move(instance));
-    if (chains) chains->push_back(std::move(walker.chains[k]));
+    if (chains) chains->push_back(std::move(walked.chains[k]));
   }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cadclash/import.h"
+#include "cadclash/tessellate.h"
 
 #include <Interface_CheckIterator.hxx>
 #include <Interface_InterfaceModel.hxx>
@@ -53,12 +54,6 @@ std::size_t append_checks(const Interface_CheckIterator& checks, const Handle(In
                           const EntityLabelFn& label, const std::string& file, const std::string& what,
                           bool warnings, std::vector<Diagnostic>& out, std::size_t limit = 40);
 
-// Walks the document's free shapes into `result`: one instance per leaf occurrence with its full path
-// and placement, one part per distinct leaf shape (shared by all its instances), tessellated as the
-// options say. Face tags come from `faces` (by TShape) and the document's colours.
-// `timings`, when given, gets add_brep_parts' seconds added.
-// `chains`, when given, gets per instance added (in order) the entries of the component labels
-// from the root down to it.
 // `side`: colours of faces the document would hold as sub-shape colours of a part, kept beside it
 // (a STEP piece's styled faces, step_attempt.cpp): they come first, as the most specific.
 struct SideColour {
@@ -66,12 +61,47 @@ struct SideColour {
   TopoDS_Shape face;  // a face of the part's shape
   std::array<float, 3> rgb{};  // sRGB, as the document's surface colour reads
 };
-void add_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
-                       const FaceEntityMap& faces, const ImportOptions& options, ImportResult& result,
-                       BrepPartTimings* timings = nullptr, std::vector<std::vector<std::string>>* chains = nullptr,
-                       const std::vector<SideColour>& side = {});
 
-// An instance's pose from its location's transformation, as add_xcaf_document makes it (the scale
+// One distinct leaf shape of a walked document: a part before it is checked, healed and tessellated.
+struct WalkedPart {
+  std::string name;
+  std::vector<BrepFaceTag> tags;  // per face, in TopExp::MapShapes order
+  TopoDS_Shape shape;             // null when the part has none (`dropped`), or until made from `packed`
+  // The shape as BinTools writes it without triangles (what a part's cache key hashes), when a
+  // reader's child sent each part on its own (cad_transfer.cpp); empty otherwise.
+  std::string packed;
+  bool dropped = false;  // no shape: said in the walk's diagnostics, its instances left out
+};
+
+// A document walked into its parts and instances: what a reader's child sends back instead of the
+// document (cad_transfer.h).
+struct WalkedDocument {
+  std::vector<Diagnostic> diagnostics;  // the walk's, in the order it says them
+  bool complete = true;
+  std::vector<WalkedPart> parts;                 // in the walk's order
+  std::vector<Instance> instances;               // part: an index into `parts`
+  std::vector<std::vector<std::string>> chains;  // per instance: the component label entries from the root down to it
+};
+
+// Walks the document's free shapes: one instance per leaf occurrence with its full path and
+// placement, one part per distinct leaf shape (shared by all its instances), each face tagged from
+// `faces` (by TShape) and the document's colours (`side`'s first). With `stored_locations`, the
+// instances are placed as they would be in the document stored in OCCT's binary format and read
+// back (each placement's transformation made again from its twelve values), as a reader's child
+// places them (cad_transfer.h), so that they do not depend on where the walk ran. Throws what OCCT
+// throws.
+WalkedDocument walk_xcaf_document(const Handle(TDocStd_Document)& doc, const std::string& file, SourceKind kind,
+                                  const FaceEntityMap& faces, const std::vector<SideColour>& side, bool stored_locations);
+
+// The walked parts checked, healed and tessellated as the options say (through the import cache
+// when it has one) into `result`, with the walk's diagnostics and the instances of every part kept.
+// `timings`, when given, gets add_brep_parts' seconds added; `chains`, when given, gets the chain
+// of every instance kept, in order.
+void add_walked_document(WalkedDocument&& walked, const std::string& file, SourceKind kind, const ImportOptions& options,
+                         ImportResult& result, BrepPartTimings* timings = nullptr,
+                         std::vector<std::vector<std::string>>* chains = nullptr);
+
+// An instance's pose from its location's transformation, as walk_xcaf_document makes it (the scale
 // divided out of the rotation part: the walk warns about a scale).
 Pose pose_of_transformation(const gp_Trsf& trsf);
 

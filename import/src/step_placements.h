@@ -60,8 +60,8 @@ bool read_component_placements(ByteReader& r, std::optional<std::vector<Componen
 struct Placements {
   std::vector<ComponentPlacement> components;
   std::vector<std::vector<std::uint32_t>> chains;
-  // The locations as the XCAF document's binary format reads them back (the document came from the
-  // isolated reader's child), not as the reader made them.
+  // The locations as the XCAF document's binary format reads them back (the isolated reader's child
+  // places its instances so: walk_xcaf_document), not as the reader made them.
   bool stored = true;
 
   std::vector<std::int64_t> value_ids() const;  // the points and directions of every axis, ascending
@@ -69,7 +69,7 @@ struct Placements {
 };
 
 // The recipe of a file whose walk gave `chains` (per instance, the component label entries from
-// the root down; add_xcaf_document); nullopt when a component has no placement in `placed`.
+// the root down; walk_xcaf_document); nullopt when a component has no placement in `placed`.
 std::optional<Placements> file_placements(const std::vector<ComponentPlacement>& placed,
                                           const std::vector<std::vector<std::string>>& chains);
 

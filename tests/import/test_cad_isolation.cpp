@@ -1,6 +1,6 @@
-// The isolated reader (ImportOptions::isolate_cad_readers) sends the transfer back from a child as a
-// stored XCAF document; what the caller gets must be what an in-process read gives: the same parts,
-// surfaces, entity ids, names, colours, triangles and instance poses, bit for bit.
+// The isolated reader (ImportOptions::isolate_cad_readers) sends the transfer back from a child as
+// its walked parts and instances; what the caller gets must be what an in-process read gives: the
+// same parts, surfaces, entity ids, names, colours, triangles and instance poses, bit for bit.
 #include "cadclash/import.h"
 #include "../test_temp.h"
 #include "readers.h"

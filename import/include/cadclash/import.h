@@ -78,7 +78,8 @@ struct ImportOptions {
   // STEP/IGES/BREP: run OCCT's reader and transfer in a forked child process, so that a file on which
   // OCCT crashes gives an error naming it instead of ending this process (a STEP file is then read
   // again without the faces that reach malformed entities, then as loose faces). STEP and IGES come
-  // back as a stored XCAF document (0-40 % slower import), a .brep's shape in OCCT's binary format.
+  // back as their parts and instances (each part's shape in OCCT's binary format), a .brep's shape
+  // in that format too.
   // Turn it off only for trusted files, or in a host that must not fork (fork copies only the
   // calling thread; a thread of the host holding a lock OCCT needs would hang the child).
   bool isolate_cad_readers = true;
