@@ -475,9 +475,9 @@ std::optional<std::string> cache_entry_name(const std::string& path, const Impor
 }
 
 ImportResult cached_import(const std::string& path, const ImportOptions& options,
-                           const std::function<ImportResult()>& read) {
+                           const std::function<ImportResult(const std::string* bytes)>& read) {
   const std::optional<std::string> bytes = file_bytes(path);
-  if (!bytes) return read();  // the reader names the problem (no such file, a directory, ...)
+  if (!bytes) return read(nullptr);  // the reader names the problem (no such file, a directory, ...)
   // Whether the file differs from an earlier one only in its placements' numbers is worked out
   // while its key is hashed and its entry looked for (a pass over the text each; here when no
   // thread can be started); asked only when the file has no entry of its own.
@@ -526,7 +526,7 @@ ImportResult cached_import(const std::string& path, const ImportOptions& options
     }
   }
 
-  ImportResult result = read();
+  ImportResult result = read(&*bytes);  // the bytes hashed are the bytes read
   result.diagnostics.insert(result.diagnostics.begin(), placed_notes.begin(), placed_notes.end());
   result.files.front().cache = damaged ? CacheUse::Rebuilt : CacheUse::Miss;
   if (stopped_by_time_limit(result, options)) return result;

@@ -13,12 +13,13 @@
 namespace cadclash::detail {
 
 // Reads `path` through the cache in options.cache_dir: a whole entry for the file's bytes and the
-// options gives back what was stored (files[0].cache = Hit); otherwise `read()` runs and its result
-// is stored (Miss, or Rebuilt with a warning first in the diagnostics when the entry was damaged).
-// `read` returns one file's result with files[0] set. A cache that cannot be read or written never
-// stops the import: a warning says so and the file is read.
+// options gives back what was stored (files[0].cache = Hit); otherwise `read(bytes)` runs and its
+// result is stored (Miss, or Rebuilt with a warning first in the diagnostics when the entry was
+// damaged). `read` gets the file's bytes this hashed (null when it could not read them: the reader
+// then names the problem) and returns one file's result with files[0] set. A cache that cannot be
+// read or written never stops the import: a warning says so and the file is read.
 ImportResult cached_import(const std::string& path, const ImportOptions& options,
-                           const std::function<ImportResult()>& read);
+                           const std::function<ImportResult(const std::string* bytes)>& read);
 
 // The bytes of the file at `path`; nullopt when it cannot be opened or read.
 std::optional<std::string> file_bytes(const std::string& path);

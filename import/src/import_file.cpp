@@ -49,7 +49,9 @@ std::string lower_extension(const std::string& path) {
 
 namespace {
 
-ImportResult read_any(const std::string& path, const ImportOptions& options);
+// `text`, when given, is the file's bytes as the caller read them (a STEP reader scans them instead
+// of reading the file again).
+ImportResult read_any(const std::string& path, const ImportOptions& options, const std::string* text);
 
 }  // namespace
 
@@ -72,9 +74,9 @@ ImportResult import_one(const std::string& path, const ImportOptions& options) {
   assert(options.uncertainty != UncertaintyChoice::Value || options.uncertainty_value > 0.0);
   const auto start = std::chrono::steady_clock::now();
   const detail::CadWork occt_in_this_process;
-  auto read = [&] {
+  auto read = [&](const std::string* text) {
     const auto read_start = std::chrono::steady_clock::now();
-    ImportResult r = read_any(path, options);
+    ImportResult r = read_any(path, options, text);
     for (Surface& s : r.model.surfaces) {
       const bool brep = r.model.parts[s.part].source != nullptr;
       if (options.uncertainty == UncertaintyChoice::Value) {
@@ -92,7 +94,7 @@ ImportResult import_one(const std::string& path, const ImportOptions& options) {
     }
     return r;
   };
-  ImportResult r = options.cache_dir.empty() ? read() : detail::cached_import(path, options, read);
+  ImportResult r = options.cache_dir.empty() ? read(nullptr) : detail::cached_import(path, options, read);
   ImportTimings& t = r.files.front().timings;
   t.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   t.transfer = std::max(0.0, t.total - t.read - t.heal - t.tessellate);
@@ -120,14 +122,14 @@ ImportResult import_file(const std::string& path, const ImportOptions& options) 
 
 namespace {
 
-ImportResult read_any(const std::string& path, const ImportOptions& options) {
+ImportResult read_any(const std::string& path, const ImportOptions& options, const std::string* text) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) return detail::failed_import(path, "no such file");
   if (std::filesystem::is_directory(status)) return detail::failed_import(path, "is a directory, not a file");
 
   const std::string ext = lower_extension(path);
-  if (ext == ".stp" || ext == ".step") return detail::read_step(path, options);
+  if (ext == ".stp" || ext == ".step") return detail::read_step(path, options, text);
   if (ext == ".igs" || ext == ".iges") return detail::read_iges(path, options);
   if (ext == ".brep" || ext == ".rle") return detail::read_brep(path, options);
   if (ext == ".obj") return detail::read_obj(path, options);

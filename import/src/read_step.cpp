@@ -22,7 +22,7 @@ namespace cadclash::detail {
 // on a LINE whose point was cut off), so each attempt runs in a child process, which sends back the
 // transferred document (cad_transfer.h): a crash there costs the attempt, not the caller's process,
 // and this process never runs OCCT's STEP code on the file.
-ImportResult read_step(const std::string& path, const ImportOptions& options) {
+ImportResult read_step(const std::string& path, const ImportOptions& options, const std::string* text) {
   prepare_occt_exchange();
   const TransferHealing healing(options.transfer_healing);
   std::vector<Diagnostic> notes;  // how the attempts went, first in the result
@@ -57,7 +57,7 @@ ImportResult read_step(const std::string& path, const ImportOptions& options) {
   if (auto warning = unapplied_time_limit(path, options)) notes.push_back(*warning);
   for (;;) {
     IsolatedTransfer run = transfer_in_child(path, options.isolate_cad_readers, clock.left(),
-                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip, workers, min_bytes, split, options.cache_dir}); });
+                                             [&](const Mark& mark) { return read_step_attempt(path, {attempt, mark, &skip, workers, min_bytes, split, options.cache_dir, text}); });
     if (run.warning) notes.push_back(*run.warning);
     const ChildRun& child = run.child;
     read_seconds += run.transfer.read_seconds;

@@ -441,7 +441,8 @@ Transfer read_step_attempt(const std::string& path, const AttemptRun& attempt_ru
     // One read of the text for every scan below; OCCT reads the file (or a corrected copy) itself.
     const auto read_start = std::chrono::steady_clock::now();
     const bool readable = static_cast<bool>(std::ifstream(path));
-    const std::string text = file_text(path);
+    const std::string read_here = run.text != nullptr ? std::string() : file_text(path);
+    const std::string& text = run.text != nullptr ? *run.text : read_here;
     for (Diagnostic& d : unknown_schemas(text, path)) {
       result.diagnostics.push_back(std::move(d));
       result.complete = false;

@@ -44,6 +44,7 @@ struct AttemptRun {
   // The import cache's directory (ImportOptions::cache_dir; empty = none): a file of at least
   // `parallel_min_bytes` is cut even for one worker, and pieces the cache holds are not read.
   std::string cache_dir;
+  const std::string* text = nullptr;  // the file's bytes, when the caller has read them (read_step)
 };
 
 // In a piece's worker: parses `piece` (step_split_text.h), transfers its representations and
