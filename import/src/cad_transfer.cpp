@@ -22,9 +22,14 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 
+#include <omp.h>
+
 #include <algorithm>
+#include <atomic>
 #include <mutex>
 #include <sstream>
+#include <system_error>
+#include <thread>
 #include <unordered_map>
 
 namespace cadclash::detail {
@@ -90,7 +95,35 @@ std::optional<std::string> shape_bytes(const TopoDS_Shape& shape) {
   return std::move(out).str();
 }
 
-void write_walked(ByteWriter& w, const WalkedDocument& d) {
+// Each part's shape_bytes, written on up to `threads` threads (they share nothing: parts_share);
+// empty when one cannot be written.
+std::vector<std::string> parts_apart(const std::vector<WalkedPart>& parts, std::size_t threads) {
+  std::vector<std::size_t> kept;
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    if (!parts[p].dropped) kept.push_back(p);
+  std::vector<std::optional<std::string>> each(kept.size());
+  std::atomic<std::size_t> next{0};
+  // (No OpenMP: this runs in a forked child, whose OpenMP runtime is the parent's copy.)
+  auto write = [&] {
+    for (std::size_t k; (k = next.fetch_add(1)) < kept.size();) each[k] = shape_bytes(parts[kept[k]].shape);
+  };
+  std::vector<std::jthread> helpers;
+  try {
+    for (std::size_t t = 1; t < std::min(threads, kept.size()); ++t) helpers.emplace_back(write);
+  } catch (const std::system_error&) {  // fewer threads: the others write the rest
+  }
+  write();
+  helpers.clear();  // joined
+  std::vector<std::string> out;
+  out.reserve(kept.size());
+  for (std::optional<std::string>& bytes : each) {
+    if (!bytes) return {};
+    out.push_back(std::move(*bytes));
+  }
+  return out;
+}
+
+void write_walked(ByteWriter& w, const WalkedDocument& d, std::size_t threads) {
   write_diagnostics(w, d.diagnostics);
   w.u64(d.complete ? 1 : 0);
   w.u64(d.parts.size());
@@ -109,17 +142,7 @@ void write_walked(ByteWriter& w, const WalkedDocument& d) {
   // Each part on its own when none shares anything with another: the reader then makes only the
   // shapes of parts its cache does not hold, and keys them by these bytes.
   std::vector<std::string> apart;
-  if (!parts_share(d.parts)) {
-    for (const WalkedPart& part : d.parts) {
-      if (part.dropped) continue;
-      std::optional<std::string> bytes = shape_bytes(part.shape);
-      if (!bytes) {
-        apart.clear();
-        break;
-      }
-      apart.push_back(std::move(*bytes));
-    }
-  }
+  if (!parts_share(d.parts)) apart = parts_apart(d.parts, threads);
   const bool is_apart = !apart.empty() || std::all_of(d.parts.begin(), d.parts.end(), [](const WalkedPart& p) { return p.dropped; });
   w.u64(is_apart ? 1 : 0);
   if (is_apart) {
@@ -263,7 +286,7 @@ Handle(TDocStd_Document) new_xcaf_document() {
   return doc;
 }
 
-std::string pack_transfer(const Transfer& t) {
+std::string pack_transfer(const Transfer& t, std::size_t threads) {
   ByteWriter w;
   write_diagnostics(w, t.diagnostics);
   w.u64(t.complete ? 1 : 0);
@@ -287,7 +310,7 @@ std::string pack_transfer(const Transfer& t) {
   write_component_placements(w, t.placements);
   if (t.walked) {
     w.u64(1);
-    write_walked(w, *t.walked);
+    write_walked(w, *t.walked, threads);
   } else if (!t.loose.IsNull()) {
     w.u64(2);
     w.u64(t.loose_ids.size());
@@ -364,6 +387,7 @@ void walk_transfer(Transfer& t, const std::string& path, bool as_stored) {
 IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double time_limit_seconds,
                                    const std::function<Transfer(const Mark&)>& transfer) {
   IsolatedTransfer out;
+  const auto threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));  // the parts' writers (asked here, before the fork)
   // OCCT's file translators keep global state (their static parameters, the schema's protocol): in
   // this process, files read in parallel take turns.
   static std::mutex unprotected;
@@ -382,7 +406,7 @@ IsolatedTransfer transfer_in_child(const std::string& path, bool isolate, double
       [&](const Mark& mark) {
         auto* made = new Transfer(transfer(mark));
         walk_transfer(*made, path, true);
-        return pack_transfer(*made);
+        return pack_transfer(*made, threads);
       },
       time_limit_seconds);
   std::string why;

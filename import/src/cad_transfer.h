@@ -112,8 +112,9 @@ void walk_transfer(Transfer& t, const std::string& path, bool as_stored);
 // The transfer as bytes (its walked parts in OCCT's binary shape format, plus our tags and
 // diagnostics). The parts go each on its own, with the bytes that key them in the cache
 // (WalkedPart::packed), unless two of them share a sub-shape, a surface or a curve (then all in one
-// compound, as they were). Precondition: a document, if any, has been walked.
-std::string pack_transfer(const Transfer& t);
+// compound, as they were), written on up to `threads` threads. Precondition: a document, if any,
+// has been walked.
+std::string pack_transfer(const Transfer& t, std::size_t threads = 1);
 
 // Back from pack_transfer's bytes; false (and `why`) if they are not whole.
 bool unpack_transfer(const std::string& bytes, Transfer& t, std::string& why);

@@ -34,7 +34,8 @@ using Mark = std::function<void(char)>;
 // stage, so a crash can be placed (marks are any char but '\0'); what it returns comes back as
 // `payload`.
 // Preconditions:
-// - `work` uses no OpenMP and starts no threads (a forked child has only the calling thread);
+// - `work` uses no OpenMP (a forked child has only the calling thread; the runtime's pool is the
+//   parent's copy), and joins the threads it starts before it forks (Children);
 // - `work` writes nothing to stdout (the child's stdout is /dev/null).
 // Several threads may each run a child at once (import_files reads files in parallel); the fork
 // itself waits until no other thread holds a CadWork. A child still running after

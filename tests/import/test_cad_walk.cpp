@@ -124,6 +124,7 @@ WalkedDocument sent_back(const TopoDS_Shape& a, const TopoDS_Shape& b) {
   }
   detail::walk_transfer(t, "sent.step", true);
   const std::string bytes = detail::pack_transfer(t);
+  EXPECT_EQ(detail::pack_transfer(t, 4), bytes);  // the parts written on threads: the same bytes
   detail::Transfer back;
   std::string why;
   EXPECT_TRUE(detail::unpack_transfer(bytes, back, why)) << why;
