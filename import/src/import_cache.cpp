@@ -237,6 +237,19 @@ bool stopped_by_time_limit(const ImportResult& r, const ImportOptions& o) {
 
 std::string sha256_hex(std::string_view bytes) { return hex(sha256(bytes)); }
 
+Sha256Stream::Sha256Stream() : context_(EVP_MD_CTX_new()) {
+  if (context_ == nullptr || EVP_DigestInit_ex(static_cast<EVP_MD_CTX*>(context_), EVP_sha256(), nullptr) != 1)
+    throw std::bad_alloc();
+}
+Sha256Stream::~Sha256Stream() { EVP_MD_CTX_free(static_cast<EVP_MD_CTX*>(context_)); }
+void Sha256Stream::update(std::string_view bytes) { EVP_DigestUpdate(static_cast<EVP_MD_CTX*>(context_), bytes.data(), bytes.size()); }
+std::string Sha256Stream::hex() {
+  Digest d{};
+  unsigned int n = 0;
+  EVP_DigestFinal_ex(static_cast<EVP_MD_CTX*>(context_), d.data(), &n);
+  return cadclash::detail::hex(d);
+}
+
 std::string cache_versions() {
   std::ostringstream k;
   k << "cadclash import cache " << kCacheFormat << "\n" << build_identity() << "\nocct " << OCC_VERSION_COMPLETE << '\n';

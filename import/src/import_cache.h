@@ -50,6 +50,19 @@ bool load_import(std::string_view bytes, ImportResult& r, std::string& why, bool
 // The lines every key starts with: the cache format, the build of cadclash and OCCT's version.
 std::string cache_versions();
 std::string sha256_hex(std::string_view bytes);
+// sha256_hex of bytes given a part at a time (one object per thread).
+class Sha256Stream {
+ public:
+  Sha256Stream();
+  ~Sha256Stream();
+  Sha256Stream(const Sha256Stream&) = delete;
+  Sha256Stream& operator=(const Sha256Stream&) = delete;
+  void update(std::string_view bytes);
+  std::string hex();  // of everything given; once
+
+ private:
+  void* context_;  // OpenSSL's EVP_MD_CTX
+};
 // An entry of `dir` for `key` (the entry file is named by the key's SHA-256 and holds the key
 // whole): its payload when the entry is whole and for this key; `damaged` says why not when the
 // file exists but is not (otherwise the entry is missing).

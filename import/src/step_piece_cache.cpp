@@ -13,7 +13,7 @@ namespace {
 
 std::string piece_key(const StepPiece& piece) {
   // The piece's shapes are transferred with this thread's healing setting (cad_xcaf.h).
-  return cache_versions() + "step piece sha256 " + sha256_hex(piece.canonical) +
+  return cache_versions() + "step piece sha256 " + piece.canonical_sha256 +
          (transfer_healing_on() ? "\n" : "\nno transfer healing\n");
 }
 

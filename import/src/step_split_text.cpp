@@ -1,5 +1,7 @@
 // A STEP file's text cut into pieces by B-rep item (step_split_text.h).
 #include "step_split_text.h"
+
+#include "import_cache.h"
 #include "step_statements.h"
 
 #include <algorithm>
@@ -623,13 +625,20 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       piece.ids.push_back(st[k].id);
       number[k] = static_cast<std::int64_t>(piece.ids.size());
     }
-    std::string& c = piece.canonical;
-    c.reserve(piece.text.size());
+    // Hashed a megabyte at a time: the canonical text is as long as the piece's, and only its digest is kept.
+    constexpr std::size_t kChunk = std::size_t{1} << 20;
+    Sha256Stream digest;
+    std::string c;
+    c.reserve(kChunk + (std::size_t{1} << 16));
     c.append(file_schema(sc.header));
     c += '\n';
     for (const std::uint32_t k : members[w]) {
       renumbered(text, k, st[k], refs_of(k), number, c);
       c += '\n';
+      if (c.size() >= kChunk) {
+        digest.update(c);
+        c.clear();
+      }
     }
     for (const Synthetic& r : synthetic_reps[w]) {  // appended piece by piece: GCC 12 warns falsely on "#" + string
       piece.ids.push_back(r.id);
@@ -644,6 +653,8 @@ std::optional<StepSplit> split_step_text(const std::string& text, bool canonical
       c += std::to_string(number[r.context_statement]);
       c += ");\n";
     }
+    digest.update(c);
+    piece.canonical_sha256 = digest.hex();
   };
   std::atomic<std::uint32_t> next{0};
   auto write_pieces = [&] {

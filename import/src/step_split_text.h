@@ -23,10 +23,11 @@ struct StepPiece {
   // What it costs to read, in bytes' worth (for sharing pieces out): its bytes, and for each face
   // with n bounds 2 n^2 / 3 (OCCT's healing at transfer compares every wire with every other).
   std::size_t weight = 0;
-  // With `canonical` asked: the piece's schema and statements with ids renumbered 1, 2, ... in the
-  // order the piece defines them (the same for the same product however the rest of the file is
-  // numbered), and ids[c - 1] the id in `text` of canonical id c.
-  std::string canonical;
+  // With `canonical` asked: the SHA-256 (hex) of the piece's canonical text, its schema and
+  // statements with ids renumbered 1, 2, ... in the order the piece defines them (the same for the
+  // same product however the rest of the file is numbered; hashed as it is made, never held
+  // whole), and ids[c - 1] the id in `text` of canonical id c.
+  std::string canonical_sha256;
   std::vector<std::int64_t> ids;
 };
 
