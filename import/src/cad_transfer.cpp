@@ -25,6 +25,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cassert>
 #include <atomic>
 #include <mutex>
 #include <sstream>
@@ -157,6 +158,7 @@ void write_walked(ByteWriter& w, const WalkedDocument& d, std::size_t threads) {
     BinTools::Write(together, out, Standard_False, Standard_False, BinTools_FormatVersion_CURRENT);  // throws: no payload
     w.str(std::move(out).str());
   }
+  assert(d.chains.size() == d.instances.size());
   w.u64(d.instances.size());
   for (std::size_t k = 0; k < d.instances.size(); ++k) {
     const Instance& instance = d.instances[k];
@@ -164,9 +166,8 @@ void write_walked(ByteWriter& w, const WalkedDocument& d, std::size_t threads) {
     w.u64(instance.part);
     const double* m = instance.pose.matrix().data();
     for (int i = 0; i < 16; ++i) w.f64(m[i]);
-    const std::vector<std::string>& chain = k < d.chains.size() ? d.chains[k] : std::vector<std::string>{};
-    w.u64(chain.size());
-    for (const std::string& entry : chain) w.str(entry);
+    w.u64(d.chains[k].size());
+    for (const std::string& entry : d.chains[k]) w.str(entry);
   }
 }
 
