@@ -11,6 +11,7 @@
 
 #include <cassert>
 #include <chrono>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -125,9 +126,9 @@ bool load_part(std::string_view bytes, const BrepPartInput& in, OnePart& out, st
 constexpr std::string_view kBinToolsHeader = "Open CASCADE Topology V";
 
 // The shapes of the parts listed in `which` made from their packed bytes, on every thread; a shape
-// OCCT cannot make is an error in `notes` (in part order) and an empty compound.
+// OCCT cannot make is an error in `notes` (in part order), an empty compound, and `complete` false.
 void unpack_shapes(const PackedShapes& packed, std::span<const BrepPartInput> parts, const std::vector<std::size_t>& which,
-                   std::vector<Diagnostic>& notes) {
+                   std::vector<Diagnostic>& notes, bool& complete) {
   std::vector<std::string> failed(which.size());
 #pragma omp parallel for schedule(dynamic, 1) if (which.size() > 1)
   for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(which.size()); ++i) {
@@ -151,6 +152,7 @@ void unpack_shapes(const PackedShapes& packed, std::span<const BrepPartInput> pa
     TopoDS_Compound empty;
     BRep_Builder().MakeCompound(empty);
     packed.shapes[k] = empty;
+    complete = false;
     notes.push_back({Severity::Error, parts[k].source_file, 0, -1,
                      "part '" + parts[k].name + "' could not be made again from what the isolated reader sent (" + failed[i] +
                          "); it is left without faces"});
@@ -169,11 +171,8 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
       (packed == nullptr && brep_inputs_share_edges(parts))) {
     if (packed != nullptr) {
       std::vector<std::size_t> all(parts.size());
-      for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
-      std::vector<Diagnostic> notes;
-      unpack_shapes(*packed, parts, all, notes);
-      for (const Diagnostic& d : notes) complete = complete && d.severity != Severity::Error;
-      diagnostics.insert(diagnostics.end(), notes.begin(), notes.end());
+      std::iota(all.begin(), all.end(), std::size_t{0});
+      unpack_shapes(*packed, parts, all, diagnostics, complete);
     }
     return add_brep_parts(model, parts, options.tessellation, options.lazy, diagnostics, complete, timings);
   }
@@ -215,12 +214,7 @@ std::vector<PartId> add_brep_parts_cached(Model& model, std::span<const BrepPart
   // Finding and loading the held parts stands in for checking and healing them.
   if (timings) timings->heal += std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   // The others' shapes, when they came packed: made now (reading them, not healing).
-  if (packed != nullptr && !missing.empty()) {
-    std::vector<Diagnostic> said;
-    unpack_shapes(*packed, parts, missing, said);
-    for (const Diagnostic& d : said) complete = complete && d.severity != Severity::Error;
-    notes.insert(notes.end(), said.begin(), said.end());
-  }
+  if (packed != nullptr && !missing.empty()) unpack_shapes(*packed, parts, missing, notes, complete);
 
   std::vector<char> written(n, 0);  // made parts whose entry was written
   if (!to_make.empty()) {
